@@ -1,0 +1,100 @@
+// Every switch of the reconstruction, so that Guo's method, the paper's
+// enhancements and dcm's own additions can be measured side by side.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <string_view>
+
+#include "dcm/status.h"
+
+namespace dcm {
+
+/// When two neighbouring pixels see different surfaces (paper 2.2 and 3.2).
+enum class ObjectTest {
+  kNone,             ///< no ID test: contrast only
+  kObjectId,         ///< Guo: the object ID differs
+  kObjectAndShader,  ///< Scheel 3.2: object ID AND shader ID differ
+};
+
+/// The per-pixel thin-object test at the finest level (paper 3.1).
+enum class ThinObjectTest {
+  kOff,          ///< Guo: interpolate every interior pixel
+  kNoneMatches,  ///< paper as written: exact when no border sample used is on the pixel's surface
+  kAnyDiffers,   ///< exact when any border sample used lies on another surface
+};
+
+/// What happens to a smooth block above the finest level.
+enum class SmoothRefinement {
+  kAlways,       ///< paper 2.1 as written: split it and classify the children again
+  kCentreProbe,  ///< evaluate its centre; split only where the bilinear prediction misses it
+  kNever,        ///< smooth blocks are final at the level where they are found
+};
+
+/// How the contrast of a set of samples is measured.
+enum class ContrastMetric {
+  kMitchell,  ///< (max-min)/(max+min) of luminance, as in the paper
+  kDisplay,   ///< max-min of sRGB-encoded luminance clipped to [0,1] (display units)
+};
+
+/// Options of one reconstruction. Defaults are dcm's; Guo() and Paper() give
+/// the published methods.
+struct ReconstructionOptions {
+  int elementaryBlock = 8;   ///< size of level-0 blocks (a power of two)
+  int minBlock = 4;          ///< finest block size (a power of two <= elementaryBlock)
+  float contrastThreshold = 0.06f;  ///< smooth/edge threshold of the contrast test
+  ContrastMetric contrastMetric = ContrastMetric::kMitchell;
+  int directions = 8;        ///< candidate directions of the least-discrepancy search
+
+  ObjectTest objectTest = ObjectTest::kObjectAndShader;
+  ThinObjectTest thinObjects = ThinObjectTest::kAnyDiffers;
+  /// An interior pixel interpolates only border samples on its own surface.
+  bool surfaceAware = true;
+  /// Interpolate (L_i, L_c) and re-apply tau per pixel (paper 3.3).
+  bool textureSplit = true;
+
+  SmoothRefinement smoothRefinement = SmoothRefinement::kCentreProbe;
+
+  bool zeroOrderTest = true;   ///< simple/complex: exactly two changes along the border
+  /// An edge block with no significant change along its border (a smooth
+  /// gradient that failed the corner contrast) counts as simple.
+  bool gradientBlocksSimple = true;
+  bool firstOrderTest = true;  ///< simple/complex: same edge direction at both crossings
+  bool lazyEvaluation = true;  ///< children of simple edge blocks: centre pixel only
+  /// At the finest level, evaluate the interior of an edge block whose border
+  /// shows more than `fallbackMaxChanges` significant changes (more than two
+  /// discontinuities cross it: no single direction can serve it).
+  bool fallback = true;
+  int fallbackMaxChanges = 4;
+
+  int downsample = 1;   ///< the working image is `downsample`x the output per axis
+  bool fullEvaluation = false;  ///< baseline: evaluate every pixel exactly
+
+  int threads = 0;      ///< 0: all cores
+  int tileSize = 64;    ///< pixels per side of a unit of parallel work (multiple of elementaryBlock)
+  int batchSize = 4096; ///< pixels per Evaluate() call
+
+  /// Progress in [0,1] with the name of the stage; called from the calling thread.
+  std::function<void(float, std::string_view)> progress;
+
+  /// Guo 1998 as described in section 2 of the paper: no thin-object test,
+  /// object-ID test, no texture split, interpolation blind to surfaces.
+  static ReconstructionOptions Guo();
+  /// Scheel et al. 2001: Guo plus the three enhancements as written.
+  static ReconstructionOptions Paper();
+
+  /// Checks ranges and consistency; the message names the field.
+  Status Validate() const;
+};
+
+/// Names for statistics, metadata and command lines.
+std::string_view ToString(ObjectTest);
+std::string_view ToString(ThinObjectTest);
+std::string_view ToString(ContrastMetric);
+std::string_view ToString(SmoothRefinement);
+Status Parse(std::string_view, ObjectTest*);
+Status Parse(std::string_view, ThinObjectTest*);
+Status Parse(std::string_view, ContrastMetric*);
+Status Parse(std::string_view, SmoothRefinement*);
+
+}  // namespace dcm

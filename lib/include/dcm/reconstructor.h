@@ -1,0 +1,81 @@
+// The DCM reconstruction: the one entry point of the engine.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+#include "dcm/color.h"
+#include "dcm/options.h"
+#include "dcm/sample_provider.h"
+#include "dcm/status.h"
+
+namespace dcm {
+
+/// Why a pixel of the working image was evaluated exactly.
+enum class SampleReason : uint8_t {
+  kInterpolated = 0,  ///< not exact
+  kCorner,            ///< corner of a block (lattice point)
+  kBorder,            ///< border of an edge block
+  kFirstOrderProbe,   ///< next to a border crossing, for the first-order test
+  kLazyCentre,        ///< centre of a simple edge block (lazy evaluation)
+  kThinObject,        ///< interior pixel on another surface than its interpolants (3.1)
+  kFallback,          ///< interior of a block no direction explains
+  kFull,              ///< full evaluation (baseline)
+  kCount
+};
+inline constexpr int kSampleReasonCount = int(SampleReason::kCount);
+std::string_view ToString(SampleReason);
+
+/// How a block was finally reconstructed.
+enum class BlockType : uint8_t {
+  kSmooth,       ///< bilinear from the four corners
+  kSimpleEdge,   ///< finest level, oriented elements, at most two border changes
+  kComplexEdge,  ///< finest level, oriented elements, more changes
+  kLazy,         ///< simple edge block: parent's direction, corrected by its exact centre
+  kFallback,     ///< interior evaluated exactly
+};
+std::string_view ToString(BlockType);
+
+/// One leaf block of the final structure (corners inclusive).
+struct BlockRecord {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  uint8_t level = 0;
+  BlockType type = BlockType::kSmooth;
+  int8_t direction = -1;  ///< index of the least-discrepancy direction, -1 for none
+};
+
+struct ReconstructionStats {
+  int64_t totalPixels = 0;   ///< working-image pixels
+  int64_t exactPixels = 0;
+  std::array<int64_t, kSampleReasonCount> byReason{};
+  int64_t nonFiniteSamples = 0;  ///< exact samples with NaN or infinity, kept to their pixel
+  int64_t smoothBlocks = 0, simpleEdgeBlocks = 0, complexEdgeBlocks = 0;
+  int64_t lazyAccepted = 0, lazyRejected = 0, fallbackBlocks = 0;
+  int64_t providerCalls = 0;
+  double timeGuidesS = 0;    ///< in the provider's Guides()
+  double timeProviderS = 0;  ///< in the provider's Evaluate() (the illumination)
+  double timeEngineS = 0;    ///< everything else
+  bool usedSplit = false, usedObjectId = false, usedShaderId = false;
+  double exactFraction() const { return totalPixels ? double(exactPixels) / double(totalPixels) : 0.0; }
+};
+
+/// The result of a reconstruction.
+struct Reconstruction {
+  int width = 0, height = 0;          ///< output resolution
+  std::vector<RGB> image;             ///< output, row-major
+  int workWidth = 0, workHeight = 0;  ///< working (supersampled) resolution
+  std::vector<RGB> workImage;         ///< reconstruction before downsampling
+  std::vector<SampleReason> sampleMap;  ///< per working pixel
+  std::vector<BlockRecord> blocks;    ///< final leaf blocks
+  ReconstructionStats stats;
+};
+
+/// Reconstructs the provider's image with DCM. On error `out` is unspecified.
+/// With a provider that answers Status::Pending, returns that status and
+/// leaves the requested pixels in `pending`.
+Status Reconstruct(SampleProvider& provider, const ReconstructionOptions& options,
+                   Reconstruction* out, std::vector<Point2i>* pending = nullptr);
+
+}  // namespace dcm

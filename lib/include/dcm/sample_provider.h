@@ -1,0 +1,85 @@
+// The protocol between the engine and any renderer: cheap guides for a region,
+// expensive exact samples for a batch of pixels.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "dcm/color.h"
+#include "dcm/geometry.h"
+#include "dcm/status.h"
+
+namespace dcm {
+
+/// What a provider can deliver for the scene it serves. A provider reports what
+/// the *scene* calls for: a scene without textures reports `texture = false`
+/// even if the renderer could compute a texture value.
+struct ProviderCapabilities {
+  int width = 0;   ///< working resolution (the supersampled image), pixels
+  int height = 0;
+  bool objectId = false;       ///< guides carry an object ID per pixel
+  bool shaderId = false;       ///< guides carry a shader (material) ID per pixel
+  bool texture = false;        ///< guides carry the texture value tau per pixel
+  bool splitRadiance = false;  ///< samples carry (L_i, L_c) with L = L_i*tau + L_c
+  bool variance = false;       ///< samples carry the variance of their estimate of L
+  /// Evaluate() may be called concurrently from several threads on disjoint
+  /// batches. Providers that are not thread safe are called from one thread.
+  bool threadSafe = true;
+  std::string name;  ///< for statistics and messages
+};
+
+/// Which guides to fill.
+struct GuideRequest {
+  bool objectId = false;
+  bool shaderId = false;
+  bool texture = false;
+};
+
+/// Guides for a region, row-major over `region`; arrays not requested stay empty.
+struct GuideImage {
+  Bounds2i region;
+  std::vector<uint32_t> objectId;
+  std::vector<uint32_t> shaderId;
+  std::vector<RGB> texture;  ///< tau
+};
+
+/// Which parts of an exact sample to compute.
+struct SampleRequest {
+  bool split = false;     ///< fill L_i and L_c
+  bool variance = false;  ///< fill variance
+};
+
+/// One exact (expensive) sample of a pixel.
+struct ExactSample {
+  RGB L;         ///< radiance; always filled
+  RGB Li;        ///< radiance before texturing (L_t / tau); with `split`
+  RGB Lc;        ///< radiance not modulated by the texture; with `split`
+  RGB variance;  ///< variance of the estimate of L; with `variance`
+};
+
+/// A source of guides and exact samples: the internal ray tracer, EXR AOVs of
+/// another renderer, a callback of a host application, or a child process.
+///
+/// Contract: exact samples are deterministic per pixel (the same pixel gives
+/// the same bits whatever the batch, its order or the thread), so that the
+/// engine's result does not depend on thread count or tiling.
+class SampleProvider {
+ public:
+  virtual ~SampleProvider() = default;
+
+  /// What this provider can deliver; constant for the provider's lifetime.
+  virtual ProviderCapabilities Capabilities() const = 0;
+
+  /// Fills the requested guides for `region` (inside the working image).
+  virtual Status Guides(const Bounds2i& region, const GuideRequest& what, GuideImage* out) = 0;
+
+  /// Evaluates `pixels` exactly; `out` has the same size as `pixels`. May
+  /// return Status::Pending when the samples must come from another process
+  /// (the engine then reports the requested pixels and stops).
+  virtual Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what,
+                          std::span<ExactSample> out) = 0;
+};
+
+}  // namespace dcm

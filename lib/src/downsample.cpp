@@ -1,0 +1,30 @@
+#include "downsample.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+
+namespace dcm::detail {
+
+std::vector<RGB> BoxDownsample(const std::vector<RGB>& in, int w, int h, int s, int* outW, int* outH) {
+  *outW = (w + s - 1) / s;
+  *outH = (h + s - 1) / s;
+  if (s == 1) return in;
+  std::vector<RGB> out(size_t(*outW) * size_t(*outH));
+  const int ow = *outW;
+  tbb::parallel_for(0, *outH, [&](int oy) {
+    for (int ox = 0; ox < ow; ++ox) {
+      double acc[3] = {0, 0, 0};
+      int n = 0;
+      for (int y = oy * s; y < std::min(h, oy * s + s); ++y)
+        for (int x = ox * s; x < std::min(w, ox * s + s); ++x, ++n) {
+          const RGB& c = in[size_t(y) * size_t(w) + size_t(x)];
+          acc[0] += c.r, acc[1] += c.g, acc[2] += c.b;
+        }
+      out[size_t(oy) * size_t(ow) + size_t(ox)] = RGB(float(acc[0] / n), float(acc[1] / n), float(acc[2] / n));
+    }
+  });
+  return out;
+}
+
+}  // namespace dcm::detail

@@ -1,0 +1,35 @@
+// Simple vs complex edge blocks (paper 2.3): the zero-order test counts the
+// significant changes along the border, the first-order test compares the
+// direction of the discontinuity at its two crossings, the ID test counts the
+// surfaces on the border.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "block.h"
+#include "contrast_test.h"
+#include "sample_store.h"
+
+namespace dcm::detail {
+
+/// Positions k in the closed loop where loop[k] and loop[k+1] differ
+/// significantly (a crossing lies between them).
+std::vector<int> SignificantChanges(const SampleStore& store, const ContrastTest& contrast,
+                                    std::span<const Point2i> loop);
+
+/// Number of surface changes between consecutive pixels of the closed loop.
+int SurfaceChanges(const SampleStore& store, std::span<const Point2i> loop);
+
+/// The pixels one step inside the border next to each crossing (two per
+/// crossing), which the first-order test evaluates.
+std::vector<Point2i> FirstOrderProbes(const Block& b, std::span<const Point2i> loop,
+                                      std::span<const int> crossings);
+
+/// True when the discontinuity has about the same direction at both of its two
+/// crossings and along the chord between them (within 40 degrees: one inward
+/// pixel step resolves directions to 45 degrees). Needs the probes evaluated.
+bool FirstOrderConsistent(const SampleStore& store, const ContrastTest& contrast, const Block& b,
+                          std::span<const Point2i> loop, std::span<const int> crossings);
+
+}  // namespace dcm::detail

@@ -1,0 +1,96 @@
+#include <array>
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "dcm/options.h"
+
+namespace dcm {
+
+ReconstructionOptions ReconstructionOptions::Guo() {
+  ReconstructionOptions o;
+  o.objectTest = ObjectTest::kObjectId;
+  o.thinObjects = ThinObjectTest::kOff;
+  o.surfaceAware = false;
+  o.textureSplit = false;
+  o.smoothRefinement = SmoothRefinement::kAlways;
+  o.gradientBlocksSimple = false;
+  o.fallback = false;
+  return o;
+}
+
+ReconstructionOptions ReconstructionOptions::Paper() {
+  ReconstructionOptions o = Guo();
+  o.objectTest = ObjectTest::kObjectAndShader;
+  o.thinObjects = ThinObjectTest::kNoneMatches;
+  o.textureSplit = true;
+  o.fallback = true;  // "switching back to a full sampling for these few critical cases"
+  return o;
+}
+
+namespace {
+bool IsPowerOfTwo(int v) { return v > 0 && (v & (v - 1)) == 0; }
+
+template <typename E, size_t N>
+Status ParseName(std::string_view text, const std::array<std::pair<std::string_view, E>, N>& names,
+                 const char* what, E* out) {
+  std::string valid;
+  for (const auto& [name, value] : names) {
+    if (text == name) {
+      *out = value;
+      return Status::Ok();
+    }
+    valid += (valid.empty() ? "" : ", ") + std::string(name);
+  }
+  return Status::Error(std::string(what) + ": unknown value '" + std::string(text) + "' (valid: " + valid + ")");
+}
+
+template <typename E, size_t N>
+std::string_view NameOf(E value, const std::array<std::pair<std::string_view, E>, N>& names) {
+  for (const auto& [name, v] : names)
+    if (v == value) return name;
+  return "?";
+}
+
+constexpr std::array<std::pair<std::string_view, ObjectTest>, 3> kObjectTests{{
+    {"none", ObjectTest::kNone}, {"id", ObjectTest::kObjectId}, {"id+shader", ObjectTest::kObjectAndShader}}};
+constexpr std::array<std::pair<std::string_view, ThinObjectTest>, 3> kThinTests{{
+    {"off", ThinObjectTest::kOff}, {"none-matches", ThinObjectTest::kNoneMatches},
+    {"any-differs", ThinObjectTest::kAnyDiffers}}};
+constexpr std::array<std::pair<std::string_view, ContrastMetric>, 2> kMetrics{{
+    {"mitchell", ContrastMetric::kMitchell}, {"display", ContrastMetric::kDisplay}}};
+constexpr std::array<std::pair<std::string_view, SmoothRefinement>, 3> kRefinements{{
+    {"always", SmoothRefinement::kAlways}, {"centre-probe", SmoothRefinement::kCentreProbe},
+    {"never", SmoothRefinement::kNever}}};
+}  // namespace
+
+std::string_view ToString(ObjectTest v) { return NameOf(v, kObjectTests); }
+std::string_view ToString(ThinObjectTest v) { return NameOf(v, kThinTests); }
+std::string_view ToString(ContrastMetric v) { return NameOf(v, kMetrics); }
+std::string_view ToString(SmoothRefinement v) { return NameOf(v, kRefinements); }
+Status Parse(std::string_view t, ObjectTest* o) { return ParseName(t, kObjectTests, "object test", o); }
+Status Parse(std::string_view t, ThinObjectTest* o) { return ParseName(t, kThinTests, "thin-object test", o); }
+Status Parse(std::string_view t, ContrastMetric* o) { return ParseName(t, kMetrics, "contrast metric", o); }
+Status Parse(std::string_view t, SmoothRefinement* o) { return ParseName(t, kRefinements, "smooth refinement", o); }
+
+Status ReconstructionOptions::Validate() const {
+  auto bad = [](const std::string& field, const std::string& why) {
+    return Status::Error("option " + field + ": " + why);
+  };
+  if (!IsPowerOfTwo(elementaryBlock) || elementaryBlock > 256)
+    return bad("elementaryBlock", "must be a power of two from 1 to 256, got " + std::to_string(elementaryBlock));
+  if (!IsPowerOfTwo(minBlock) || minBlock > elementaryBlock)
+    return bad("minBlock", "must be a power of two from 1 to elementaryBlock (" + std::to_string(elementaryBlock) +
+                               "), got " + std::to_string(minBlock));
+  if (!(contrastThreshold >= 0) || !std::isfinite(contrastThreshold))
+    return bad("contrastThreshold", "must be a finite number >= 0");
+  if (directions < 1 || directions > 64) return bad("directions", "must be from 1 to 64, got " + std::to_string(directions));
+  if (fallbackMaxChanges < 0) return bad("fallbackMaxChanges", "must be >= 0");
+  if (downsample < 1 || downsample > 64) return bad("downsample", "must be from 1 to 64, got " + std::to_string(downsample));
+  if (threads < 0) return bad("threads", "must be >= 0");
+  if (tileSize < 1) return bad("tileSize", "must be >= 1");
+  if (batchSize < 1) return bad("batchSize", "must be >= 1");
+  return Status::Ok();
+}
+
+}  // namespace dcm

@@ -1,0 +1,518 @@
+// The DCM driver: level by level, phase by phase (collect requests, evaluate
+// the batch, classify, next requests). Every decision about a block depends
+// only on samples at its own pixels, and requests are deduplicated per phase,
+// so the result is the same for any thread count and tile size.
+#include "dcm/reconstructor.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <string>
+
+#include "block.h"
+#include "contrast_test.h"
+#include "downsample.h"
+#include "edge_classification.h"
+#include "least_discrepancy_direction.h"
+#include "oriented_interpolation.h"
+#include "sample_store.h"
+
+namespace dcm {
+
+std::string_view ToString(SampleReason r) {
+  switch (r) {
+    case SampleReason::kInterpolated: return "interpolated";
+    case SampleReason::kCorner: return "corner";
+    case SampleReason::kBorder: return "border";
+    case SampleReason::kFirstOrderProbe: return "first_order_probe";
+    case SampleReason::kLazyCentre: return "lazy_centre";
+    case SampleReason::kThinObject: return "thin_object";
+    case SampleReason::kFallback: return "fallback";
+    case SampleReason::kFull: return "full";
+    case SampleReason::kCount: break;
+  }
+  return "?";
+}
+
+std::string_view ToString(BlockType t) {
+  switch (t) {
+    case BlockType::kSmooth: return "smooth";
+    case BlockType::kSimpleEdge: return "simple_edge";
+    case BlockType::kComplexEdge: return "complex_edge";
+    case BlockType::kLazy: return "lazy";
+    case BlockType::kFallback: return "fallback";
+  }
+  return "?";
+}
+
+namespace detail {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// A block whose reconstruction is settled.
+struct Leaf {
+  Block block;
+  BlockType type = BlockType::kSmooth;
+  int8_t direction = -1;
+  // Lazy leaves: the exact centre corrects the parent's interpolation.
+  Point2i centre;
+  Value delta;
+  Value lo, hi;  // range of the samples the leaf interpolates
+};
+
+Leaf MakeLeaf(const Block& b, BlockType type, int dir = -1) {
+  Leaf l;
+  l.block = b;
+  l.type = type;
+  l.direction = int8_t(dir);
+  return l;
+}
+
+/// An edge block with its border known.
+struct EdgeBlock {
+  Block block;
+  std::vector<Point2i> border;
+  DirectionChoice direction;
+  std::vector<int> crossings;
+  bool simple = false;
+};
+
+class Engine {
+ public:
+  Engine(SampleProvider& provider, const ReconstructionOptions& opt, const ProviderCapabilities& caps,
+         bool split)
+      : provider_(provider),
+        opt_(opt),
+        caps_(caps),
+        split_(split),
+        store_(caps.width, caps.height, split),
+        contrast_(opt.contrastMetric, opt.contrastThreshold, split) {
+    const int blocksPerTile = std::max(1, opt.tileSize / std::max(1, opt.elementaryBlock));
+    grain_ = size_t(blocksPerTile) * size_t(blocksPerTile);
+    request_.split = split;
+  }
+
+  Status Run(Reconstruction* out, std::vector<Point2i>* pending);
+
+ private:
+  template <typename T, typename F>
+  void ForEach(std::vector<T>& items, F&& f) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, items.size(), grain_),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                        for (size_t i = r.begin(); i != r.end(); ++i) f(items[i], i);
+                      });
+  }
+  Status Flush() {
+    return store_.Flush(provider_, request_, opt_.batchSize, caps_.threadSafe, &stats_, pending_);
+  }
+  void Progress(float f, std::string_view stage) {
+    if (opt_.progress) opt_.progress(f, stage);
+  }
+
+  Status LoadGuides();
+  void RequestCorners(const Block& b) {
+    for (Point2i p : {Point2i{b.x0, b.y0}, Point2i{b.x1, b.y0}, Point2i{b.x0, b.y1}, Point2i{b.x1, b.y1}})
+      store_.Request(p.x, p.y, SampleReason::kCorner);
+  }
+  Value At(Point2i p) const { return store_.ValueAt(store_.Index(p.x, p.y)); }
+  bool IsSmooth(const Block& b) const;
+  bool HasSurfaceChange(const Block& b) const;
+
+  /// Resolves the interpolant of interior pixel q against the surfaces and the
+  /// finite samples. Returns the reason q must be exact, or kInterpolated.
+  SampleReason Resolve(Point2i q, Interpolant* in) const;
+  void WriteSmooth(const Leaf& leaf);
+  void WriteOriented(const Leaf& leaf);
+  void RecordLeaves(Reconstruction* out);
+
+  SampleProvider& provider_;
+  const ReconstructionOptions& opt_;
+  ProviderCapabilities caps_;
+  bool split_;
+  SampleStore store_;
+  ContrastTest contrast_;
+  SampleRequest request_;
+  size_t grain_ = 1;
+  ReconstructionStats stats_;
+  std::vector<Point2i>* pending_ = nullptr;
+  std::vector<Leaf> smoothLeaves_, orientedLeaves_, fallbackLeaves_;
+};
+
+Status Engine::LoadGuides() {
+  GuideRequest want;
+  want.objectId = caps_.objectId && opt_.objectTest != ObjectTest::kNone;
+  want.shaderId = want.objectId && caps_.shaderId && opt_.objectTest == ObjectTest::kObjectAndShader;
+  want.texture = split_;
+  stats_.usedObjectId = want.objectId;
+  stats_.usedShaderId = want.shaderId;
+  stats_.usedSplit = split_;
+  if (!want.objectId && !want.texture) {
+    store_.SetGuides({}, ObjectTest::kNone);
+    return Status::Ok();
+  }
+  const Bounds2i all{{0, 0}, {caps_.width, caps_.height}};
+  GuideImage g;
+  const auto t0 = Clock::now();
+  DCM_RETURN_IF_ERROR(provider_.Guides(all, want, &g));
+  stats_.timeGuidesS += std::chrono::duration<double>(Clock::now() - t0).count();
+  const size_t n = size_t(all.area());
+  auto check = [&](bool wanted, size_t size, const char* name) {
+    if (wanted && size != n)
+      return Status::Error(std::string("provider '") + caps_.name + "' returned " + std::to_string(size) + " " +
+                           name + " guide values for " + std::to_string(n) + " pixels");
+    return Status::Ok();
+  };
+  DCM_RETURN_IF_ERROR(check(want.objectId, g.objectId.size(), "object ID"));
+  DCM_RETURN_IF_ERROR(check(want.shaderId, g.shaderId.size(), "shader ID"));
+  DCM_RETURN_IF_ERROR(check(want.texture, g.texture.size(), "texture"));
+  store_.SetGuides(std::move(g), want.objectId ? opt_.objectTest : ObjectTest::kNone);
+  return Status::Ok();
+}
+
+bool Engine::HasSurfaceChange(const Block& b) const {
+  const SurfaceTest& s = store_.surfaces();
+  if (!s.enabled()) return false;
+  for (int y = b.y0; y <= b.y1; ++y)
+    for (int x = b.x0; x <= b.x1; ++x) {
+      const int64_t i = store_.Index(x, y);
+      if (x < b.x1 && !s.Same(i, i + 1)) return true;
+      if (y < b.y1 && !s.Same(i, i + store_.width())) return true;
+    }
+  return false;
+}
+
+bool Engine::IsSmooth(const Block& b) const {
+  const Value corners[4] = {At({b.x0, b.y0}), At({b.x1, b.y0}), At({b.x0, b.y1}), At({b.x1, b.y1})};
+  return !contrast_.IsEdge(corners) && !HasSurfaceChange(b);
+}
+
+SampleReason Engine::Resolve(Point2i q, Interpolant* in) const {
+  const int64_t iq = store_.Index(q.x, q.y);
+  const SurfaceTest& s = store_.surfaces();
+  bool anyOther = false, anySame = false;
+  Interpolant kept;
+  Interpolant finite;
+  for (int k = 0; k < in->count; ++k) {
+    const int64_t i = in->index[k];
+    if (!store_.IsFinite(i)) continue;  // non-finite samples never spread
+    finite.index[finite.count] = i, finite.weight[finite.count++] = in->weight[k];
+    if (s.Same(iq, i)) {
+      anySame = true;
+      kept.index[kept.count] = i, kept.weight[kept.count++] = in->weight[k];
+    } else {
+      anyOther = true;
+    }
+  }
+  if (opt_.thinObjects == ThinObjectTest::kAnyDiffers && anyOther) return SampleReason::kThinObject;
+  if (opt_.thinObjects == ThinObjectTest::kNoneMatches && !anySame && s.enabled())
+    return SampleReason::kThinObject;
+  Interpolant& use = (opt_.surfaceAware && kept.count > 0) ? kept : finite;
+  if (use.count == 0) return SampleReason::kFallback;
+  double sum = 0;
+  for (int k = 0; k < use.count; ++k) sum += use.weight[k];
+  for (int k = 0; k < use.count; ++k) use.weight[k] /= sum;
+  *in = use;
+  return SampleReason::kInterpolated;
+}
+
+void Engine::WriteSmooth(const Leaf& leaf) {
+  const Block& b = leaf.block;
+  // A smooth leaf owns [x0, x1) x [y0, y1), and its last column and row at the
+  // image border: leaves partition the image, so no pixel is written twice.
+  const int xe = (b.x1 == store_.width() - 1 || b.x1 == b.x0) ? b.x1 : b.x1 - 1;
+  const int ye = (b.y1 == store_.height() - 1 || b.y1 == b.y0) ? b.y1 : b.y1 - 1;
+  // Bilinear as two linear steps in double (exact for linear ramps up to the
+  // final rounding to float); the six channels are (a, b) of Value.
+  double c[4][6];
+  const Point2i corners[4] = {{b.x0, b.y0}, {b.x1, b.y0}, {b.x0, b.y1}, {b.x1, b.y1}};
+  for (int k = 0; k < 4; ++k) {
+    const Value v = At(corners[k]);
+    for (int ch = 0; ch < 3; ++ch) c[k][ch] = v.a[ch], c[k][3 + ch] = v.b[ch];
+  }
+  const double sx = b.x1 > b.x0 ? 1.0 / (b.x1 - b.x0) : 0.0, sy = b.y1 > b.y0 ? 1.0 / (b.y1 - b.y0) : 0.0;
+  const int channels = split_ ? 6 : 3;
+  for (int y = b.y0; y <= ye; ++y) {
+    const double v = (y - b.y0) * sy;
+    double left[6], right[6];
+    for (int ch = 0; ch < channels; ++ch) {
+      left[ch] = v == 0 ? c[0][ch] : (1 - v) * c[0][ch] + v * c[2][ch];
+      right[ch] = v == 0 ? c[1][ch] : (1 - v) * c[1][ch] + v * c[3][ch];
+    }
+    for (int x = b.x0; x <= xe; ++x) {
+      const int64_t i = store_.Index(x, y);
+      if (store_.IsExact(i)) continue;
+      const double u = (x - b.x0) * sx;
+      Value out;
+      for (int ch = 0; ch < channels; ++ch) {
+        const float f = float(u == 0 ? left[ch] : (1 - u) * left[ch] + u * right[ch]);
+        if (ch < 3) out.a[ch] = f;
+        else out.b[ch - 3] = f;
+      }
+      store_.SetInterpolated(i, out);
+    }
+  }
+}
+
+void Engine::WriteOriented(const Leaf& leaf) {
+  const Block& b = leaf.block;
+  const Direction d = Direction::Of(leaf.direction, opt_.directions);
+  const bool lazy = leaf.type == BlockType::kLazy;
+  const double hx = 0.5 * (b.x1 - b.x0), hy = 0.5 * (b.y1 - b.y0);
+  for (int y = b.y0 + 1; y < b.y1; ++y)
+    for (int x = b.x0 + 1; x < b.x1; ++x) {
+      const int64_t i = store_.Index(x, y);
+      if (store_.IsExact(i)) continue;
+      Interpolant in;
+      if (!OrientedInterpolant(store_, b, {x, y}, d, &in) || Resolve({x, y}, &in) != SampleReason::kInterpolated)
+        continue;  // cannot happen after the thin-object pass; keep the pixel untouched
+      Value v = Evaluate(store_, in);
+      if (lazy) {
+        // The centre sample corrects the parent's interpolation with a tent
+        // that is 1 at the centre and 0 on the border; the result stays in
+        // the range of the samples used.
+        const double w = std::max(0.0, 1 - std::fabs(x - leaf.centre.x) / hx) *
+                         std::max(0.0, 1 - std::fabs(y - leaf.centre.y) / hy);
+        for (int c = 0; c < 3; ++c) {
+          v.a[c] = std::clamp(float(v.a[c] + w * leaf.delta.a[c]), leaf.lo.a[c], leaf.hi.a[c]);
+          v.b[c] = std::clamp(float(v.b[c] + w * leaf.delta.b[c]), leaf.lo.b[c], leaf.hi.b[c]);
+        }
+      }
+      store_.SetInterpolated(i, v);
+    }
+}
+
+Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
+  pending_ = pending;
+  const auto tStart = Clock::now();
+  const int W = caps_.width, H = caps_.height;
+  DCM_RETURN_IF_ERROR(LoadGuides());
+
+  if (opt_.fullEvaluation) {
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) store_.Request(x, y, SampleReason::kFull);
+    Progress(0.f, "full evaluation");
+    DCM_RETURN_IF_ERROR(Flush());
+  } else {
+    std::vector<Block> classify = LatticeBlocks(W, H, opt_.elementaryBlock);
+    std::vector<Block> edges;
+    int levels = 1;
+    while ((opt_.elementaryBlock >> (levels - 1)) > opt_.minBlock) ++levels;
+    std::vector<Point2i> loopScratch;
+
+    for (int level = 0; level < levels && !(classify.empty() && edges.empty()); ++level) {
+      const int size = opt_.elementaryBlock >> level;
+      const bool finest = level == levels - 1;
+      const float f0 = float(level) / float(levels), df = 1.f / float(levels);
+      std::vector<Block> nextClassify, nextEdges;
+
+      // Corners, then smooth/edge classification (2.2).
+      Progress(f0, "corners");
+      ForEach(classify, [&](Block& b, size_t) { RequestCorners(b); });
+      DCM_RETURN_IF_ERROR(Flush());
+      std::vector<uint8_t> smooth(classify.size());
+      ForEach(classify, [&](Block& b, size_t i) { smooth[i] = IsSmooth(b); });
+      std::vector<Block> probe;
+      for (size_t i = 0; i < classify.size(); ++i) {
+        const Block& b = classify[i];
+        if (!smooth[i]) {
+          edges.push_back(b);
+        } else if (finest || (b.width() <= 1 && b.height() <= 1) ||
+                   opt_.smoothRefinement == SmoothRefinement::kNever) {
+          smoothLeaves_.push_back(MakeLeaf(b, BlockType::kSmooth));
+        } else if (opt_.smoothRefinement == SmoothRefinement::kAlways) {
+          ChildBlocks(b, size / 2, W, H, &nextClassify);
+        } else {
+          probe.push_back(b);
+        }
+      }
+      // Smoothness by prediction: the centre (a corner of the children) must
+      // match the bilinear interpolation of the corners.
+      if (!probe.empty()) {
+        ForEach(probe, [&](Block& b, size_t) { store_.Request(b.Centre().x, b.Centre().y, SampleReason::kCorner); });
+        DCM_RETURN_IF_ERROR(Flush());
+        std::vector<uint8_t> split(probe.size());
+        ForEach(probe, [&](Block& b, size_t i) {
+          split[i] = contrast_.Differ(At(b.Centre()), Bilinear(store_, b, b.Centre()));
+        });
+        for (size_t i = 0; i < probe.size(); ++i) {
+          if (split[i]) ChildBlocks(probe[i], size / 2, W, H, &nextClassify);
+          else smoothLeaves_.push_back(MakeLeaf(probe[i], BlockType::kSmooth));
+        }
+      }
+
+      // Edge blocks: full border and least-discrepancy direction (2.1).
+      Progress(f0 + 0.4f * df, "edge borders");
+      std::vector<EdgeBlock> eb(edges.size());
+      ForEach(edges, [&](Block& b, size_t i) {
+        eb[i].block = b;
+        BorderLoop(b, &eb[i].border);
+        for (Point2i p : eb[i].border) store_.Request(p.x, p.y, SampleReason::kBorder);
+      });
+      DCM_RETURN_IF_ERROR(Flush());
+      ForEach(eb, [&](EdgeBlock& e, size_t) {
+        e.direction = LeastDiscrepancyDirection(store_, e.block, e.border, opt_.directions);
+        e.crossings = SignificantChanges(store_, contrast_, e.border);
+      });
+
+      if (!finest) {
+        // Simple vs complex (2.3).
+        ForEach(eb, [&](EdgeBlock& e, size_t) {
+          const size_t n = e.crossings.size();
+          const bool zeroOrder = !opt_.zeroOrderTest || n == 2 || (n == 0 && opt_.gradientBlocksSimple);
+          e.simple = e.block.HasInterior() && zeroOrder && SurfaceChanges(store_, e.border) <= 2;
+          if (e.simple && opt_.firstOrderTest && n == 2)
+            for (Point2i p : FirstOrderProbes(e.block, e.border, e.crossings))
+              store_.Request(p.x, p.y, SampleReason::kFirstOrderProbe);
+        });
+        if (opt_.firstOrderTest) {
+          DCM_RETURN_IF_ERROR(Flush());
+          ForEach(eb, [&](EdgeBlock& e, size_t) {
+            if (e.simple && e.crossings.size() == 2)
+              e.simple = FirstOrderConsistent(store_, contrast_, e.block, e.border, e.crossings);
+          });
+        }
+        // Lazy evaluation of simple blocks: the parent's centre only.
+        if (opt_.lazyEvaluation) {
+          ForEach(eb, [&](EdgeBlock& e, size_t) {
+            if (e.simple) store_.Request(e.block.Centre().x, e.block.Centre().y, SampleReason::kLazyCentre);
+          });
+          DCM_RETURN_IF_ERROR(Flush());
+        }
+        std::vector<Leaf> lazy(eb.size());
+        std::vector<uint8_t> accepted(eb.size(), 0);
+        ForEach(eb, [&](EdgeBlock& e, size_t i) {
+          if (!e.simple || !opt_.lazyEvaluation) return;
+          const Block& b = e.block;
+          const Point2i c = b.Centre();
+          Interpolant in;
+          if (!OrientedInterpolant(store_, b, c, Direction::Of(e.direction.index, opt_.directions), &in) ||
+              Resolve(c, &in) != SampleReason::kInterpolated)
+            return;
+          const Value predicted = Evaluate(store_, in), exact = At(c);
+          if (contrast_.Differ(exact, predicted)) return;
+          Leaf& leaf = lazy[i];
+          leaf = MakeLeaf(b, BlockType::kLazy, e.direction.index);
+          leaf.centre = c;
+          leaf.delta = {exact.a - predicted.a, exact.b - predicted.b};
+          leaf.lo = leaf.hi = exact;
+          for (Point2i p : e.border) {
+            const int64_t ip = store_.Index(p.x, p.y);
+            if (!store_.IsFinite(ip)) continue;
+            const Value v = store_.ValueAt(ip);
+            for (int ch = 0; ch < 3; ++ch) {
+              leaf.lo.a[ch] = std::min(leaf.lo.a[ch], v.a[ch]), leaf.hi.a[ch] = std::max(leaf.hi.a[ch], v.a[ch]);
+              leaf.lo.b[ch] = std::min(leaf.lo.b[ch], v.b[ch]), leaf.hi.b[ch] = std::max(leaf.hi.b[ch], v.b[ch]);
+            }
+          }
+          accepted[i] = 1;
+        });
+        for (size_t i = 0; i < eb.size(); ++i) {
+          const EdgeBlock& e = eb[i];
+          if (accepted[i]) {
+            orientedLeaves_.push_back(lazy[i]);
+            ++stats_.lazyAccepted;
+          } else if (!e.block.HasInterior()) {
+            orientedLeaves_.push_back(MakeLeaf(e.block, BlockType::kComplexEdge, e.direction.index));
+          } else {
+            if (e.simple && opt_.lazyEvaluation) ++stats_.lazyRejected;
+            e.simple ? ++stats_.simpleEdgeBlocks : ++stats_.complexEdgeBlocks;
+            ChildBlocks(e.block, size / 2, W, H, &nextEdges);
+          }
+        }
+      } else {
+        for (const EdgeBlock& e : eb) {
+          const bool fallback = opt_.fallback && int(e.crossings.size()) > opt_.fallbackMaxChanges;
+          const BlockType type = fallback ? BlockType::kFallback
+                                 : e.crossings.size() <= 2 ? BlockType::kSimpleEdge : BlockType::kComplexEdge;
+          (fallback ? fallbackLeaves_ : orientedLeaves_).push_back(MakeLeaf(e.block, type, e.direction.index));
+        }
+      }
+      classify = std::move(nextClassify);
+      edges = std::move(nextEdges);
+    }
+
+    // Fallback blocks: every interior pixel exactly.
+    ForEach(fallbackLeaves_, [&](Leaf& l, size_t) {
+      for (int y = l.block.y0 + 1; y < l.block.y1; ++y)
+        for (int x = l.block.x0 + 1; x < l.block.x1; ++x) store_.Request(x, y, SampleReason::kFallback);
+    });
+    // Thin objects (3.1): interior pixels whose interpolants lie on another surface.
+    Progress(0.9f, "thin objects");
+    ForEach(orientedLeaves_, [&](Leaf& l, size_t) {
+      const Direction d = Direction::Of(l.direction, opt_.directions);
+      for (int y = l.block.y0 + 1; y < l.block.y1; ++y)
+        for (int x = l.block.x0 + 1; x < l.block.x1; ++x) {
+          Interpolant in;
+          if (store_.IsExact(store_.Index(x, y))) continue;
+          if (!OrientedInterpolant(store_, l.block, {x, y}, d, &in)) {
+            store_.Request(x, y, SampleReason::kFallback);
+            continue;
+          }
+          const SampleReason r = Resolve({x, y}, &in);
+          if (r != SampleReason::kInterpolated) store_.Request(x, y, r);
+        }
+    });
+    DCM_RETURN_IF_ERROR(Flush());
+
+    Progress(0.95f, "interpolation");
+    ForEach(smoothLeaves_, [&](Leaf& l, size_t) { WriteSmooth(l); });
+    ForEach(orientedLeaves_, [&](Leaf& l, size_t) { WriteOriented(l); });
+    stats_.smoothBlocks = int64_t(smoothLeaves_.size());
+    stats_.fallbackBlocks = int64_t(fallbackLeaves_.size());
+  }
+
+  // Outputs.
+  out->workWidth = W;
+  out->workHeight = H;
+  out->workImage = store_.TakeRadiance();
+  out->sampleMap = store_.reasons();
+  out->image = BoxDownsample(out->workImage, W, H, opt_.downsample, &out->width, &out->height);
+  RecordLeaves(out);
+  stats_.totalPixels = int64_t(W) * H;
+  for (SampleReason r : out->sampleMap) ++stats_.byReason[size_t(r)];
+  stats_.exactPixels = stats_.totalPixels - stats_.byReason[size_t(SampleReason::kInterpolated)];
+  const double total = std::chrono::duration<double>(Clock::now() - tStart).count();
+  stats_.timeEngineS = std::max(0.0, total - stats_.timeProviderS - stats_.timeGuidesS);
+  out->stats = stats_;
+  Progress(1.f, "done");
+  return Status::Ok();
+}
+
+void Engine::RecordLeaves(Reconstruction* out) {
+  out->blocks.clear();
+  auto record = [&](const Leaf& l) {
+    const Block& b = l.block;
+    out->blocks.push_back({b.x0, b.y0, b.x1, b.y1, b.level, l.type, l.direction});
+  };
+  for (const Leaf& l : smoothLeaves_) record(l);
+  for (const Leaf& l : orientedLeaves_) record(l);
+  for (const Leaf& l : fallbackLeaves_) record(l);
+}
+
+}  // namespace
+}  // namespace detail
+
+Status Reconstruct(SampleProvider& provider, const ReconstructionOptions& options, Reconstruction* out,
+                   std::vector<Point2i>* pending) {
+  DCM_RETURN_IF_ERROR(options.Validate());
+  const ProviderCapabilities caps = provider.Capabilities();
+  constexpr int64_t kMaxPixels = int64_t(1) << 30;
+  if (caps.width <= 0 || caps.height <= 0 || int64_t(caps.width) * caps.height > kMaxPixels)
+    return Status::Error("provider '" + caps.name + "' reports an unusable size " + std::to_string(caps.width) +
+                         "x" + std::to_string(caps.height));
+  const bool split = options.textureSplit && caps.texture && caps.splitRadiance;
+  Status status;
+  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+  arena.execute([&] {
+    detail::Engine engine(provider, options, caps, split);
+    status = engine.Run(out, pending);
+  });
+  return status;
+}
+
+}  // namespace dcm

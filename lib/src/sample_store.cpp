@@ -1,0 +1,106 @@
+#include "sample_store.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+
+namespace dcm::detail {
+
+SampleStore::SampleStore(int width, int height, bool split)
+    : width_(width), height_(height), split_(split) {
+  const size_t n = size_t(width) * size_t(height);
+  if (split_) {
+    a_.assign(n, RGB{});
+    b_.assign(n, RGB{});
+  }
+  out_.assign(n, RGB{});
+  reason_.assign(n, SampleReason::kInterpolated);
+  finite_.assign(n, 1);
+}
+
+void SampleStore::SetGuides(GuideImage guides, ObjectTest test) {
+  guides_ = std::move(guides);
+  if (split_) tau_ = guides_.texture;
+  const uint32_t* obj = (test != ObjectTest::kNone && !guides_.objectId.empty()) ? guides_.objectId.data() : nullptr;
+  const uint32_t* shader = (obj && test == ObjectTest::kObjectAndShader && !guides_.shaderId.empty())
+                               ? guides_.shaderId.data() : nullptr;
+  surfaces_ = SurfaceTest(obj, shader);
+}
+
+void SampleStore::SetInterpolated(int64_t i, const Value& v) {
+  if (IsExact(i)) return;
+  if (split_) {
+    a_[i] = v.a;
+    b_[i] = v.b;
+    out_[i] = v.a * tau_[i] + v.b;
+  } else {
+    out_[i] = v.a;
+  }
+}
+
+Status SampleStore::Flush(SampleProvider& provider, const SampleRequest& what, int batchSize,
+                          bool parallel, ReconstructionStats* stats, std::vector<Point2i>* pending) {
+  std::vector<uint64_t> keys;
+  for (auto& local : requests_) {
+    keys.insert(keys.end(), local.begin(), local.end());
+    local.clear();
+  }
+  if (keys.empty()) return Status::Ok();
+  // Sorted by pixel, then by reason: the first key of each pixel carries the
+  // reason of highest priority, whatever order the requests came in.
+  std::sort(keys.begin(), keys.end());
+  std::vector<Point2i> pixels;
+  std::vector<SampleReason> reasons;
+  pixels.reserve(keys.size());
+  for (size_t k = 0; k < keys.size(); ++k) {
+    const int64_t i = int64_t(keys[k] >> 8);
+    if (k > 0 && (keys[k - 1] >> 8) == (keys[k] >> 8)) continue;
+    if (IsExact(i)) continue;
+    pixels.push_back({int(i % width_), int(i / width_)});
+    reasons.push_back(SampleReason(keys[k] & 0xff));
+  }
+  if (pixels.empty()) return Status::Ok();
+
+  std::vector<ExactSample> samples(pixels.size());
+  const size_t batch = size_t(std::max(1, batchSize));
+  const size_t nbatches = (pixels.size() + batch - 1) / batch;
+  std::vector<Status> results(nbatches);
+  auto run = [&](size_t bi) {
+    const size_t begin = bi * batch, end = std::min(pixels.size(), begin + batch);
+    results[bi] = provider.Evaluate(std::span(pixels).subspan(begin, end - begin), what,
+                                    std::span(samples).subspan(begin, end - begin));
+  };
+  const auto t0 = std::chrono::steady_clock::now();
+  if (parallel && nbatches > 1) {
+    tbb::parallel_for(size_t(0), nbatches, run);
+  } else {
+    for (size_t bi = 0; bi < nbatches; ++bi) run(bi);
+  }
+  stats->timeProviderS += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  stats->providerCalls += int64_t(nbatches);
+  for (const Status& s : results) {
+    if (s.pending()) {
+      if (pending) *pending = std::move(pixels);
+      return s;
+    }
+    if (!s.ok()) return s;
+  }
+
+  for (size_t k = 0; k < pixels.size(); ++k) {
+    const int64_t i = Index(pixels[k].x, pixels[k].y);
+    const ExactSample& s = samples[k];
+    reason_[i] = reasons[k];
+    out_[i] = s.L;
+    if (split_) {
+      a_[i] = s.Li;
+      b_[i] = s.Lc;
+    }
+    const bool finite = dcm::IsFinite(s.L) && (!split_ || (dcm::IsFinite(s.Li) && dcm::IsFinite(s.Lc)));
+    finite_[i] = finite ? 1 : 0;
+    if (!finite) ++stats->nonFiniteSamples;
+  }
+  return Status::Ok();
+}
+
+}  // namespace dcm::detail

@@ -1,0 +1,95 @@
+// Per-pixel state of a reconstruction: guides, exact samples, interpolated
+// values and why each pixel is exact. Exact samples are requested once each:
+// requests are collected per phase, deduplicated and evaluated in batches.
+#pragma once
+
+#include <tbb/enumerable_thread_specific.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "dcm/options.h"
+#include "dcm/reconstructor.h"
+#include "dcm/sample_provider.h"
+
+namespace dcm::detail {
+
+/// A value in the interpolation domain: (L_i, L_c) with the texture split, or
+/// (L, 0) without. The displayed radiance is a*tau + b.
+struct Value {
+  RGB a;
+  RGB b;
+};
+
+/// Which pairs of pixels lie on the same surface (paper 2.2 and 3.2).
+class SurfaceTest {
+ public:
+  SurfaceTest() = default;
+  SurfaceTest(const uint32_t* objectId, const uint32_t* shaderId)
+      : objectId_(objectId), shaderId_(shaderId) {}
+  bool enabled() const { return objectId_ != nullptr; }
+  /// Without IDs everything is one surface; with object IDs only, equal IDs;
+  /// with object and shader IDs, a surface changes where both differ.
+  bool Same(int64_t i, int64_t j) const {
+    if (!objectId_) return true;
+    if (objectId_[i] == objectId_[j]) return true;
+    return shaderId_ && shaderId_[i] == shaderId_[j];
+  }
+
+ private:
+  const uint32_t* objectId_ = nullptr;
+  const uint32_t* shaderId_ = nullptr;
+};
+
+class SampleStore {
+ public:
+  SampleStore(int width, int height, bool split);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  bool split() const { return split_; }
+  int64_t Index(int x, int y) const { return int64_t(y) * width_ + x; }
+
+  bool IsExact(int64_t i) const { return reason_[i] != SampleReason::kInterpolated; }
+  bool IsFinite(int64_t i) const { return finite_[i] != 0; }
+  /// Without the split the interpolated quantity is L itself, stored once.
+  Value ValueAt(int64_t i) const { return split_ ? Value{a_[i], b_[i]} : Value{out_[i], RGB{}}; }
+  RGB Tau(int64_t i) const { return tau_.empty() ? RGB::Gray(1.f) : tau_[i]; }
+
+  /// Writes an interpolated value (never over an exact pixel).
+  void SetInterpolated(int64_t i, const Value& v);
+
+  /// Asks for pixel (x, y) to be evaluated exactly in the next Flush(). Safe
+  /// to call concurrently. When several reasons ask for one pixel, the one
+  /// listed first in SampleReason is recorded, so the record is independent of
+  /// the order of requests.
+  void Request(int x, int y, SampleReason reason) {
+    requests_.local().push_back((uint64_t(Index(x, y)) << 8) | uint64_t(reason));
+  }
+
+  /// Evaluates every pixel requested since the last flush that is not exact
+  /// yet. On Status::Pending, `pending` receives those pixels.
+  Status Flush(SampleProvider& provider, const SampleRequest& what, int batchSize, bool parallel,
+               ReconstructionStats* stats, std::vector<Point2i>* pending);
+
+  const SurfaceTest& surfaces() const { return surfaces_; }
+  void SetGuides(GuideImage guides, ObjectTest test);
+
+  /// The radiance of every pixel: exact L where exact, a*tau+b elsewhere.
+  const std::vector<RGB>& radiance() const { return out_; }
+  std::vector<RGB> TakeRadiance() { return std::move(out_); }
+  const std::vector<SampleReason>& reasons() const { return reason_; }
+
+ private:
+  int width_, height_;
+  bool split_;
+  std::vector<RGB> a_, b_;  // (L_i, L_c) with the split only
+  std::vector<RGB> out_, tau_;
+  std::vector<SampleReason> reason_;
+  std::vector<uint8_t> finite_;
+  GuideImage guides_;
+  SurfaceTest surfaces_;
+  tbb::enumerable_thread_specific<std::vector<uint64_t>> requests_;
+};
+
+}  // namespace dcm::detail

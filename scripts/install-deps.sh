@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages dcm needs to build, test and run its examples.
+# Only what is missing is installed; nothing is downloaded outside apt.
+# Usage: scripts/install-deps.sh [--with-renderers]
+set -euo pipefail
+
+packages=(
+  # toolchain
+  cmake g++ ninja-build pkg-config
+  # engine, providers and tool
+  libopenimageio-dev openimageio-tools libopenexr-dev libimath-dev
+  libopencolorio-dev libembree-dev libtbb-dev
+  libcli11-dev nlohmann-json3-dev libassimp-dev
+  # tests and benchmarks
+  libgtest-dev libgmock-dev libbenchmark-dev
+  # helper scripts (plots, checks): Debian's python, not the one first on PATH
+  python3-numpy python3-matplotlib python3-openimageio
+)
+if [[ "${1:-}" == "--with-renderers" ]]; then
+  packages+=(povray blender)
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+if ((${#missing[@]} == 0)); then
+  echo "install-deps: all ${#packages[@]} packages present" >&2
+  exit 0
+fi
+
+echo "install-deps: installing ${missing[*]}" >&2
+SUDO=""
+if [[ $(id -u) -ne 0 ]]; then SUDO="sudo"; fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+echo "install-deps: done" >&2

@@ -1,0 +1,180 @@
+// Image files in and out through OpenImageIO, every output written atomically.
+#include "image_io.h"
+
+#include <unistd.h>
+
+#include <OpenImageIO/imageio.h>
+
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <system_error>
+
+namespace dcm::toolkit {
+namespace {
+
+namespace fs = std::filesystem;
+using OIIO::ImageInput;
+using OIIO::ImageOutput;
+using OIIO::ImageSpec;
+using OIIO::TypeDesc;
+
+/// A temporary name next to `path` that keeps its extension (OpenImageIO picks
+/// the format from it) and cannot collide with another process or thread.
+std::string TemporaryName(const std::string& path) {
+  static std::atomic<unsigned> counter{0};
+  fs::path p(path);
+  std::string name = "." + p.stem().string() + ".dcmtmp" + std::to_string(::getpid()) + "_" +
+                     std::to_string(counter.fetch_add(1)) + p.extension().string();
+  return (p.parent_path() / name).string();
+}
+
+Status CheckSize(const std::string& path, int width, int height, size_t count) {
+  if (width <= 0 || height <= 0)
+    return Status::Error("cannot write '" + path + "': empty image (" + std::to_string(width) + "x" +
+                         std::to_string(height) + ")");
+  if (count != size_t(width) * size_t(height))
+    return Status::Error("cannot write '" + path + "': " + std::to_string(count) +
+                         " pixels given for a " + std::to_string(width) + "x" +
+                         std::to_string(height) + " image");
+  return Status::Ok();
+}
+
+Status WriteSpec(const std::string& tmp, const std::string& path, const ImageSpec& spec,
+                 const void* data, TypeDesc format) {
+  auto out = ImageOutput::create(tmp);
+  if (!out) return Status::Error("cannot write '" + path + "': " + OIIO::geterror());
+  if (!out->open(tmp, spec))
+    return Status::Error("cannot write '" + path + "': " + out->geterror());
+  bool ok = out->write_image(format, data);
+  std::string err = ok ? "" : out->geterror();
+  if (!out->close() && ok) {
+    ok = false;
+    err = out->geterror();
+  }
+  if (!ok) return Status::Error("cannot write '" + path + "': " + err);
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status WriteAtomically(const std::string& path,
+                       const std::function<Status(const std::string& tmpPath)>& write) {
+  if (path.empty()) return Status::Error("empty output file name");
+  const std::string tmp = TemporaryName(path);
+  Status st;
+  try {
+    st = write(tmp);
+  } catch (const std::exception& e) {
+    st = Status::Error("cannot write '" + path + "': " + e.what());
+  }
+  std::error_code ec;
+  if (!st.ok()) {
+    fs::remove(tmp, ec);
+    return st;
+  }
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    return Status::Error("cannot write '" + path + "': " + ec.message());
+  }
+  return Status::Ok();
+}
+
+Status WriteRgbExr(const std::string& path, int width, int height, std::span<const RGB> pixels,
+                   const Metadata& metadata) {
+  return WriteRgbExr(path, width, height, pixels, metadata, /*alpha=*/false);
+}
+
+Status WriteRgbExr(const std::string& path, int width, int height, std::span<const RGB> pixels,
+                   const Metadata& metadata, bool alpha) {
+  DCM_RETURN_IF_ERROR(CheckSize(path, width, height, pixels.size()));
+  const int nch = alpha ? 4 : 3;
+  ImageSpec spec(width, height, nch, TypeDesc::FLOAT);
+  spec.channelnames = alpha ? std::vector<std::string>{"R", "G", "B", "A"}
+                            : std::vector<std::string>{"R", "G", "B"};
+  spec.alpha_channel = alpha ? 3 : -1;
+  spec.attribute("compression", "zip");
+  for (const auto& [name, value] : metadata.strings) spec.attribute(name, value);
+  for (const auto& [name, value] : metadata.floats) spec.attribute(name, value);
+  std::vector<float> buffer(pixels.size() * size_t(nch));
+  for (size_t i = 0; i < pixels.size(); ++i) {
+    buffer[i * nch + 0] = pixels[i].r;
+    buffer[i * nch + 1] = pixels[i].g;
+    buffer[i * nch + 2] = pixels[i].b;
+    if (alpha) buffer[i * nch + 3] = 1.f;
+  }
+  return WriteAtomically(path, [&](const std::string& tmp) {
+    return WriteSpec(tmp, path, spec, buffer.data(), TypeDesc::FLOAT);
+  });
+}
+
+Status WriteRgb8(const std::string& path, int width, int height, std::span<const uint8_t> rgb) {
+  if (rgb.size() % 3 != 0)
+    return Status::Error("cannot write '" + path + "': RGB data size is not a multiple of 3");
+  DCM_RETURN_IF_ERROR(CheckSize(path, width, height, rgb.size() / 3));
+  ImageSpec spec(width, height, 3, TypeDesc::UINT8);
+  return WriteAtomically(path, [&](const std::string& tmp) {
+    return WriteSpec(tmp, path, spec, rgb.data(), TypeDesc::UINT8);
+  });
+}
+
+Status CheckImageDimensions(const std::string& path, int width, int height, int channels) {
+  const int64_t kMaxSide = int64_t(1) << 17;  // 131072 pixels per side
+  if (width <= 0 || height <= 0 || width > kMaxSide || height > kMaxSide)
+    return Status::Error("'" + path + "': absurd image dimensions " + std::to_string(width) + "x" +
+                         std::to_string(height) + " (at most " + std::to_string(kMaxSide) +
+                         " pixels per side)");
+  const double bytes = double(width) * double(height) * double(std::max(channels, 1)) * 4.0;
+  if (bytes > double(kMaxImageBytes))
+    return Status::Error("'" + path + "': " + std::to_string(width) + "x" + std::to_string(height) +
+                         " with " + std::to_string(channels) + " channels needs " +
+                         std::to_string(int64_t(bytes / double(1 << 20))) +
+                         " MiB, more than the limit of " +
+                         std::to_string(kMaxImageBytes >> 20) + " MiB");
+  return Status::Ok();
+}
+
+Status ReadRgb(const std::string& path, int* width, int* height, std::vector<RGB>* pixels) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return Status::Error("'" + path + "': no such file");
+  auto in = ImageInput::open(path);
+  if (!in) return Status::Error("cannot read '" + path + "': " + OIIO::geterror());
+  const ImageSpec spec = in->spec();
+  if (spec.deep) return Status::Error("'" + path + "': deep images are not supported");
+  if (spec.depth > 1) return Status::Error("'" + path + "': volume images are not supported");
+  if (spec.x != spec.full_x || spec.y != spec.full_y || spec.width != spec.full_width ||
+      spec.height != spec.full_height)
+    return Status::Error("'" + path + "': the data window differs from the display window");
+  DCM_RETURN_IF_ERROR(CheckImageDimensions(path, spec.width, spec.height, 3));
+  int idx[3] = {spec.channelindex("R"), spec.channelindex("G"), spec.channelindex("B")};
+  if (idx[0] < 0 || idx[1] < 0 || idx[2] < 0) {
+    if (spec.nchannels == 1) {
+      idx[0] = idx[1] = idx[2] = 0;
+    } else {
+      std::string names;
+      for (const auto& n : spec.channelnames) names += (names.empty() ? "" : ", ") + n;
+      return Status::Error("'" + path + "': no R, G, B channels (channels: " + names + ")");
+    }
+  }
+  const size_t n = size_t(spec.width) * size_t(spec.height);
+  std::vector<float> plane(n);
+  pixels->assign(n, RGB{});
+  for (int c = 0; c < 3; ++c) {
+    if (c > 0 && idx[c] == idx[c - 1]) {
+      for (size_t i = 0; i < n; ++i) (*pixels)[i][c] = (*pixels)[i][c - 1];
+      continue;
+    }
+    if (!in->read_image(0, 0, idx[c], idx[c] + 1, TypeDesc::FLOAT, plane.data()))
+      return Status::Error("cannot read channel '" + spec.channelnames[size_t(idx[c])] + "' of '" +
+                           path + "': " + in->geterror());
+    for (size_t i = 0; i < n; ++i) (*pixels)[i][c] = plane[i];
+  }
+  *width = spec.width;
+  *height = spec.height;
+  return Status::Ok();
+}
+
+}  // namespace dcm::toolkit

@@ -1,0 +1,55 @@
+// Image files in and out. Every output is written to a temporary name in the
+// destination folder and renamed into place, so a failure never leaves a
+// partial or truncated file under the requested name.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "dcm/color.h"
+#include "dcm/status.h"
+
+namespace dcm::toolkit {
+
+/// String and float attributes for EXR metadata (provenance). Names follow the
+/// "dcm:..." convention, e.g. "dcm:exact_fraction".
+struct Metadata {
+  std::vector<std::pair<std::string, std::string>> strings;
+  std::vector<std::pair<std::string, float>> floats;
+};
+
+/// Writes float RGB (optionally with a fourth alpha channel of 1) as an EXR
+/// (zip compression), atomically. Metadata become EXR header attributes.
+Status WriteRgbExr(const std::string& path, int width, int height, std::span<const RGB> pixels,
+                   const Metadata& metadata = {});
+
+/// As above; with `alpha` a fourth channel A = 1 is written (RGBA).
+Status WriteRgbExr(const std::string& path, int width, int height, std::span<const RGB> pixels,
+                   const Metadata& metadata, bool alpha);
+
+/// Writes an 8-bit RGB image atomically (PNG, or any format OIIO picks from the extension).
+Status WriteRgb8(const std::string& path, int width, int height, std::span<const uint8_t> rgb);
+
+/// Upper bound on the float pixel data one image may need (width * height *
+/// channels * 4 bytes): 8 GiB. Checked from the header, before allocating.
+inline constexpr int64_t kMaxImageBytes = int64_t(8) << 30;
+
+/// The memory guard: rejects dimensions <= 0, above 2^17 per side, or whose
+/// float data (`channels` planes) would exceed kMaxImageBytes. The message
+/// names the file.
+Status CheckImageDimensions(const std::string& path, int width, int height, int channels);
+
+/// Reads the R, G, B channels of an image (by channel name; a 1-channel image
+/// is read as gray). The message names the file and what is wrong.
+Status ReadRgb(const std::string& path, int* width, int* height, std::vector<RGB>* pixels);
+
+/// Runs `write(tmpPath)` and renames the temporary file to `path` on success;
+/// removes it on failure.
+Status WriteAtomically(const std::string& path,
+                       const std::function<Status(const std::string& tmpPath)>& write);
+
+}  // namespace dcm::toolkit

@@ -1,0 +1,78 @@
+// Statistics and settings as JSON.
+#include "stats_json.h"
+
+#include <fstream>
+
+#include "image_io.h"
+
+namespace dcm::toolkit {
+
+nlohmann::json OptionsToJson(const ReconstructionOptions& o) {
+  nlohmann::json j;
+  j["elementary_block"] = o.elementaryBlock;
+  j["min_block"] = o.minBlock;
+  j["contrast_threshold"] = o.contrastThreshold;
+  j["contrast_metric"] = std::string(ToString(o.contrastMetric));
+  j["directions"] = o.directions;
+  j["object_test"] = std::string(ToString(o.objectTest));
+  j["thin_objects"] = std::string(ToString(o.thinObjects));
+  j["surface_aware"] = o.surfaceAware;
+  j["texture_split"] = o.textureSplit;
+  j["smooth_refinement"] = std::string(ToString(o.smoothRefinement));
+  j["zero_order_test"] = o.zeroOrderTest;
+  j["gradient_blocks_simple"] = o.gradientBlocksSimple;
+  j["first_order_test"] = o.firstOrderTest;
+  j["lazy_evaluation"] = o.lazyEvaluation;
+  j["fallback"] = o.fallback;
+  j["fallback_max_changes"] = o.fallbackMaxChanges;
+  j["downsample"] = o.downsample;
+  j["full_evaluation"] = o.fullEvaluation;
+  j["threads"] = o.threads;
+  j["tile_size"] = o.tileSize;
+  j["batch_size"] = o.batchSize;
+  return j;
+}
+
+nlohmann::json StatsToJson(const ReconstructionStats& s) {
+  nlohmann::json j;
+  j["exact_pixels"] = s.exactPixels;
+  j["total_pixels"] = s.totalPixels;
+  j["exact_fraction"] = s.exactFraction();
+  j["time_s"] = s.timeEngineS;
+  j["time_illum_s"] = s.timeProviderS;
+  j["time_guides_s"] = s.timeGuidesS;
+  nlohmann::json reasons = nlohmann::json::object();
+  for (int i = 0; i < kSampleReasonCount; ++i)
+    reasons[std::string(ToString(SampleReason(i)))] = s.byReason[size_t(i)];
+  j["by_reason"] = reasons;
+  j["blocks"] = {{"smooth", s.smoothBlocks},
+                 {"simple_edge", s.simpleEdgeBlocks},
+                 {"complex_edge", s.complexEdgeBlocks},
+                 {"lazy_accepted", s.lazyAccepted},
+                 {"lazy_rejected", s.lazyRejected},
+                 {"fallback", s.fallbackBlocks}};
+  j["non_finite_samples"] = s.nonFiniteSamples;
+  j["provider_calls"] = s.providerCalls;
+  j["used"] = {{"split", s.usedSplit}, {"object_id", s.usedObjectId}, {"shader_id", s.usedShaderId}};
+  return j;
+}
+
+Status WriteJson(const std::string& path, const nlohmann::json& j) {
+  std::string text;
+  try {
+    // Replace invalid UTF-8 (e.g. from a file name) instead of throwing.
+    text = j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+  } catch (const std::exception& e) {
+    return Status::Error("cannot write '" + path + "': " + e.what());
+  }
+  return WriteAtomically(path, [&](const std::string& tmp) {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) return Status::Error("cannot write '" + path + "': cannot create a file in its folder");
+    out << text;
+    out.close();
+    if (!out) return Status::Error("cannot write '" + path + "': write failed");
+    return Status::Ok();
+  });
+}
+
+}  // namespace dcm::toolkit

@@ -1,0 +1,27 @@
+// Statistics and settings as JSON, for --stats files and EXR metadata.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "dcm/options.h"
+#include "dcm/reconstructor.h"
+#include "dcm/status.h"
+
+namespace dcm::toolkit {
+
+/// The switches of a reconstruction (every field except the progress callback),
+/// with snake_case names and enums by their ToString() names.
+nlohmann::json OptionsToJson(const ReconstructionOptions& o);
+
+/// exact_pixels, total_pixels, exact_fraction, time_s (engine), time_illum_s
+/// (provider), time_guides_s, by_reason {reason name: count, for every reason
+/// including "interpolated"}, blocks {...}, non_finite_samples, provider_calls,
+/// used {split, object_id, shader_id}.
+nlohmann::json StatsToJson(const ReconstructionStats& s);
+
+/// Writes JSON (pretty, 2 spaces) atomically. Non-finite numbers become null
+/// (JSON has no infinity).
+Status WriteJson(const std::string& path, const nlohmann::json& j);
+
+}  // namespace dcm::toolkit

@@ -1,0 +1,270 @@
+// dcm render: ray trace a scene file with the internal Embree renderer,
+// evaluating only a few percent of the pixels exactly and reconstructing the
+// rest with DCM; optionally also the full (baseline) render, for the speed-up
+// and the error.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "commands.h"
+#include "common/image_io.h"
+#include "common/metrics.h"
+#include "common/preview.h"
+#include "common/progress.h"
+#include "common/sample_map.h"
+#include "common/stats_json.h"
+#include "dcm/reconstructor.h"
+#include "embree/embree_provider.h"
+#include "embree/scene_file.h"
+#include "engine_flags.h"
+
+namespace dcm::cli {
+namespace {
+
+struct RenderFlags {
+  std::string scene;
+  std::string output;
+  std::string compare;
+  std::string stats;
+  std::string sampleMap;
+  std::string preview;
+  std::string size;
+  float scale = 0.f;
+  int supersampling = 0;
+  bool withReference = false;
+  std::string referenceOut;
+  EngineFlags engine;
+};
+
+Status ParseSize(const std::string& s, int* w, int* h) {
+  int a = 0, b = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(s.c_str(), "%d%c%d%c", &a, &x, &b, &extra) != 3 || (x != 'x' && x != 'X') || a < 1 ||
+      b < 1 || a > 16384 || b > 16384) {
+    return Status::Error("--size: expected WIDTHxHEIGHT (e.g. 256x256), got '" + s + "'");
+  }
+  *w = a;
+  *h = b;
+  return Status::Ok();
+}
+
+nlohmann::json RaysToJson(const embree::RayCounts& c) {
+  return {{"primary", c.primary}, {"guide", c.guide},   {"shadow", c.shadow}, {"glossy", c.glossy},
+          {"mirror", c.mirror},   {"indirect", c.indirect}, {"total", c.total()}};
+}
+
+nlohmann::json ErrorToJson(const toolkit::ImageError& e) {
+  return {{"psnr", e.psnr}, {"rmse", e.rmse}, {"relmse", e.relmse}, {"ssim", e.ssim}, {"non_finite", e.nonFinite}};
+}
+
+std::string Join(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& e : v) s += (s.empty() ? "" : ",") + e;
+  return s.empty() ? "none" : s;
+}
+
+/// One reconstruction with its wall-clock time and the rays it cost.
+struct Run {
+  Reconstruction rec;
+  double wallS = 0;
+  embree::RayCounts rays;
+};
+
+Status RunOnce(embree::EmbreeProvider& provider, const ReconstructionOptions& options, Run* run) {
+  provider.ResetRayCounts();
+  auto t0 = std::chrono::steady_clock::now();
+  Status st = Reconstruct(provider, options, &run->rec);
+  run->wallS = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  run->rays = provider.rayCounts();
+  return st;
+}
+
+int Fail(const Status& st) {
+  std::cerr << "dcm render: error: " << st.message() << "\n";
+  return kExitFailure;
+}
+
+int RunRender(const RenderFlags& f, CLI::App* app) {
+  // Scene and its overrides.
+  embree::Scene scene;
+  if (Status st = embree::LoadSceneFile(f.scene, &scene); !st.ok()) return Fail(st);
+  if (!f.size.empty()) {
+    if (Status st = ParseSize(f.size, &scene.camera.width, &scene.camera.height); !st.ok()) {
+      std::cerr << "dcm render: " << st.message() << "\n";
+      return kExitUsage;
+    }
+  } else if (f.scale > 0.f) {
+    scene.camera.width = std::max(1, int(std::lround(float(scene.camera.width) * f.scale)));
+    scene.camera.height = std::max(1, int(std::lround(float(scene.camera.height) * f.scale)));
+  }
+  if (f.supersampling > 0) scene.render.supersampling = f.supersampling;
+
+  ReconstructionOptions options;
+  if (Status st = ToOptions(f.engine, &options); !st.ok()) {
+    std::cerr << "dcm render: " << st.message() << "\n";
+    return kExitUsage;
+  }
+  if (app->count("--downsample") && f.engine.downsample != scene.render.supersampling) {
+    std::cerr << "dcm render: --downsample is the scene's render.supersampling ("
+              << scene.render.supersampling << "); use --supersampling to change it\n";
+    return kExitUsage;
+  }
+  options.downsample = scene.render.supersampling;
+  if (Status st = options.Validate(); !st.ok()) {
+    std::cerr << "dcm render: " << st.message() << "\n";
+    return kExitUsage;
+  }
+
+  toolkit::Progress progress(!f.engine.quiet);
+  std::unique_ptr<embree::EmbreeProvider> provider;
+  if (Status st = embree::EmbreeProvider::Create(scene, &provider); !st.ok()) return Fail(st);
+  if (f.engine.verbose) {
+    std::cerr << "scene " << f.scene << ": " << scene.objects.size() << " objects, "
+              << provider->triangleCount() << " triangles, " << scene.lights.size() << " lights; working image "
+              << provider->workWidth() << "x" << provider->workHeight() << "; effects "
+              << Join(provider->effects().Names()) << "\n";
+  }
+
+  // The reference compared against, from a file or rendered in this run.
+  std::optional<std::vector<RGB>> reference;
+  if (!f.compare.empty()) {
+    int rw = 0, rh = 0;
+    std::vector<RGB> px;
+    if (Status st = toolkit::ReadRgb(f.compare, &rw, &rh, &px); !st.ok()) return Fail(st);
+    if (rw != scene.camera.width || rh != scene.camera.height) {
+      return Fail(Status::Error(f.compare + ": reference is " + std::to_string(rw) + "x" + std::to_string(rh) +
+                                ", the render " + std::to_string(scene.camera.width) + "x" +
+                                std::to_string(scene.camera.height)));
+    }
+    reference = std::move(px);
+  }
+
+  const bool wantReference = (f.withReference || !f.referenceOut.empty()) && !options.fullEvaluation;
+  std::optional<Run> full;
+  if (wantReference) {
+    ReconstructionOptions fo = options;
+    fo.fullEvaluation = true;
+    fo.progress = [&](float v, std::string_view stage) { progress.Update(v, "full render: " + std::string(stage)); };
+    Run r;
+    if (Status st = RunOnce(*provider, fo, &r); !st.ok()) return Fail(st);
+    full = std::move(r);
+  }
+
+  options.progress = [&](float v, std::string_view stage) { progress.Update(v, stage); };
+  Run run;
+  if (Status st = RunOnce(*provider, options, &run); !st.ok()) return Fail(st);
+  progress.Done();
+  const Reconstruction& rec = run.rec;
+  const ReconstructionStats& stats = rec.stats;
+  if (full && !reference) reference = full->rec.image;
+
+  const std::string method = options.fullEvaluation ? "full" : f.engine.method;
+  const auto effects = provider->effects().Names();
+  toolkit::Metadata meta;
+  meta.strings.push_back({"dcm:scene", f.scene});
+  meta.strings.push_back({"dcm:method", method});
+  meta.strings.push_back({"dcm:options", toolkit::OptionsToJson(options).dump()});
+  meta.strings.push_back({"dcm:effects", Join(effects)});
+  meta.strings.push_back({"dcm:provider", "embree"});
+  meta.floats.push_back({"dcm:exact_fraction", float(stats.exactFraction())});
+  meta.floats.push_back({"dcm:time_illum_s", float(stats.timeProviderS)});
+  meta.floats.push_back({"dcm:time_dcm_s", float(stats.timeEngineS)});
+  if (Status st = toolkit::WriteRgbExr(f.output, rec.width, rec.height, rec.image, meta); !st.ok()) return Fail(st);
+  if (full && !f.referenceOut.empty()) {
+    toolkit::Metadata fm = meta;
+    fm.strings[1].second = "full";
+    fm.floats = {{"dcm:exact_fraction", 1.f}, {"dcm:time_illum_s", float(full->rec.stats.timeProviderS)}};
+    if (Status st = toolkit::WriteRgbExr(f.referenceOut, full->rec.width, full->rec.height, full->rec.image, fm);
+        !st.ok()) {
+      return Fail(st);
+    }
+  }
+  if (!f.sampleMap.empty()) {
+    if (Status st = toolkit::WriteSampleMap(f.sampleMap, rec); !st.ok()) return Fail(st);
+  }
+  if (!f.preview.empty()) {
+    if (Status st = toolkit::WritePreview(f.preview, rec.width, rec.height, rec.image); !st.ok()) return Fail(st);
+  }
+
+  std::optional<toolkit::ImageError> error;
+  if (reference) error = toolkit::Compare(rec.image, *reference, rec.width, rec.height);
+
+  if (!f.stats.empty()) {
+    nlohmann::json j = toolkit::StatsToJson(stats);
+    j["scene"] = f.scene;
+    j["method"] = method;
+    j["options"] = toolkit::OptionsToJson(options);
+    j["resolution"] = {rec.width, rec.height};
+    j["working_resolution"] = {rec.workWidth, rec.workHeight};
+    j["exact_fraction"] = stats.exactFraction();
+    j["time_illum_s"] = stats.timeProviderS;
+    j["time_dcm_s"] = stats.timeEngineS;
+    j["time_guides_s"] = stats.timeGuidesS;
+    j["time_wall_s"] = run.wallS;
+    j["effects"] = effects;
+    j["rays"] = RaysToJson(run.rays);
+    if (error) j["reference"] = ErrorToJson(*error);
+    if (full) {
+      j["full"] = {{"time_illum_s", full->rec.stats.timeProviderS},
+                   {"time_wall_s", full->wallS},
+                   {"rays", RaysToJson(full->rays)}};
+      j["speedup"] = run.wallS > 0 ? full->wallS / run.wallS : 0.0;
+    }
+    if (Status st = toolkit::WriteJson(f.stats, j); !st.ok()) return Fail(st);
+  }
+
+  std::printf("%s: %dx%d (working %dx%d), %s\n", f.scene.c_str(), rec.width, rec.height, rec.workWidth,
+              rec.workHeight, method.c_str());
+  std::printf("  effects        %s\n", Join(effects).c_str());
+  std::printf("  exact pixels   %.2f %% (%lld of %lld)\n", 100.0 * stats.exactFraction(),
+              static_cast<long long>(stats.exactPixels), static_cast<long long>(stats.totalPixels));
+  std::printf("  time           illumination %.2f s, DCM %.2f s, guides %.2f s, total %.2f s\n",
+              stats.timeProviderS, stats.timeEngineS, stats.timeGuidesS, run.wallS);
+  std::printf("  rays           %llu (shadow %llu, glossy %llu, mirror %llu, indirect %llu)\n",
+              static_cast<unsigned long long>(run.rays.total()), static_cast<unsigned long long>(run.rays.shadow),
+              static_cast<unsigned long long>(run.rays.glossy), static_cast<unsigned long long>(run.rays.mirror),
+              static_cast<unsigned long long>(run.rays.indirect));
+  if (full) {
+    std::printf("  full render    illumination %.2f s, total %.2f s, %llu rays\n", full->rec.stats.timeProviderS,
+                full->wallS, static_cast<unsigned long long>(full->rays.total()));
+    std::printf("  speed-up       %.2fx (wall clock), %.2fx (rays)\n", run.wallS > 0 ? full->wallS / run.wallS : 0.0,
+                run.rays.total() ? double(full->rays.total()) / double(run.rays.total()) : 0.0);
+  }
+  if (error) {
+    std::printf("  error          PSNR %.2f dB, RMSE %.5f, relMSE %.6f, SSIM %.4f (against %s)\n", error->psnr,
+                error->rmse, error->relmse, error->ssim, f.compare.empty() ? "the full render" : f.compare.c_str());
+  }
+  return kExitOk;
+}
+
+Registration reg("render", "Ray trace a scene file (Embree) with DCM: a few percent of the pixels exact",
+                 [](CLI::App* app) -> std::function<int()> {
+                   auto f = std::make_shared<RenderFlags>();
+                   app->add_option("scene", f->scene, "scene file (JSON, see plugins/embree/SCENE-FORMAT.md)")
+                       ->required();
+                   app->add_option("-o,--output", f->output, "output image (EXR)")->required();
+                   app->add_option("--compare", f->compare, "reference image (EXR) to report the error against");
+                   app->add_option("--stats", f->stats, "write statistics (JSON)");
+                   app->add_option("--sample-map", f->sampleMap, "write the sample map (PNG): which pixels were exact, why");
+                   app->add_option("--preview", f->preview, "write a display image (PNG) through OpenColorIO");
+                   auto* size = app->add_option("--size", f->size, "override the resolution, WIDTHxHEIGHT");
+                   app->add_option("--scale", f->scale, "scale the scene's resolution (e.g. 0.25 for a quick preview)")
+                       ->check(CLI::Range(1e-3f, 16.f))
+                       ->excludes(size);
+                   app->add_option("--supersampling", f->supersampling,
+                                   "override render.supersampling (samples per output pixel per axis)")
+                       ->check(CLI::Range(1, 16));
+                   app->add_flag("--with-reference", f->withReference,
+                                 "also render the full image in this run: prints the speed-up and the error");
+                   app->add_option("--reference-out", f->referenceOut,
+                                   "write the full render (EXR); implies --with-reference");
+                   AddEngineFlags(app, &f->engine);
+                   return [f, app] { return RunRender(*f, app); };
+                 });
+
+}  // namespace
+}  // namespace dcm::cli

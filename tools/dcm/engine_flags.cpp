@@ -1,0 +1,51 @@
+#include "engine_flags.h"
+
+namespace dcm::cli {
+
+void AddEngineFlags(CLI::App* app, EngineFlags* f) {
+  app->add_option("--method", f->method, "dcm (default), paper (Scheel et al. 2001) or guo (Guo 1998)")
+      ->check(CLI::IsMember({"dcm", "paper", "guo"}));
+  app->add_option("--threshold", f->threshold, "contrast threshold of the smooth/edge test");
+  app->add_option("--block", f->block, "elementary block size (power of two, default 8)");
+  app->add_option("--min-block", f->minBlock, "finest block size (power of two, default 4)");
+  app->add_option("--directions", f->directions, "candidate directions of the least-discrepancy search (default 8)");
+  app->add_flag("--no-thin", f->noThin, "switch off the thin-object test (paper 3.1)");
+  app->add_option("--thin-test", f->thinTest, "off | none-matches | any-differs");
+  app->add_flag("--no-texture-split", f->noTextureSplit, "interpolate L instead of (L_i, L_c) (paper 3.3)");
+  app->add_option("--object-test", f->objectTest, "none | id | id+shader (paper 3.2)");
+  app->add_option("--contrast", f->contrast, "mitchell | display");
+  app->add_flag("--no-lazy", f->noLazy, "full border evaluation for children of simple edge blocks");
+  app->add_flag("--no-fallback", f->noFallback, "never fall back to exact evaluation of a block interior");
+  app->add_flag("--no-surface-aware", f->noSurfaceAware, "interpolate across surfaces (Guo)");
+  app->add_flag("--full", f->full, "evaluate every pixel exactly (the baseline)");
+  app->add_option("--downsample", f->downsample, "the input is supersampled N times per axis; box-filter the result down");
+  app->add_option("--threads", f->threads, "worker threads (0: all cores)");
+  app->add_option("--tile", f->tile, "tile size in pixels for parallel work");
+  app->add_flag("-v,--verbose", f->verbose, "say more");
+  app->add_flag("--quiet", f->quiet, "no progress on stderr");
+}
+
+Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {
+  if (f.method == "paper") *o = ReconstructionOptions::Paper();
+  else if (f.method == "guo") *o = ReconstructionOptions::Guo();
+  else *o = ReconstructionOptions{};
+  if (f.threshold >= 0) o->contrastThreshold = f.threshold;
+  if (f.block) o->elementaryBlock = f.block;
+  if (f.minBlock) o->minBlock = f.minBlock;
+  if (f.directions) o->directions = f.directions;
+  if (f.noThin) o->thinObjects = ThinObjectTest::kOff;
+  if (!f.thinTest.empty()) DCM_RETURN_IF_ERROR(Parse(f.thinTest, &o->thinObjects));
+  if (f.noTextureSplit) o->textureSplit = false;
+  if (!f.objectTest.empty()) DCM_RETURN_IF_ERROR(Parse(f.objectTest, &o->objectTest));
+  if (!f.contrast.empty()) DCM_RETURN_IF_ERROR(Parse(f.contrast, &o->contrastMetric));
+  if (f.noLazy) o->lazyEvaluation = false;
+  if (f.noFallback) o->fallback = false;
+  if (f.noSurfaceAware) o->surfaceAware = false;
+  if (f.full) o->fullEvaluation = true;
+  o->downsample = f.downsample;
+  o->threads = f.threads;
+  if (f.tile) o->tileSize = f.tile;
+  return o->Validate();
+}
+
+}  // namespace dcm::cli

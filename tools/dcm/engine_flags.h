@@ -1,0 +1,33 @@
+// The engine switches shared by `dcm render`, `dcm reconstruct` and `dcm plan`.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "dcm/options.h"
+#include "dcm/status.h"
+
+namespace dcm::cli {
+
+/// Flag values as parsed; turned into ReconstructionOptions by ToOptions().
+struct EngineFlags {
+  std::string method = "dcm";  ///< dcm | paper | guo
+  float threshold = -1;        ///< <0: the method's default
+  int block = 0, minBlock = 0, directions = 0, downsample = 1, threads = 0, tile = 0;
+  bool noThin = false, noTextureSplit = false, noLazy = false, noFallback = false;
+  bool noSurfaceAware = false, full = false;
+  std::string objectTest;      ///< none | id | id+shader
+  std::string thinTest;        ///< off | none-matches | any-differs
+  std::string contrast;        ///< mitchell | display
+  bool verbose = false, quiet = false;
+};
+
+/// Adds --method, --threshold, --block, --min-block, --directions, --no-thin,
+/// --thin-test, --no-texture-split, --object-test, --contrast, --no-lazy,
+/// --no-fallback, --no-surface-aware, --downsample, --threads, --tile, -v, --quiet.
+void AddEngineFlags(CLI::App* app, EngineFlags* flags);
+
+/// The options the flags select. The message names the flag at fault.
+Status ToOptions(const EngineFlags& flags, ReconstructionOptions* options);
+
+}  // namespace dcm::cli
