@@ -14,6 +14,8 @@ ReconstructionOptions ReconstructionOptions::Guo() {
   o.surfaceAware = false;
   o.textureSplit = false;
   o.smoothRefinement = SmoothRefinement::kAlways;
+  o.adaptiveBorders = false;
+  o.finestCentreProbe = false;
   o.gradientBlocksSimple = false;
   o.fallback = false;
   return o;

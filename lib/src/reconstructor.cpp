@@ -9,6 +9,8 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <atomic>
+#include <tuple>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -30,6 +32,7 @@ std::string_view ToString(SampleReason r) {
     case SampleReason::kBorder: return "border";
     case SampleReason::kFirstOrderProbe: return "first_order_probe";
     case SampleReason::kLazyCentre: return "lazy_centre";
+    case SampleReason::kCentreProbe: return "centre_probe";
     case SampleReason::kThinObject: return "thin_object";
     case SampleReason::kFallback: return "fallback";
     case SampleReason::kFull: return "full";
@@ -115,6 +118,7 @@ class Engine {
   }
 
   Status LoadGuides();
+  Status EvaluateBordersAdaptively(const std::vector<Block>& edges);
   void RequestCorners(const Block& b) {
     for (Point2i p : {Point2i{b.x0, b.y0}, Point2i{b.x1, b.y0}, Point2i{b.x0, b.y1}, Point2i{b.x1, b.y1}})
       store_.Request(p.x, p.y, SampleReason::kCorner);
@@ -245,7 +249,7 @@ void Engine::WriteSmooth(const Leaf& leaf) {
     }
     for (int x = b.x0; x <= xe; ++x) {
       const int64_t i = store_.Index(x, y);
-      if (store_.IsExact(i)) continue;
+      if (store_.IsExact(i) || store_.IsFilled(i)) continue;
       const double u = (x - b.x0) * sx;
       Value out;
       for (int ch = 0; ch < channels; ++ch) {
@@ -284,6 +288,78 @@ void Engine::WriteOriented(const Leaf& leaf) {
       }
       store_.SetInterpolated(i, v);
     }
+}
+
+Status Engine::EvaluateBordersAdaptively(const std::vector<Block>& edges) {
+  // The sides of all edge blocks of this level, each once: blocks of one level
+  // sit on one lattice, so two sides are equal or share at most an end. A side
+  // is a pure function of its own samples, whichever block it borders.
+  struct Side {
+    Point2i a, step;
+    int length;  // pixels - 1
+    auto key() const { return std::tuple(a.y, a.x, step.y, step.x, length); }
+  };
+  std::vector<Side> sides;
+  for (const Block& b : edges) {
+    if (b.x1 == b.x0 || b.y1 == b.y0) {
+      for (int y = b.y0; y <= b.y1; ++y)
+        for (int x = b.x0; x <= b.x1; ++x) store_.Request(x, y, SampleReason::kBorder);
+      continue;
+    }
+    sides.push_back({{b.x0, b.y0}, {1, 0}, b.x1 - b.x0});
+    sides.push_back({{b.x0, b.y1}, {1, 0}, b.x1 - b.x0});
+    sides.push_back({{b.x0, b.y0}, {0, 1}, b.y1 - b.y0});
+    sides.push_back({{b.x1, b.y0}, {0, 1}, b.y1 - b.y0});
+  }
+  std::sort(sides.begin(), sides.end(), [](const Side& l, const Side& r) { return l.key() < r.key(); });
+  sides.erase(std::unique(sides.begin(), sides.end(), [](const Side& l, const Side& r) { return l.key() == r.key(); }),
+              sides.end());
+  auto index = [&](const Side& s, int k) { return store_.Index(s.a.x + k * s.step.x, s.a.y + k * s.step.y); };
+  const SurfaceTest& surf = store_.surfaces();
+
+  // Round 0: the ends, and both pixels of every surface change.
+  ForEach(sides, [&](Side& s, size_t) {
+    for (int k = 0; k <= s.length; k += s.length) store_.Request(s.a.x + k * s.step.x, s.a.y + k * s.step.y, SampleReason::kBorder);
+    for (int k = 0; k < s.length; ++k)
+      if (!surf.Same(index(s, k), index(s, k + 1)))
+        for (int j : {k, k + 1}) store_.Request(s.a.x + j * s.step.x, s.a.y + j * s.step.y, SampleReason::kBorder);
+  });
+  DCM_RETURN_IF_ERROR(Flush());
+  // Bisect every gap whose known ends differ, until none is left.
+  for (;;) {
+    std::atomic<int64_t> requested{0};
+    ForEach(sides, [&](Side& s, size_t) {
+      int last = 0;
+      for (int k = 1; k <= s.length; ++k) {
+        if (!store_.IsExact(index(s, k))) continue;
+        if (k > last + 1 && contrast_.Differ(store_.ValueAt(index(s, last)), store_.ValueAt(index(s, k)))) {
+          const int mid = (last + k) / 2;
+          store_.Request(s.a.x + mid * s.step.x, s.a.y + mid * s.step.y, SampleReason::kBorder);
+          ++requested;
+        }
+        last = k;
+      }
+    });
+    if (requested == 0) break;
+    DCM_RETURN_IF_ERROR(Flush());
+  }
+  // Fill the gaps along the side from known pixels of the same surface.
+  ForEach(sides, [&](Side& s, size_t) {
+    int last = 0;
+    for (int k = 1; k <= s.length; ++k) {
+      if (!store_.IsExact(index(s, k))) continue;
+      const int64_t i0 = index(s, last), i1 = index(s, k);
+      const Value v0 = store_.ValueAt(i0), v1 = store_.ValueAt(i1);
+      for (int j = last + 1; j < k; ++j) {
+        const int64_t ij = index(s, j);
+        const bool same0 = surf.Same(ij, i0), same1 = surf.Same(ij, i1);
+        const float t = (same0 == same1) ? float(j - last) / float(k - last) : (same0 ? 0.f : 1.f);
+        store_.SetFilled(ij, {v0.a * (1 - t) + v1.a * t, v0.b * (1 - t) + v1.b * t});
+      }
+      last = k;
+    }
+  });
+  return Status::Ok();
 }
 
 Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
@@ -351,8 +427,10 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
       ForEach(edges, [&](Block& b, size_t i) {
         eb[i].block = b;
         BorderLoop(b, &eb[i].border);
-        for (Point2i p : eb[i].border) store_.Request(p.x, p.y, SampleReason::kBorder);
+        if (!opt_.adaptiveBorders)
+          for (Point2i p : eb[i].border) store_.Request(p.x, p.y, SampleReason::kBorder);
       });
+      if (opt_.adaptiveBorders) DCM_RETURN_IF_ERROR(EvaluateBordersAdaptively(edges));
       DCM_RETURN_IF_ERROR(Flush());
       ForEach(eb, [&](EdgeBlock& e, size_t) {
         e.direction = LeastDiscrepancyDirection(store_, e.block, e.border, opt_.directions);
@@ -425,11 +503,37 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
           }
         }
       } else {
-        for (const EdgeBlock& e : eb) {
-          const bool fallback = opt_.fallback && int(e.crossings.size()) > opt_.fallbackMaxChanges;
-          const BlockType type = fallback ? BlockType::kFallback
+        // More discontinuities than one direction can serve, a border that
+        // needed nearly every pixel exactly (adaptive borders), or an
+        // interpolation that misses the block's centre: evaluate it all.
+        std::vector<uint8_t> fallback(eb.size(), 0);
+        ForEach(eb, [&](EdgeBlock& e, size_t i) {
+          size_t exactBorder = 0;
+          for (Point2i p : e.border) exactBorder += store_.IsExact(store_.Index(p.x, p.y));
+          const bool busy = opt_.adaptiveBorders && 4 * exactBorder > 3 * e.border.size();
+          fallback[i] = opt_.fallback && (busy || int(e.crossings.size()) > opt_.fallbackMaxChanges);
+          if (!fallback[i] && opt_.fallback && opt_.finestCentreProbe && e.block.HasInterior())
+            store_.Request(e.block.Centre().x, e.block.Centre().y, SampleReason::kCentreProbe);
+        });
+        if (opt_.fallback && opt_.finestCentreProbe) {
+          DCM_RETURN_IF_ERROR(Flush());
+          ForEach(eb, [&](EdgeBlock& e, size_t i) {
+            if (fallback[i] || !e.block.HasInterior()) return;
+            const Point2i c = e.block.Centre();
+            Interpolant in;
+            if (!OrientedInterpolant(store_, e.block, c, Direction::Of(e.direction.index, opt_.directions), &in))
+              return;
+            // A centre on another surface than its interpolants is the thin
+            // object test's business, not a miss.
+            if (Resolve(c, &in) != SampleReason::kInterpolated) return;
+            fallback[i] = contrast_.Differ(At(c), Evaluate(store_, in));
+          });
+        }
+        for (size_t i = 0; i < eb.size(); ++i) {
+          const EdgeBlock& e = eb[i];
+          const BlockType type = fallback[i] ? BlockType::kFallback
                                  : e.crossings.size() <= 2 ? BlockType::kSimpleEdge : BlockType::kComplexEdge;
-          (fallback ? fallbackLeaves_ : orientedLeaves_).push_back(MakeLeaf(e.block, type, e.direction.index));
+          (fallback[i] ? fallbackLeaves_ : orientedLeaves_).push_back(MakeLeaf(e.block, type, e.direction.index));
         }
       }
       classify = std::move(nextClassify);
@@ -437,9 +541,10 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
     }
 
     // Fallback blocks: every interior pixel exactly.
+    // (with adaptive borders, the border pixels not evaluated yet too).
     ForEach(fallbackLeaves_, [&](Leaf& l, size_t) {
-      for (int y = l.block.y0 + 1; y < l.block.y1; ++y)
-        for (int x = l.block.x0 + 1; x < l.block.x1; ++x) store_.Request(x, y, SampleReason::kFallback);
+      for (int y = l.block.y0; y <= l.block.y1; ++y)
+        for (int x = l.block.x0; x <= l.block.x1; ++x) store_.Request(x, y, SampleReason::kFallback);
     });
     // Thin objects (3.1): interior pixels whose interpolants lie on another surface.
     Progress(0.9f, "thin objects");

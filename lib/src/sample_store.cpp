@@ -17,6 +17,7 @@ SampleStore::SampleStore(int width, int height, bool split)
   out_.assign(n, RGB{});
   reason_.assign(n, SampleReason::kInterpolated);
   finite_.assign(n, 1);
+  filled_.assign(n, 0);
 }
 
 void SampleStore::SetGuides(GuideImage guides, ObjectTest test) {

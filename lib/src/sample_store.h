@@ -58,6 +58,13 @@ class SampleStore {
 
   /// Writes an interpolated value (never over an exact pixel).
   void SetInterpolated(int64_t i, const Value& v);
+  /// Writes a value filled along an edge-block border; block interiors then
+  /// interpolate it, and smooth blocks leave it in place.
+  void SetFilled(int64_t i, const Value& v) {
+    SetInterpolated(i, v);
+    if (!IsExact(i)) filled_[i] = 1;
+  }
+  bool IsFilled(int64_t i) const { return filled_[i] != 0; }
 
   /// Asks for pixel (x, y) to be evaluated exactly in the next Flush(). Safe
   /// to call concurrently. When several reasons ask for one pixel, the one
@@ -86,7 +93,7 @@ class SampleStore {
   std::vector<RGB> a_, b_;  // (L_i, L_c) with the split only
   std::vector<RGB> out_, tau_;
   std::vector<SampleReason> reason_;
-  std::vector<uint8_t> finite_;
+  std::vector<uint8_t> finite_, filled_;
   GuideImage guides_;
   SurfaceTest surfaces_;
   tbb::enumerable_thread_specific<std::vector<uint64_t>> requests_;

@@ -59,21 +59,27 @@ TEST(TextureSplit, TexturedFloorNeedsSeveralTimesFewerSamples) {
         }
     return double(exact) / double(total);
   };
-  AnalyticProvider p1(N, N, FurnishedScene(N, N, floorOnly)), p2(N, N, FurnishedScene(N, N, floorOnly));
-  ReconstructionOptions split;
-  ReconstructionOptions noSplit = split;
+  AnalyticProvider provider(N, N, FurnishedScene(N, N, floorOnly));
+  const auto full = provider.FullRender();
+  ReconstructionOptions noSplit;
   noSplit.textureSplit = false;
-  const Reconstruction a = ReconstructOrFail(p1, split);
-  const Reconstruction b = ReconstructOrFail(p2, noSplit);
-  const auto full = p1.FullRender();
-  const double psnrSplit = DisplayPsnr(a.workImage, full), psnrNoSplit = DisplayPsnr(b.workImage, full);
-  EXPECT_TRUE(a.stats.usedSplit);
-  EXPECT_FALSE(b.stats.usedSplit);
-  // Equal error: the split is at least as accurate...
-  EXPECT_GT(psnrSplit, psnrNoSplit - 0.5) << psnrSplit << " vs " << psnrNoSplit;
-  // ...with several times fewer exact pixels on the floor.
-  EXPECT_GT(fractionOnFloor(b), 3.0 * fractionOnFloor(a))
-      << fractionOnFloor(b) << " vs " << fractionOnFloor(a);
+  const Reconstruction guo = ReconstructOrFail(provider, noSplit);
+  const double targetPsnr = DisplayPsnr(guo.workImage, full);
+  EXPECT_FALSE(guo.stats.usedSplit);
+  // Equal error: the coarsest threshold at which the split is at least as
+  // accurate as the unsplit reconstruction.
+  double best = 1.0;
+  for (float threshold : {0.06f, 0.1f, 0.15f, 0.25f, 0.4f}) {
+    ReconstructionOptions split;
+    split.contrastThreshold = threshold;
+    const Reconstruction r = ReconstructOrFail(provider, split);
+    EXPECT_TRUE(r.stats.usedSplit);
+    if (DisplayPsnr(r.workImage, full) >= targetPsnr) best = std::min(best, fractionOnFloor(r));
+  }
+  std::printf("floor exact fraction at %.1f dB: %.4f without the split, %.4f with\n", targetPsnr,
+              fractionOnFloor(guo), best);
+  // Several times fewer exact pixels on the floor (the paper: 4.9x).
+  EXPECT_GT(fractionOnFloor(guo), 3.0 * best);
 }
 
 // Without texture the engine does not ask for the split at all.

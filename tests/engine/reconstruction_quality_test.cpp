@@ -76,10 +76,20 @@ TEST(ReconstructionQuality, FullEvaluationIsTheBaseline) {
 TEST(ReconstructionQuality, PureNoiseFallsBackToTheFullRender) {
   const int N = 48;
   AnalyticProvider provider(N, N, Noise(7));
-  const Reconstruction r = ReconstructOrFail(provider, ReconstructionOptions{});
+  // With full borders every block of noise shows more changes along its
+  // border than one direction can serve: the result is the full render.
+  ReconstructionOptions fullBorders;
+  fullBorders.adaptiveBorders = false;
+  Reconstruction r = ReconstructOrFail(provider, fullBorders);
   EXPECT_EQ(r.stats.exactPixels, r.stats.totalPixels);
   EXPECT_EQ(r.workImage, provider.FullRender());
   EXPECT_GT(r.stats.byReason[size_t(SampleReason::kFallback)], 0);
+  // Adaptive borders fill gaps whose ends agree; in noise two samples agree
+  // by chance, so a block may escape all three detectors (changes, busy
+  // border, centre probe). Measured: 9 of 2304 pixels interpolated.
+  AnalyticProvider provider2(N, N, Noise(7));
+  r = ReconstructOrFail(provider2, ReconstructionOptions{});
+  EXPECT_GT(r.stats.exactFraction(), 0.98);
 }
 
 TEST(ReconstructionQuality, ConstantImageNeedsOnlyTheLattice) {

@@ -54,6 +54,11 @@ struct ReconstructionOptions {
   bool textureSplit = true;
 
   SmoothRefinement smoothRefinement = SmoothRefinement::kCentreProbe;
+  /// Edge-block borders: evaluate the pixels at surface changes and bisect
+  /// every gap whose ends differ significantly; fill the rest along the border
+  /// from known pixels of the same surface. Off: every border pixel exactly
+  /// (the paper).
+  bool adaptiveBorders = true;
 
   bool zeroOrderTest = true;   ///< simple/complex: exactly two changes along the border
   /// An edge block with no significant change along its border (a smooth
@@ -63,9 +68,14 @@ struct ReconstructionOptions {
   bool lazyEvaluation = true;  ///< children of simple edge blocks: centre pixel only
   /// At the finest level, evaluate the interior of an edge block whose border
   /// shows more than `fallbackMaxChanges` significant changes (more than two
-  /// discontinuities cross it: no single direction can serve it).
+  /// discontinuities cross it: no single direction can serve it), or, with
+  /// adaptive borders, whose border needed more than 3/4 of its pixels exactly.
   bool fallback = true;
   int fallbackMaxChanges = 4;
+  /// At the finest level, evaluate the centre of each edge block and fall back
+  /// to exact evaluation where its interpolation misses it (an error estimate
+  /// that refines below the finest block size).
+  bool finestCentreProbe = true;
 
   int downsample = 1;   ///< the working image is `downsample`x the output per axis
   bool fullEvaluation = false;  ///< baseline: evaluate every pixel exactly

@@ -20,6 +20,7 @@ enum class SampleReason : uint8_t {
   kBorder,            ///< border of an edge block
   kFirstOrderProbe,   ///< next to a border crossing, for the first-order test
   kLazyCentre,        ///< centre of a simple edge block (lazy evaluation)
+  kCentreProbe,       ///< centre of a finest edge block, checking its interpolation
   kThinObject,        ///< interior pixel on another surface than its interpolants (3.1)
   kFallback,          ///< interior of a block no direction explains
   kFull,              ///< full evaluation (baseline)
