@@ -366,7 +366,8 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
   pending_ = pending;
   const auto tStart = Clock::now();
   const int W = caps_.width, H = caps_.height;
-  DCM_RETURN_IF_ERROR(LoadGuides());
+  // The baseline needs no guides: it evaluates every pixel.
+  if (!opt_.fullEvaluation) DCM_RETURN_IF_ERROR(LoadGuides());
 
   if (opt_.fullEvaluation) {
     for (int y = 0; y < H; ++y)
@@ -610,7 +611,7 @@ Status Reconstruct(SampleProvider& provider, const ReconstructionOptions& option
   if (caps.width <= 0 || caps.height <= 0 || int64_t(caps.width) * caps.height > kMaxPixels)
     return Status::Error("provider '" + caps.name + "' reports an unusable size " + std::to_string(caps.width) +
                          "x" + std::to_string(caps.height));
-  const bool split = options.textureSplit && caps.texture && caps.splitRadiance;
+  const bool split = options.textureSplit && caps.texture && caps.splitRadiance && !options.fullEvaluation;
   Status status;
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   arena.execute([&] {

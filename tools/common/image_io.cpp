@@ -25,8 +25,14 @@ using OIIO::TypeDesc;
 std::string TemporaryName(const std::string& path) {
   static std::atomic<unsigned> counter{0};
   fs::path p(path);
-  std::string name = "." + p.stem().string() + ".dcmtmp" + std::to_string(::getpid()) + "_" +
-                     std::to_string(counter.fetch_add(1)) + p.extension().string();
+  // Built by append: GCC 12 warns falsely (-Wrestrict) on "." + std::string.
+  std::string name(1, '.');
+  name.append(p.stem().string());
+  name.append(".dcmtmp");
+  name.append(std::to_string(::getpid()));
+  name.push_back('_');
+  name.append(std::to_string(counter.fetch_add(1)));
+  name.append(p.extension().string());
   return (p.parent_path() / name).string();
 }
 

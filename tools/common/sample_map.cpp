@@ -16,12 +16,13 @@ std::array<uint8_t, 3> ReasonColor(SampleReason reason) {
     case SampleReason::kBorder: return {0, 190, 255};           // cyan-blue
     case SampleReason::kFirstOrderProbe: return {255, 0, 255};  // magenta
     case SampleReason::kLazyCentre: return {0, 220, 0};         // green
+    case SampleReason::kCentreProbe: return {255, 255, 0};      // yellow
     case SampleReason::kThinObject: return {255, 40, 40};       // red
     case SampleReason::kFallback: return {255, 170, 0};         // orange
     case SampleReason::kFull: return {150, 150, 255};           // lavender
     case SampleReason::kCount: break;
   }
-  return {255, 255, 0};  // yellow: an unknown reason (never expected)
+  return {128, 64, 0};  // brown: an unknown reason (never expected)
 }
 
 std::vector<uint8_t> SampleMapImage(const Reconstruction& r) {

@@ -13,7 +13,7 @@ namespace dcm::toolkit {
 
 /// sRGB colour of each reason (interpolated pixels are drawn dark gray):
 /// corner white, border cyan-blue, first-order probe magenta, lazy centre
-/// green, thin object red, fallback orange, full evaluation lavender.
+/// green, centre probe yellow, thin object red, fallback orange, full evaluation lavender.
 std::array<uint8_t, 3> ReasonColor(SampleReason reason);
 
 /// The sample map as 8-bit RGB (row-major, 3 bytes a pixel) at the working

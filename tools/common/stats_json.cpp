@@ -1,17 +1,34 @@
 // Statistics and settings as JSON.
 #include "stats_json.h"
 
+#include <cstdio>
+#include <cstdlib>
 #include <fstream>
+#include <string>
 
 #include "image_io.h"
 
 namespace dcm::toolkit {
 
+namespace {
+/// A float option as the shortest decimal that reads back as the same float
+/// (0.06, not 0.0599999986...).
+double Decimal(float v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.9g", double(v));
+  for (int digits = 1; digits <= 9; ++digits) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, double(v));
+    if (std::strtof(buf, nullptr) == v) break;
+  }
+  return std::strtod(buf, nullptr);
+}
+}  // namespace
+
 nlohmann::json OptionsToJson(const ReconstructionOptions& o) {
   nlohmann::json j;
   j["elementary_block"] = o.elementaryBlock;
   j["min_block"] = o.minBlock;
-  j["contrast_threshold"] = o.contrastThreshold;
+  j["contrast_threshold"] = Decimal(o.contrastThreshold);
   j["contrast_metric"] = std::string(ToString(o.contrastMetric));
   j["directions"] = o.directions;
   j["object_test"] = std::string(ToString(o.objectTest));

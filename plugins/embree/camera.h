@@ -1,0 +1,34 @@
+// The pinhole camera of the internal ray tracer.
+#pragma once
+
+#include "embree/scene.h"
+#include "embree/vec3.h"
+
+namespace dcm::embree {
+
+/// A primary ray with the directions through the next pixel centres in x and
+/// y (ray differentials, for texture filtering).
+struct CameraRay {
+  Vec3 origin;
+  Vec3 dir;    ///< unit
+  Vec3 dirDx;  ///< unit, through (x+1, y)
+  Vec3 dirDy;  ///< unit, through (x, y+1)
+};
+
+/// A pinhole camera over a working image of `width` x `height` pixels (the
+/// supersampled image): pixel (x, y) is sampled at its centre, y grows down.
+class Camera {
+ public:
+  Camera(const CameraDesc& desc, int width, int height);
+
+  /// The ray through the centre of working pixel (x, y).
+  CameraRay Generate(int x, int y) const;
+
+ private:
+  Vec3 Direction(float fx, float fy) const;
+  Vec3 origin_, forward_, right_, up_;
+  float tanHalf_ = 1.f, aspect_ = 1.f;
+  int width_ = 1, height_ = 1;
+};
+
+}  // namespace dcm::embree

@@ -1,0 +1,170 @@
+#include "embree/embree_scene.h"
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "embree/mesh_loader.h"
+
+namespace dcm::embree {
+namespace {
+
+/// Keeps the first error Embree reports on a device (user pointer: a std::string).
+void OnDeviceError(void* user, RTCError code, const char* message) {
+  auto* first = static_cast<std::string*>(user);
+  if (first->empty()) *first = "Embree error " + std::to_string(int(code)) + ": " + (message ? message : "");
+}
+
+}  // namespace
+
+EmbreeScene::~EmbreeScene() {
+  if (scene_) rtcReleaseScene(scene_);
+  if (device_) rtcReleaseDevice(device_);
+}
+
+Status EmbreeScene::AddMesh(TriangleMesh mesh, int object, int light) {
+  if (mesh.indices.empty()) return Status::Ok();
+  RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+  // rtcSetNewGeometryBuffer pads the buffer as Embree needs (16-byte reads).
+  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                        3 * sizeof(float), mesh.positions.size()));
+  auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                             3 * sizeof(uint32_t), mesh.triangleCount()));
+  if (!v || !idx) {
+    rtcReleaseGeometry(g);
+    return Status::Error("Embree: cannot allocate a geometry buffer");
+  }
+  for (size_t i = 0; i < mesh.positions.size(); ++i) {
+    v[3 * i] = mesh.positions[i].x;
+    v[3 * i + 1] = mesh.positions[i].y;
+    v[3 * i + 2] = mesh.positions[i].z;
+  }
+  std::copy(mesh.indices.begin(), mesh.indices.end(), idx);
+  rtcCommitGeometry(g);
+  unsigned id = unsigned(geometries_.size());
+  rtcAttachGeometryByID(scene_, g, id);
+  rtcReleaseGeometry(g);
+  geometries_.push_back({std::move(mesh), object, light});
+  return Status::Ok();
+}
+
+Status EmbreeScene::Build(const Scene& scene, std::unique_ptr<EmbreeScene>* out) {
+  std::unique_ptr<EmbreeScene> s(new EmbreeScene());
+  s->device_ = rtcNewDevice(nullptr);
+  if (!s->device_) return Status::Error("Embree: cannot create a device");
+  rtcSetDeviceErrorFunction(s->device_, OnDeviceError, &s->deviceError_);
+  s->scene_ = rtcNewScene(s->device_);
+  rtcSetSceneBuildQuality(s->scene_, RTC_BUILD_QUALITY_HIGH);
+  const std::string prefix = scene.file.empty() ? "" : scene.file + ": ";
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    const ObjectDesc& o = scene.objects[i];
+    TriangleMesh mesh;
+    if (o.shape == ShapeKind::kMesh) {
+      DCM_RETURN_IF_ERROR(LoadMeshFile(o.file, prefix + o.path + ".file", &mesh));
+    } else {
+      mesh = TessellateShape(o);
+    }
+    ApplyTransform(o.transform, &mesh);
+    DCM_RETURN_IF_ERROR(s->AddMesh(std::move(mesh), int(i), -1));
+  }
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    const LightDesc& l = scene.lights[i];
+    if (l.kind == LightKind::kRect && l.visible) {
+      DCM_RETURN_IF_ERROR(s->AddMesh(MakeParallelogram(l.origin, l.edgeU, l.edgeV), -1, int(i)));
+    }
+  }
+  rtcCommitScene(s->scene_);
+  rtcSetDeviceErrorFunction(s->device_, nullptr, nullptr);
+  if (!s->deviceError_.empty()) return Status::Error(prefix + s->deviceError_);
+  *out = std::move(s);
+  return Status::Ok();
+}
+
+size_t EmbreeScene::triangleCount() const {
+  size_t n = 0;
+  for (const auto& g : geometries_) n += g.mesh.triangleCount();
+  return n;
+}
+
+Vec3 EmbreeScene::Offset(Vec3 p, Vec3 n) {
+  // Relative to the magnitude of the coordinates: float spacing grows with it.
+  float m = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z), 1.f});
+  return p + n * (2e-5f * m);
+}
+
+bool EmbreeScene::Intersect(Vec3 org, Vec3 dir, float tnear, float tfar, SurfaceHit* hit) const {
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  RTCRayHit rh;
+  rh.ray.org_x = org.x; rh.ray.org_y = org.y; rh.ray.org_z = org.z;
+  rh.ray.dir_x = dir.x; rh.ray.dir_y = dir.y; rh.ray.dir_z = dir.z;
+  rh.ray.tnear = tnear;
+  rh.ray.tfar = tfar;
+  rh.ray.mask = 0xffffffffu;
+  rh.ray.flags = 0;
+  rh.ray.time = 0.f;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(scene_, &ctx, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+
+  const Geometry& g = geometries_[rh.hit.geomID];
+  const TriangleMesh& m = g.mesh;
+  const uint32_t i0 = m.indices[3 * rh.hit.primID], i1 = m.indices[3 * rh.hit.primID + 1],
+                 i2 = m.indices[3 * rh.hit.primID + 2];
+  const float b1 = rh.hit.u, b2 = rh.hit.v, b0 = 1.f - b1 - b2;
+  const Vec3 p0 = m.positions[i0], p1 = m.positions[i1], p2 = m.positions[i2];
+  hit->t = rh.ray.tfar;
+  hit->p = p0 * b0 + p1 * b1 + p2 * b2;
+  Vec3 ng = Normalize(Cross(p1 - p0, p2 - p0));
+  Vec3 ns = m.normals.empty() ? ng : Normalize(m.normals[i0] * b0 + m.normals[i1] * b1 + m.normals[i2] * b2);
+  if (Dot(ns, ng) < 0.f) ns = -ns;  // vertex normals agree with the winding only up to sign
+  hit->front = Dot(ng, dir) < 0.f;
+  if (!hit->front) {
+    ng = -ng;
+    ns = -ns;
+  }
+  hit->ng = ng;
+  hit->ns = ns;
+
+  Vec2 t0{0.f, 0.f}, t1{1.f, 0.f}, t2{0.f, 1.f};
+  if (!m.uvs.empty()) {
+    t0 = m.uvs[i0];
+    t1 = m.uvs[i1];
+    t2 = m.uvs[i2];
+  }
+  hit->uv = t0 * b0 + t1 * b1 + t2 * b2;
+  // dp/du and dp/dv from the triangle's edges in position and uv (pbrt 3.6.2).
+  Vec2 d02 = t0 - t2, d12 = t1 - t2;
+  Vec3 dp02 = p0 - p2, dp12 = p1 - p2;
+  float det = d02.x * d12.y - d02.y * d12.x;
+  if (std::abs(det) < 1e-12f) {
+    Frame f(ng);
+    hit->dpdu = f.s;
+    hit->dpdv = f.t;
+  } else {
+    float inv = 1.f / det;
+    hit->dpdu = (dp02 * d12.y - dp12 * d02.y) * inv;
+    hit->dpdv = (dp12 * d02.x - dp02 * d12.x) * inv;
+  }
+  hit->object = g.object;
+  hit->light = g.light;
+  return true;
+}
+
+bool EmbreeScene::Occluded(Vec3 org, Vec3 dir, float tnear, float tfar) const {
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  RTCRay ray;
+  ray.org_x = org.x; ray.org_y = org.y; ray.org_z = org.z;
+  ray.dir_x = dir.x; ray.dir_y = dir.y; ray.dir_z = dir.z;
+  ray.tnear = tnear;
+  ray.tfar = tfar;
+  ray.mask = 0xffffffffu;
+  ray.flags = 0;
+  ray.time = 0.f;
+  rtcOccluded1(scene_, &ctx, &ray);
+  return ray.tfar < 0.f;  // set to -inf when occluded
+}
+
+}  // namespace dcm::embree

@@ -1,0 +1,115 @@
+// Exact evaluation of one pixel: direct light with stratified shadow rays (soft
+// shadows), glossy reflection by lobe sampling with multiple importance
+// sampling, recursive perfect mirrors, optional indirect diffuse light; and the
+// cheap guides of a pixel from its primary ray.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "dcm/color.h"
+#include "embree/camera.h"
+#include "embree/embree_scene.h"
+#include "embree/lights.h"
+#include "embree/materials.h"
+#include "embree/sampling.h"
+#include "embree/scene.h"
+
+namespace dcm::embree {
+
+/// Rays traced, by purpose.
+struct RayCounts {
+  uint64_t primary = 0;   ///< camera rays of exact samples
+  uint64_t guide = 0;     ///< camera and mirror rays of the guides
+  uint64_t shadow = 0;    ///< towards lights
+  uint64_t glossy = 0;    ///< sampling glossy lobes
+  uint64_t mirror = 0;    ///< perfect reflections
+  uint64_t indirect = 0;  ///< indirect diffuse
+  uint64_t total() const { return primary + guide + shadow + glossy + mirror + indirect; }
+  RayCounts& operator+=(const RayCounts& o) {
+    primary += o.primary; guide += o.guide; shadow += o.shadow;
+    glossy += o.glossy; mirror += o.mirror; indirect += o.indirect;
+    return *this;
+  }
+};
+
+/// One exact pixel: L = Li * tau + Lc (exactly, in floats).
+struct PixelRadiance {
+  RGB L, Li, Lc;
+  RGB tau{1.f, 1.f, 1.f};
+};
+
+/// The guides of one pixel.
+struct PixelGuide {
+  uint32_t objectId = 0;  ///< 0: background
+  uint32_t shaderId = 0;  ///< 0: background
+  RGB tau{1.f, 1.f, 1.f};
+};
+
+/// What the integrator may trace; set from the scene (only the effects the
+/// scene calls for).
+struct IntegratorConfig {
+  int shadowRays = 16;
+  int secondaryShadowRays = 1;
+  int glossyRays = 0;       ///< 0 when no material is glossy
+  int mirrorDepth = 0;      ///< 0 when no material is a mirror
+  int indirectBounces = 0;  ///< 0: off
+  int indirectRays = 0;
+  uint32_t seed = 0;
+  RGB background;
+};
+
+/// Evaluates pixels of the working image. Thread safe: all state is const and
+/// every call seeds its own random numbers from the pixel.
+class Integrator {
+ public:
+  /// `materials` indexed like Scene::materials; `objectMaterial` and `objectId`
+  /// per object; `lightId` per light (for visible rect lights).
+  Integrator(const EmbreeScene& bvh, const Camera& camera, IntegratorConfig config,
+             std::vector<Material> materials, std::vector<Light> lights,
+             std::vector<int> objectMaterial, std::vector<uint32_t> objectId,
+             std::vector<uint32_t> lightId);
+
+  /// The exact radiance of working pixel (x, y), split at the first hit.
+  PixelRadiance Evaluate(int x, int y, RayCounts* counts) const;
+
+  /// Object ID, shader ID (through mirror chains: IDs of the whole chain) and
+  /// tau of working pixel (x, y); `tau` only when `wantTau`.
+  PixelGuide Guide(int x, int y, bool wantTau, RayCounts* counts) const;
+
+ private:
+  struct Quality;
+  struct Differentials;
+  struct Shading {
+    RGB diffuse;   ///< (1/pi) * incident light * cos: multiplied by the albedo
+    RGB constant;  ///< glossy, mirror: not multiplied by the albedo
+  };
+
+  Shading Shade(const SurfaceHit& h, Vec3 wo, const Material& m, const Quality& q,
+                const Differentials* diff, Pcg32& rng, RayCounts* counts) const;
+  /// Radiance leaving `h` towards -dir, emission excluded.
+  RGB Reflected(const SurfaceHit& h, Vec3 dir, const Quality& q, const Differentials* diff,
+                Pcg32& rng, RayCounts* counts) const;
+  /// Radiance arriving along a mirror-reflected ray (emission included).
+  RGB TraceMirror(Vec3 org, Vec3 dir, const Quality& q, const Differentials* diff, Pcg32& rng,
+                  RayCounts* counts) const;
+  void DirectLight(const SurfaceHit& h, Vec3 wo, const Material& m, int samples, int glossyRays,
+                   Pcg32& rng, RayCounts* counts, Shading* out) const;
+  RGB TauAt(const SurfaceHit& h, const Material& m, const Differentials* diff) const;
+  RGB Emission(const SurfaceHit& h) const;
+
+  const EmbreeScene& bvh_;
+  const Camera& camera_;
+  IntegratorConfig cfg_;
+  std::vector<Material> materials_;
+  std::vector<Light> lights_;
+  std::vector<int> objectMaterial_;
+  std::vector<uint32_t> objectId_;
+  std::vector<uint32_t> lightId_;
+};
+
+/// The ID of a chain of surfaces seen through mirrors: the plain ID for a
+/// chain of one, else a hash of the chain with the top bit set.
+uint32_t ChainId(const uint32_t* ids, int count);
+
+}  // namespace dcm::embree

@@ -1,0 +1,163 @@
+// Guides: object and shader IDs at known pixels, and through a planar mirror
+// the IDs of what the mirror shows.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "embree/integrator.h"
+#include "test_scenes.h"
+
+namespace dcm::embree {
+namespace {
+
+using testing::MakeProvider;
+
+/// Camera at z=5 looking down -z at a quad in the plane z=0 (id 10), which
+/// fills the view; 64x64 pixels, tan(fov/2) = 0.1763 (fov 20 degrees). Behind
+/// the camera, out of its view, a large backdrop at z=10 (id 20) and a small
+/// box around (0.5, 0.5, 7) (id 30). `wall` is the quad's material.
+std::string MirrorScene(const std::string& wall) {
+  return R"({
+    "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 20, "resolution": [64, 64]},
+    "render": {"mirror_depth": 2, "shadow_rays": 1},
+    "materials": {"wall": )" + wall + R"(, "backdrop": {"type": "diffuse"}, "red": {"type": "diffuse", "color": [1, 0, 0]}},
+    "objects": [
+      {"type": "quad", "id": 10, "material": "wall", "origin": [-1.5, -1.5, 0], "edge_u": [3, 0, 0], "edge_v": [0, 3, 0]},
+      {"type": "quad", "id": 20, "material": "backdrop", "origin": [-6, -6, 10], "edge_u": [12, 0, 0], "edge_v": [0, 12, 0]},
+      {"type": "box", "id": 30, "material": "red", "min": [0.3, 0.3, 6.9], "max": [0.7, 0.7, 7.1]}
+    ],
+    "lights": [{"type": "point", "position": [0, 0, 8], "intensity": 5}]
+  })";
+}
+
+/// The working pixel whose primary ray hits the plane z=0 at (x, y), camera as above.
+Point2i PixelOf(float x, float y) {
+  const float tanHalf = std::tan(10.f * 3.14159265f / 180.f);
+  float sx = x / 5.f / tanHalf, sy = y / 5.f / tanHalf;
+  return {int(std::floor((sx + 1.f) * 0.5f * 64.f)), int(std::floor((1.f - sy) * 0.5f * 64.f))};
+}
+
+GuideImage AllGuides(EmbreeProvider& p) {
+  GuideImage g;
+  GuideRequest req;
+  req.objectId = req.shaderId = req.texture = true;
+  Status st = p.Guides({{0, 0}, {p.workWidth(), p.workHeight()}}, req, &g);
+  EXPECT_TRUE(st.ok()) << st.message();
+  return g;
+}
+
+TEST(Guides, DiffuseWallShowsItsOwnIds) {
+  auto p = MakeProvider(MirrorScene(R"({"type": "diffuse"})"));
+  ASSERT_TRUE(p);
+  GuideImage g = AllGuides(*p);
+  ASSERT_EQ(g.objectId.size(), 64u * 64u);
+  for (size_t i = 0; i < g.objectId.size(); ++i) {
+    ASSERT_EQ(g.objectId[i], 10u) << i;
+    ASSERT_EQ(g.shaderId[i], 1u) << i;  // material index 0 + 1
+    ASSERT_EQ(g.texture[i], RGB::Gray(1.f)) << i;  // untextured: tau = 1
+  }
+}
+
+TEST(Guides, MirrorShowsTheIdsOfWhatItReflects) {
+  auto p = MakeProvider(MirrorScene(R"({"type": "mirror"})"));
+  ASSERT_TRUE(p);
+  GuideImage g = AllGuides(*p);
+  const Bounds2i& r = g.region;
+  // A reflected ray from mirror point (x, y, 0) reaches z=7 at (2.4x, 2.4y):
+  // the box (0.3..0.7) is seen around mirror point (0.21, 0.21).
+  const Point2i onBox = PixelOf(0.21f, 0.21f);
+  const Point2i onBackdrop = PixelOf(-0.6f, -0.6f);
+  const uint32_t boxChain[2] = {10u, 30u}, backdropChain[2] = {10u, 20u};
+  const uint32_t boxShaders[2] = {1u, 3u}, backdropShaders[2] = {1u, 2u};
+  EXPECT_EQ(g.objectId[size_t(r.offset(onBox))], ChainId(boxChain, 2));
+  EXPECT_EQ(g.shaderId[size_t(r.offset(onBox))], ChainId(boxShaders, 2));
+  EXPECT_EQ(g.objectId[size_t(r.offset(onBackdrop))], ChainId(backdropChain, 2));
+  EXPECT_EQ(g.shaderId[size_t(r.offset(onBackdrop))], ChainId(backdropShaders, 2));
+  // Mirrored IDs never collide with plain ones, and the two chains differ.
+  EXPECT_NE(ChainId(boxChain, 2) & 0x80000000u, 0u);
+  EXPECT_NE(ChainId(boxChain, 2), ChainId(backdropChain, 2));
+  // The box is behind the camera: only the mirror chain shows it. Predict, per
+  // pixel, whether the reflected centre ray hits the box: the camera ray is
+  // (sx, sy, -1), it meets the mirror at 5*(sx, sy), the reflection is at
+  // sx*(5+z), sy*(5+z) at depth z. Pixels within 0.003 of the box's outline
+  // are left out (float rounding of the tessellated box).
+  const float tanHalf = std::tan(10.f * 3.14159265f / 180.f);
+  auto hitsBox = [&](int px, int py, float grow) {
+    float sx = (2.f * (float(px) + 0.5f) / 64.f - 1.f) * tanHalf;
+    float sy = (1.f - 2.f * (float(py) + 0.5f) / 64.f) * tanHalf;
+    if (sx <= 0.f || sy <= 0.f) return false;
+    float z0 = 6.9f - grow, z1 = 7.1f + grow;
+    z0 = std::max({z0, (0.3f - grow) / sx - 5.f, (0.3f - grow) / sy - 5.f});
+    z1 = std::min({z1, (0.7f + grow) / sx - 5.f, (0.7f + grow) / sy - 5.f});
+    return z0 <= z1;
+  };
+  int boxPixels = 0;
+  for (int y = 0; y < 64; ++y) {
+    for (int x = 0; x < 64; ++x) {
+      bool surelyIn = hitsBox(x, y, -0.003f), possiblyIn = hitsBox(x, y, 0.003f);
+      bool isBox = g.objectId[size_t(r.offset({x, y}))] == ChainId(boxChain, 2);
+      boxPixels += isBox;
+      if (surelyIn) {
+        EXPECT_TRUE(isBox) << x << "," << y;
+      }
+      if (!possiblyIn) {
+        EXPECT_FALSE(isBox) << x << "," << y;
+      }
+    }
+  }
+  EXPECT_GT(boxPixels, 25);  // about 0.17 units of mirror = 6 pixels per side
+}
+
+TEST(Guides, SubRegionMatchesFullImage) {
+  auto p = MakeProvider(MirrorScene(R"({"type": "mirror"})"));
+  ASSERT_TRUE(p);
+  GuideImage full = AllGuides(*p);
+  GuideImage part;
+  GuideRequest req;
+  req.objectId = true;
+  const Bounds2i region{{30, 17}, {45, 40}};
+  ASSERT_TRUE(p->Guides(region, req, &part).ok());
+  EXPECT_TRUE(part.shaderId.empty());
+  EXPECT_TRUE(part.texture.empty());
+  for (int y = region.min.y; y < region.max.y; ++y)
+    for (int x = region.min.x; x < region.max.x; ++x)
+      ASSERT_EQ(part.objectId[size_t(region.offset({x, y}))], full.objectId[size_t(full.region.offset({x, y}))]);
+}
+
+TEST(Guides, ObjectsAndBackgroundAtKnownPixels) {
+  // Looking straight down at a floor quad (id 5) spanning x,z in [-1, 1] with
+  // a box (id 6) in the middle; the corners of the view miss the floor.
+  auto p = MakeProvider(R"({
+    "camera": {"position": [0, 5, 0], "look_at": [0, 0, 0], "up": [0, 0, -1], "fov": 30, "resolution": [40, 40]},
+    "materials": {"a": {"type": "diffuse"}, "b": {"type": "diffuse"}},
+    "objects": [
+      {"type": "quad", "id": 5, "material": "a", "origin": [-1, 0, 1], "edge_u": [2, 0, 0], "edge_v": [0, 0, -2]},
+      {"type": "box", "id": 6, "material": "b", "min": [-0.2, 0, -0.2], "max": [0.2, 0.3, 0.2]}
+    ],
+    "lights": [{"type": "point", "position": [0, 3, 0], "intensity": 1}]
+  })");
+  ASSERT_TRUE(p);
+  GuideImage g = AllGuides(*p);
+  auto at = [&](int x, int y) { return size_t(g.region.offset({x, y})); };
+  // View half-width at the floor: 5 * tan(15 deg) = 1.34 > 1: corners see nothing.
+  EXPECT_EQ(g.objectId[at(0, 0)], 0u);
+  EXPECT_EQ(g.shaderId[at(0, 0)], 0u);
+  EXPECT_EQ(g.objectId[at(20, 20)], 6u);
+  EXPECT_EQ(g.shaderId[at(20, 20)], 2u);
+  // x = 0.7 on the floor: pixel (0.7/1.34 + 1) * 20 = 30.4.
+  EXPECT_EQ(g.objectId[at(30, 20)], 5u);
+  EXPECT_EQ(g.shaderId[at(30, 20)], 1u);
+}
+
+TEST(Guides, RegionOutsideTheImageIsAnError) {
+  auto p = MakeProvider(MirrorScene(R"({"type": "diffuse"})"));
+  ASSERT_TRUE(p);
+  GuideImage g;
+  GuideRequest req;
+  req.objectId = true;
+  EXPECT_FALSE(p->Guides({{60, 60}, {70, 70}}, req, &g).ok());
+}
+
+}  // namespace
+}  // namespace dcm::embree
