@@ -9,6 +9,8 @@ namespace dcm {
 
 ReconstructionOptions ReconstructionOptions::Guo() {
   ReconstructionOptions o;
+  o.elementaryBlock = 8;  // Guo's and the paper's elementary blocks
+  o.contrastThreshold = 0.06f;
   o.objectTest = ObjectTest::kObjectId;
   o.thinObjects = ThinObjectTest::kOff;
   o.surfaceAware = false;

@@ -118,7 +118,9 @@ TEST(Invariants, PendingProviderGetsTheFirstRoundOfRequests) {
   PendingProvider p;
   Reconstruction r;
   std::vector<Point2i> pending;
-  const Status s = Reconstruct(p, ReconstructionOptions{}, &r, &pending);
+  ReconstructionOptions o;
+  o.elementaryBlock = 8;
+  const Status s = Reconstruct(p, o, &r, &pending);
   ASSERT_TRUE(s.pending());
   // The lattice corners of a 17x9 image: x in {0, 8, 16}, y in {0, 8}.
   EXPECT_EQ(pending.size(), 6u);
@@ -127,7 +129,7 @@ TEST(Invariants, PendingProviderGetsTheFirstRoundOfRequests) {
 TEST(Invariants, InvalidOptionsNameTheField) {
   AnalyticProvider p(8, 8, Constant(RGB::Gray(1)));
   ReconstructionOptions o;
-  o.minBlock = 16;
+  o.minBlock = 2 * o.elementaryBlock;
   Reconstruction r;
   const Status s = Reconstruct(p, o, &r);
   ASSERT_FALSE(s.ok());

@@ -33,9 +33,10 @@ TEST(HardCases, NonFiniteSamplesNeverSpread) {
   auto poisoned = [&](int x, int y) {
     PixelTruth t = base(x, y);
     const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
-    // Lattice points (always evaluated) and a few arbitrary pixels.
-    if ((x == 8 && y == 16) || (x == 40 && y == 40)) t.Li = RGB(nan, nan, nan);
-    if ((x == 64 && y == 8) || (x == 13 && y == 77)) t.Li = RGB(inf, 0, 0);
+    // Lattice points of the default 16-pixel blocks (always evaluated) and
+    // an arbitrary pixel.
+    if ((x == 16 && y == 32) || (x == 48 && y == 48)) t.Li = RGB(nan, nan, nan);
+    if ((x == 64 && y == 16) || (x == 13 && y == 77)) t.Li = RGB(inf, 0, 0);
     return t;
   };
   for (const ReconstructionOptions& opt : {ReconstructionOptions{}, ReconstructionOptions::Guo()}) {

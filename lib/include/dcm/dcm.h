@@ -1,0 +1,214 @@
+/* The C API of dcm: Directional Coherence Maps reconstruction for host
+ * applications written in any language that can call C.
+ *
+ * In the manner of Open Image Denoise: an opaque, reference-counted handle;
+ * options set by name; the renderer supplies the cheap guides (object ID,
+ * shader ID, texture value tau) as images and the expensive exact samples
+ * through a callback that evaluates batches of pixels. Nothing is thrown
+ * across this boundary: every function records its error on the handle (or,
+ * for a NULL handle, per thread) and dcmGetError() reports it.
+ *
+ *   DCMReconstructor r = dcmNewReconstructor();
+ *   dcmSetString(r, "method", "dcm");            // preset first, then overrides
+ *   dcmSetFloat(r, "contrast_threshold", 0.05f);
+ *   dcmSetImageSize(r, width, height);
+ *   dcmSetObjectIds(r, ids);                     // optional guides
+ *   dcmSetSampleFunction(r, evaluate, &scene, DCM_SAMPLE_THREAD_SAFE);
+ *   if (dcmExecute(r) != DCM_ERROR_NONE) { const char* m; dcmGetError(r, &m); ... }
+ *   const float* rgb = dcmGetImage(r, &w, &h);   // w*h*3 floats, row-major
+ *   dcmReleaseReconstructor(r);
+ *
+ * The C++ API (dcm/reconstructor.h) is the primary one; this wraps it.
+ * Link with -ldcm (pkg-config dcm, or find_package(dcm) and dcm::dcm). */
+#ifndef DCM_DCM_H_
+#define DCM_DCM_H_
+
+#include <stddef.h>
+#include <stdint.h>
+
+#if defined(_WIN32)
+#if defined(DCM_C_API_BUILD)
+#define DCM_API __declspec(dllexport)
+#else
+#define DCM_API __declspec(dllimport)
+#endif
+#else
+#define DCM_API __attribute__((visibility("default")))
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Version of this C interface; raised on incompatible changes. */
+#define DCM_C_API_VERSION 1
+
+/** A reconstructor: options, guides, the sample callback and the last result. */
+typedef struct DCMReconstructorImpl* DCMReconstructor;
+
+/** Error codes. */
+typedef enum DCMError {
+  DCM_ERROR_NONE = 0,              /**< no error */
+  DCM_ERROR_INVALID_ARGUMENT = 1,  /**< a NULL pointer, an unknown option name, a value out of range */
+  DCM_ERROR_INVALID_OPERATION = 2, /**< a call at the wrong time (e.g. executing without a size) */
+  DCM_ERROR_CALLBACK = 3,          /**< the sample callback reported a failure */
+  DCM_ERROR_OUT_OF_MEMORY = 4,     /**< an allocation failed */
+  DCM_ERROR_RECONSTRUCTION = 5,    /**< the engine rejected the input (its message says why) */
+  DCM_ERROR_UNKNOWN = 6            /**< anything else (an internal error) */
+} DCMError;
+
+/** Flags of dcmSetSampleFunction(). */
+enum {
+  /** The callback may be called concurrently from several threads on disjoint batches. */
+  DCM_SAMPLE_THREAD_SAFE = 1,
+  /** The callback can fill the split radiance (L_i, L_c), L = L_i * tau + L_c
+   *  (Scheel et al. 2001, 3.3); used together with a texture guide. */
+  DCM_SAMPLE_SPLIT = 2
+};
+
+/** Why a pixel of the working image was evaluated exactly: the values of
+ *  dcmGetSampleMap(). DCM_REASON_INTERPOLATED means "not exact". */
+enum {
+  DCM_REASON_INTERPOLATED = 0,
+  DCM_REASON_CORNER = 1,
+  DCM_REASON_BORDER = 2,
+  DCM_REASON_FIRST_ORDER_PROBE = 3,
+  DCM_REASON_LAZY_CENTRE = 4,
+  DCM_REASON_CENTRE_PROBE = 5,
+  DCM_REASON_THIN_OBJECT = 6,
+  DCM_REASON_FALLBACK = 7,
+  DCM_REASON_FULL = 8,
+  DCM_REASON_COUNT = 9
+};
+
+/** Evaluates `count` pixels exactly. `xy` holds 2*count ints (x0, y0, x1, y1,
+ *  ...) in working-image coordinates (x right, y down). Writes 3*count floats
+ *  of linear RGB radiance L to `rgb`. `li` and `lc` are NULL unless split
+ *  radiance is in use (DCM_SAMPLE_SPLIT and a texture guide); then they receive
+ *  3*count floats each of L_i and L_c. Returns 0 on success; any other value
+ *  stops the reconstruction with DCM_ERROR_CALLBACK (the value is in the
+ *  message). Exact samples must be deterministic per pixel. */
+typedef int (*DCMSampleFunction)(void* user, const int* xy, int count, float* rgb, float* li, float* lc);
+
+/** Reports progress in [0,1] with the name of the current stage; called from
+ *  the thread that runs dcmExecute(). */
+typedef void (*DCMProgressFunction)(void* user, float fraction, const char* stage);
+
+/** The version of the library, e.g. "0.1.0". */
+DCM_API const char* dcmGetVersionString(void);
+
+/** DCM_C_API_VERSION of the library that is loaded (compare with the header's). */
+DCM_API int dcmGetApiVersion(void);
+
+/** Creates a reconstructor with dcm's default options (method "dcm") and a
+ *  reference count of 1. Returns NULL on failure; dcmGetError(NULL, ...) then
+ *  says why. */
+DCM_API DCMReconstructor dcmNewReconstructor(void);
+
+/** Adds a reference to `r`. */
+DCM_API void dcmRetainReconstructor(DCMReconstructor r);
+
+/** Drops a reference to `r`; the last one frees it, its guides and its result.
+ *  NULL is ignored. */
+DCM_API void dcmReleaseReconstructor(DCMReconstructor r);
+
+/** Returns the first error recorded on `r` since the last call and clears it;
+ *  with `r` NULL, the first error of a call with a NULL handle (or of
+ *  dcmNewReconstructor) on this thread. When `message` is not NULL it receives
+ *  a description (valid until the next call on `r` from this thread; "" when
+ *  there is no error). */
+DCM_API DCMError dcmGetError(DCMReconstructor r, const char** message);
+
+/** Sets a string option:
+ *   "method"             "dcm" (default), "paper" (Scheel et al. 2001) or "guo"
+ *                        (Guo 1998): resets EVERY option to that preset, so set
+ *                        it first;
+ *   "object_test"        "none" | "id" | "id+shader";
+ *   "thin_objects"       "off" | "none-matches" | "any-differs";
+ *   "contrast_metric"    "mitchell" | "display";
+ *   "smooth_refinement"  "always" | "centre-probe" | "never".
+ *  An unknown name or value records DCM_ERROR_INVALID_ARGUMENT. */
+DCM_API void dcmSetString(DCMReconstructor r, const char* name, const char* value);
+
+/** Sets an integer option: "elementary_block", "min_block", "directions",
+ *  "fallback_max_changes", "downsample", "threads" (0: all cores),
+ *  "tile_size", "batch_size" (pixels per callback call). Bool options accept
+ *  0/1 here too. Ranges are checked by dcmExecute(). */
+DCM_API void dcmSetInt(DCMReconstructor r, const char* name, int value);
+
+/** Sets a float option: "contrast_threshold". Integer options accept whole
+ *  numbers here too. */
+DCM_API void dcmSetFloat(DCMReconstructor r, const char* name, float value);
+
+/** Sets a bool option: "surface_aware", "texture_split", "adaptive_borders",
+ *  "zero_order_test", "gradient_blocks_simple", "first_order_test",
+ *  "lazy_evaluation", "fallback", "finest_centre_probe", "full_evaluation". */
+DCM_API void dcmSetBool(DCMReconstructor r, const char* name, int value);
+
+/** The value of an integer (or bool) option; 0 and an error for an unknown name. */
+DCM_API int dcmGetInt(DCMReconstructor r, const char* name);
+
+/** The value of a float option (or an integer one); 0 and an error for an unknown name. */
+DCM_API float dcmGetFloat(DCMReconstructor r, const char* name);
+
+/** The value of a bool option as 0/1; 0 and an error for an unknown name. */
+DCM_API int dcmGetBool(DCMReconstructor r, const char* name);
+
+/** Sets the size of the working image in pixels (with option "downsample" N,
+ *  the output is width/N x height/N). Clears the guides set before. */
+DCM_API void dcmSetImageSize(DCMReconstructor r, int width, int height);
+
+/** Sets the object ID guide: width*height values, row-major, copied. NULL
+ *  removes it. Call after dcmSetImageSize(). */
+DCM_API void dcmSetObjectIds(DCMReconstructor r, const uint32_t* ids);
+
+/** Sets the shader (material) ID guide: width*height values, row-major,
+ *  copied. NULL removes it. Used only together with object IDs. */
+DCM_API void dcmSetShaderIds(DCMReconstructor r, const uint32_t* ids);
+
+/** Sets the texture guide tau: width*height*3 floats (linear RGB), row-major,
+ *  copied. NULL removes it. Used for texture de-modulation when the sample
+ *  function has DCM_SAMPLE_SPLIT. */
+DCM_API void dcmSetTexture(DCMReconstructor r, const float* rgb);
+
+/** Sets the function that evaluates exact samples, its user pointer and
+ *  DCM_SAMPLE_* flags. Without DCM_SAMPLE_THREAD_SAFE it is called from one
+ *  thread at a time. */
+DCM_API void dcmSetSampleFunction(DCMReconstructor r, DCMSampleFunction fn, void* user, int flags);
+
+/** Sets (or with NULL removes) a progress function. */
+DCM_API void dcmSetProgressFunction(DCMReconstructor r, DCMProgressFunction fn, void* user);
+
+/** Runs the reconstruction: calls the sample function for the pixels it needs
+ *  and keeps the result on `r`. Returns DCM_ERROR_NONE on success, otherwise
+ *  the error (also recorded for dcmGetError()); the previous result is then
+ *  discarded. */
+DCM_API DCMError dcmExecute(DCMReconstructor r);
+
+/** The reconstructed image of the last successful dcmExecute(): width*height*3
+ *  floats of linear RGB, row-major, at the output resolution; NULL before.
+ *  `width` and `height` may be NULL. Valid until the next dcmExecute() or the
+ *  release of `r`. */
+DCM_API const float* dcmGetImage(DCMReconstructor r, int* width, int* height);
+
+/** Why each pixel of the working image was exact: one DCM_REASON_* byte per
+ *  pixel, row-major, at the working resolution; NULL before a successful
+ *  dcmExecute(). Valid like dcmGetImage(). */
+DCM_API const uint8_t* dcmGetSampleMap(DCMReconstructor r, int* width, int* height);
+
+/** A statistic of the last successful dcmExecute(): "exact_pixels",
+ *  "total_pixels", "exact_fraction", "provider_calls", "non_finite_samples",
+ *  "smooth_blocks", "simple_edge_blocks", "complex_edge_blocks",
+ *  "fallback_blocks", "time_provider_s", "time_guides_s", "time_engine_s".
+ *  0 and an error for an unknown name or before a result. */
+DCM_API double dcmGetStat(DCMReconstructor r, const char* name);
+
+/** The name of a DCM_REASON_* value ("interpolated", "corner", ...); "?" when
+ *  out of range. */
+DCM_API const char* dcmSampleReasonName(int reason);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* DCM_DCM_H_ */

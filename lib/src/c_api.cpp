@@ -1,0 +1,609 @@
+// The C API (dcm/dcm.h): a thin wrapper of the C++ engine. Every entry point
+// catches everything; errors are recorded on the handle (or per thread for a
+// NULL handle) and never cross the boundary as exceptions.
+#include "dcm/dcm.h"
+
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <exception>
+#include <limits>
+#include <mutex>
+#include <new>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "dcm/reconstructor.h"
+
+#ifndef DCM_VERSION_STRING
+#define DCM_VERSION_STRING "unknown"
+#endif
+
+static_assert(DCM_REASON_INTERPOLATED == int(dcm::SampleReason::kInterpolated));
+static_assert(DCM_REASON_CORNER == int(dcm::SampleReason::kCorner));
+static_assert(DCM_REASON_BORDER == int(dcm::SampleReason::kBorder));
+static_assert(DCM_REASON_FIRST_ORDER_PROBE == int(dcm::SampleReason::kFirstOrderProbe));
+static_assert(DCM_REASON_LAZY_CENTRE == int(dcm::SampleReason::kLazyCentre));
+static_assert(DCM_REASON_CENTRE_PROBE == int(dcm::SampleReason::kCentreProbe));
+static_assert(DCM_REASON_THIN_OBJECT == int(dcm::SampleReason::kThinObject));
+static_assert(DCM_REASON_FALLBACK == int(dcm::SampleReason::kFallback));
+static_assert(DCM_REASON_FULL == int(dcm::SampleReason::kFull));
+static_assert(DCM_REASON_COUNT == dcm::kSampleReasonCount);
+
+/// The object behind a DCMReconstructor handle.
+struct DCMReconstructorImpl {
+  std::atomic<int> refs{1};
+  dcm::ReconstructionOptions options;
+  int width = 0, height = 0;
+  std::vector<uint32_t> objectIds, shaderIds;
+  std::vector<dcm::RGB> texture;
+  DCMSampleFunction sample = nullptr;
+  void* sampleUser = nullptr;
+  int sampleFlags = 0;
+  DCMProgressFunction progress = nullptr;
+  void* progressUser = nullptr;
+
+  bool hasResult = false;
+  dcm::Reconstruction result;
+  std::vector<uint8_t> sampleMap;
+
+  std::mutex errorMutex;
+  DCMError error = DCM_ERROR_NONE;
+  std::string errorMessage;
+  std::string reportedMessage;  ///< the string dcmGetError() handed out last
+};
+
+namespace {
+
+/// Errors of calls with a NULL handle, per thread.
+struct ThreadError {
+  DCMError error = DCM_ERROR_NONE;
+  std::string message;
+  std::string reported;
+};
+thread_local ThreadError tlsError;
+
+/// Records the first error since the last dcmGetError().
+void SetError(DCMReconstructor r, DCMError code, const std::string& message) noexcept {
+  try {
+    if (!r) {
+      if (tlsError.error == DCM_ERROR_NONE) {
+        tlsError.error = code;
+        tlsError.message = message;
+      }
+      return;
+    }
+    std::lock_guard<std::mutex> lock(r->errorMutex);
+    if (r->error == DCM_ERROR_NONE) {
+      r->error = code;
+      r->errorMessage = message;
+    }
+  } catch (...) {
+    // Out of memory while recording the message: keep at least the code.
+    if (!r) {
+      if (tlsError.error == DCM_ERROR_NONE) tlsError.error = code;
+    } else if (r->error == DCM_ERROR_NONE) {
+      r->error = code;
+    }
+  }
+}
+
+/// As above, for a message that is a C string (built inside the try).
+void SetError(DCMReconstructor r, DCMError code, const char* message) noexcept {
+  try {
+    SetError(r, code, std::string(message));
+  } catch (...) {
+    SetError(r, code, std::string());
+  }
+}
+
+/// Runs `body`, turning exceptions into errors recorded on `r`.
+template <typename F>
+void Guard(DCMReconstructor r, F&& body) noexcept {
+  try {
+    body();
+  } catch (const std::bad_alloc&) {
+    SetError(r, DCM_ERROR_OUT_OF_MEMORY, "out of memory");
+  } catch (const std::exception& e) {
+    SetError(r, DCM_ERROR_UNKNOWN, std::string("internal error: ") + e.what());
+  } catch (...) {
+    SetError(r, DCM_ERROR_UNKNOWN, "internal error: unknown exception");
+  }
+}
+
+/// Checks the handle and the name; records an error when either is NULL.
+bool CheckArgsOrThrow(DCMReconstructor r, const char* name, const char* function) {
+  if (!r) {
+    SetError(nullptr, DCM_ERROR_INVALID_ARGUMENT, std::string(function) + ": NULL reconstructor");
+    return false;
+  }
+  if (!name) {
+    SetError(r, DCM_ERROR_INVALID_ARGUMENT, std::string(function) + ": NULL option name");
+    return false;
+  }
+  return true;
+}
+
+/// As CheckArgsOrThrow, never throwing.
+bool CheckArgs(DCMReconstructor r, const char* name, const char* function) noexcept {
+  try {
+    return CheckArgsOrThrow(r, name, function);
+  } catch (...) {
+    SetError(r, DCM_ERROR_OUT_OF_MEMORY, "out of memory");
+    return false;
+  }
+}
+
+using Options = dcm::ReconstructionOptions;
+
+struct IntOption {
+  const char* name;
+  int Options::*member;
+};
+struct BoolOption {
+  const char* name;
+  bool Options::*member;
+};
+
+constexpr IntOption kIntOptions[] = {
+    {"elementary_block", &Options::elementaryBlock},
+    {"min_block", &Options::minBlock},
+    {"directions", &Options::directions},
+    {"fallback_max_changes", &Options::fallbackMaxChanges},
+    {"downsample", &Options::downsample},
+    {"threads", &Options::threads},
+    {"tile_size", &Options::tileSize},
+    {"batch_size", &Options::batchSize},
+};
+constexpr BoolOption kBoolOptions[] = {
+    {"surface_aware", &Options::surfaceAware},
+    {"texture_split", &Options::textureSplit},
+    {"adaptive_borders", &Options::adaptiveBorders},
+    {"zero_order_test", &Options::zeroOrderTest},
+    {"gradient_blocks_simple", &Options::gradientBlocksSimple},
+    {"first_order_test", &Options::firstOrderTest},
+    {"lazy_evaluation", &Options::lazyEvaluation},
+    {"fallback", &Options::fallback},
+    {"finest_centre_probe", &Options::finestCentreProbe},
+    {"full_evaluation", &Options::fullEvaluation},
+};
+
+int* FindInt(Options& o, std::string_view name) {
+  for (const auto& e : kIntOptions)
+    if (name == e.name) return &(o.*e.member);
+  return nullptr;
+}
+bool* FindBool(Options& o, std::string_view name) {
+  for (const auto& e : kBoolOptions)
+    if (name == e.name) return &(o.*e.member);
+  return nullptr;
+}
+
+std::string UnknownOption(const char* kind, const char* name) {
+  return std::string("unknown ") + kind + " option '" + name + "'";
+}
+
+/// The SampleProvider the engine sees: guides from the copied images,
+/// samples from the host's callback.
+class CallbackProvider final : public dcm::SampleProvider {
+ public:
+  explicit CallbackProvider(const DCMReconstructorImpl& r) : r_(r) {}
+
+  dcm::ProviderCapabilities Capabilities() const override {
+    dcm::ProviderCapabilities c;
+    c.width = r_.width;
+    c.height = r_.height;
+    c.objectId = !r_.objectIds.empty();
+    c.shaderId = !r_.shaderIds.empty();
+    c.texture = !r_.texture.empty();
+    c.splitRadiance = (r_.sampleFlags & DCM_SAMPLE_SPLIT) != 0;
+    c.threadSafe = (r_.sampleFlags & DCM_SAMPLE_THREAD_SAFE) != 0;
+    c.name = "C API sample function";
+    return c;
+  }
+
+  dcm::Status Guides(const dcm::Bounds2i& region, const dcm::GuideRequest& what, dcm::GuideImage* out) override {
+    const dcm::Bounds2i all{{0, 0}, {r_.width, r_.height}};
+    if (dcm::Intersect(region, all) != region)
+      return dcm::Status::Error("guide region outside the image");
+    out->region = region;
+    const size_t n = size_t(region.area());
+    auto copy = [&](const auto& src, auto* dst) {
+      dst->resize(n);
+      size_t k = 0;
+      for (int y = region.min.y; y < region.max.y; ++y)
+        for (int x = region.min.x; x < region.max.x; ++x) (*dst)[k++] = src[size_t(all.offset({x, y}))];
+    };
+    if (what.objectId && !r_.objectIds.empty()) copy(r_.objectIds, &out->objectId);
+    if (what.shaderId && !r_.shaderIds.empty()) copy(r_.shaderIds, &out->shaderId);
+    if (what.texture && !r_.texture.empty()) copy(r_.texture, &out->texture);
+    return dcm::Status::Ok();
+  }
+
+  dcm::Status Evaluate(std::span<const dcm::Point2i> pixels, const dcm::SampleRequest& what,
+                       std::span<dcm::ExactSample> out) override {
+    const size_t n = pixels.size();
+    if (n > size_t(std::numeric_limits<int>::max()))
+      return dcm::Status::Error("batch too large for the C sample function");
+    std::vector<int> xy(2 * n);
+    for (size_t i = 0; i < n; ++i) {
+      xy[2 * i] = pixels[i].x;
+      xy[2 * i + 1] = pixels[i].y;
+    }
+    std::vector<float> rgb(3 * n, 0.f), li, lc;
+    if (what.split) {
+      li.assign(3 * n, 0.f);
+      lc.assign(3 * n, 0.f);
+    }
+    const int code = r_.sample(r_.sampleUser, xy.data(), int(n), rgb.data(), what.split ? li.data() : nullptr,
+                               what.split ? lc.data() : nullptr);
+    if (code != 0) {
+      failed_ = true;
+      return dcm::Status::Error("the sample function returned " + std::to_string(code) + " for a batch of " +
+                                std::to_string(n) + " pixels");
+    }
+    for (size_t i = 0; i < n; ++i) {
+      out[i].L = {rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]};
+      if (what.split) {
+        out[i].Li = {li[3 * i], li[3 * i + 1], li[3 * i + 2]};
+        out[i].Lc = {lc[3 * i], lc[3 * i + 1], lc[3 * i + 2]};
+      }
+    }
+    return dcm::Status::Ok();
+  }
+
+ /// Whether the sample function reported a failure.
+  bool failed() const { return failed_; }
+
+ private:
+  const DCMReconstructorImpl& r_;
+  std::atomic<bool> failed_{false};
+};
+
+/// Whether a guide may be set now; records the error otherwise.
+bool CanSetGuideOrThrow(DCMReconstructor r, const char* function) {
+  if (!r) {
+    SetError(nullptr, DCM_ERROR_INVALID_ARGUMENT, std::string(function) + ": NULL reconstructor");
+    return false;
+  }
+  if (r->width <= 0 || r->height <= 0) {
+    SetError(r, DCM_ERROR_INVALID_OPERATION, std::string(function) + ": call dcmSetImageSize() first");
+    return false;
+  }
+  return true;
+}
+
+/// As CanSetGuideOrThrow, never throwing.
+bool CanSetGuide(DCMReconstructor r, const char* function) noexcept {
+  try {
+    return CanSetGuideOrThrow(r, function);
+  } catch (...) {
+    SetError(r, DCM_ERROR_OUT_OF_MEMORY, "out of memory");
+    return false;
+  }
+}
+
+}  // namespace
+
+extern "C" {
+
+DCM_API const char* dcmGetVersionString(void) { return DCM_VERSION_STRING; }
+
+DCM_API int dcmGetApiVersion(void) { return DCM_C_API_VERSION; }
+
+DCM_API DCMReconstructor dcmNewReconstructor(void) {
+  try {
+    return new DCMReconstructorImpl();
+  } catch (...) {
+    SetError(nullptr, DCM_ERROR_OUT_OF_MEMORY, "dcmNewReconstructor: out of memory");
+    return nullptr;
+  }
+}
+
+DCM_API void dcmRetainReconstructor(DCMReconstructor r) {
+  if (!r) {
+    SetError(nullptr, DCM_ERROR_INVALID_ARGUMENT, "dcmRetainReconstructor: NULL reconstructor");
+    return;
+  }
+  r->refs.fetch_add(1, std::memory_order_relaxed);
+}
+
+DCM_API void dcmReleaseReconstructor(DCMReconstructor r) {
+  if (!r) return;
+  if (r->refs.fetch_sub(1, std::memory_order_acq_rel) == 1) delete r;
+}
+
+DCM_API DCMError dcmGetError(DCMReconstructor r, const char** message) {
+  DCMError code = DCM_ERROR_NONE;
+  try {
+    if (!r) {
+      code = tlsError.error;
+      tlsError.reported = std::move(tlsError.message);
+      tlsError.message.clear();
+      tlsError.error = DCM_ERROR_NONE;
+      if (message) *message = tlsError.reported.c_str();
+      return code;
+    }
+    std::lock_guard<std::mutex> lock(r->errorMutex);
+    code = r->error;
+    r->reportedMessage = std::move(r->errorMessage);
+    r->errorMessage.clear();
+    r->error = DCM_ERROR_NONE;
+    if (message) *message = r->reportedMessage.c_str();
+  } catch (...) {
+    if (message) *message = "";
+  }
+  return code;
+}
+
+DCM_API void dcmSetString(DCMReconstructor r, const char* name, const char* value) {
+  if (!CheckArgs(r, name, "dcmSetString")) return;
+  Guard(r, [&] {
+    if (!value) return SetError(r, DCM_ERROR_INVALID_ARGUMENT, std::string("option ") + name + ": NULL value");
+    const std::string_view n(name), v(value);
+    dcm::Status st;
+    if (n == "method") {
+      if (v == "dcm") r->options = Options{};
+      else if (v == "paper") r->options = Options::Paper();
+      else if (v == "guo") r->options = Options::Guo();
+      else st = dcm::Status::Error("method: unknown value '" + std::string(v) + "' (valid: dcm, paper, guo)");
+    } else if (n == "object_test") {
+      st = dcm::Parse(v, &r->options.objectTest);
+    } else if (n == "thin_objects") {
+      st = dcm::Parse(v, &r->options.thinObjects);
+    } else if (n == "contrast_metric") {
+      st = dcm::Parse(v, &r->options.contrastMetric);
+    } else if (n == "smooth_refinement") {
+      st = dcm::Parse(v, &r->options.smoothRefinement);
+    } else {
+      st = dcm::Status::Error(UnknownOption("string", name));
+    }
+    if (!st.ok()) SetError(r, DCM_ERROR_INVALID_ARGUMENT, st.message());
+  });
+}
+
+DCM_API void dcmSetInt(DCMReconstructor r, const char* name, int value) {
+  if (!CheckArgs(r, name, "dcmSetInt")) return;
+  Guard(r, [&] {
+    if (int* p = FindInt(r->options, name)) *p = value;
+    else if (bool* b = FindBool(r->options, name)) *b = value != 0;
+    else SetError(r, DCM_ERROR_INVALID_ARGUMENT, UnknownOption("integer", name));
+  });
+}
+
+DCM_API void dcmSetFloat(DCMReconstructor r, const char* name, float value) {
+  if (!CheckArgs(r, name, "dcmSetFloat")) return;
+  Guard(r, [&] {
+    if (std::string_view(name) == "contrast_threshold") {
+      r->options.contrastThreshold = value;
+    } else if (int* p = FindInt(r->options, name)) {
+      if (!(std::nearbyint(value) == value) || std::fabs(value) > 1e9f)
+        return SetError(r, DCM_ERROR_INVALID_ARGUMENT,
+                        std::string("option ") + name + ": expected a whole number, got " + std::to_string(value));
+      *p = int(value);
+    } else {
+      SetError(r, DCM_ERROR_INVALID_ARGUMENT, UnknownOption("float", name));
+    }
+  });
+}
+
+DCM_API void dcmSetBool(DCMReconstructor r, const char* name, int value) {
+  if (!CheckArgs(r, name, "dcmSetBool")) return;
+  Guard(r, [&] {
+    if (bool* b = FindBool(r->options, name)) *b = value != 0;
+    else SetError(r, DCM_ERROR_INVALID_ARGUMENT, UnknownOption("bool", name));
+  });
+}
+
+DCM_API int dcmGetInt(DCMReconstructor r, const char* name) {
+  if (!CheckArgs(r, name, "dcmGetInt")) return 0;
+  int result = 0;
+  Guard(r, [&] {
+    if (int* p = FindInt(r->options, name)) result = *p;
+    else if (bool* b = FindBool(r->options, name)) result = *b ? 1 : 0;
+    else SetError(r, DCM_ERROR_INVALID_ARGUMENT, UnknownOption("integer", name));
+  });
+  return result;
+}
+
+DCM_API float dcmGetFloat(DCMReconstructor r, const char* name) {
+  if (!CheckArgs(r, name, "dcmGetFloat")) return 0.f;
+  float result = 0.f;
+  Guard(r, [&] {
+    if (std::string_view(name) == "contrast_threshold") result = r->options.contrastThreshold;
+    else if (int* p = FindInt(r->options, name)) result = float(*p);
+    else SetError(r, DCM_ERROR_INVALID_ARGUMENT, UnknownOption("float", name));
+  });
+  return result;
+}
+
+DCM_API int dcmGetBool(DCMReconstructor r, const char* name) {
+  if (!CheckArgs(r, name, "dcmGetBool")) return 0;
+  int result = 0;
+  Guard(r, [&] {
+    if (bool* b = FindBool(r->options, name)) result = *b ? 1 : 0;
+    else SetError(r, DCM_ERROR_INVALID_ARGUMENT, UnknownOption("bool", name));
+  });
+  return result;
+}
+
+DCM_API void dcmSetImageSize(DCMReconstructor r, int width, int height) {
+  if (!r) return SetError(nullptr, DCM_ERROR_INVALID_ARGUMENT, "dcmSetImageSize: NULL reconstructor");
+  Guard(r, [&] {
+    constexpr int kMaxSide = 1 << 17;
+    if (width < 1 || height < 1 || width > kMaxSide || height > kMaxSide || int64_t(width) * height > (int64_t(1) << 30))
+      return SetError(r, DCM_ERROR_INVALID_ARGUMENT,
+                      "dcmSetImageSize: unusable size " + std::to_string(width) + "x" + std::to_string(height));
+    r->width = width;
+    r->height = height;
+    r->objectIds.clear();
+    r->shaderIds.clear();
+    r->texture.clear();
+  });
+}
+
+DCM_API void dcmSetObjectIds(DCMReconstructor r, const uint32_t* ids) {
+  if (!CanSetGuide(r, "dcmSetObjectIds")) return;
+  Guard(r, [&] {
+    if (!ids) return r->objectIds.clear();
+    r->objectIds.assign(ids, ids + size_t(r->width) * size_t(r->height));
+  });
+}
+
+DCM_API void dcmSetShaderIds(DCMReconstructor r, const uint32_t* ids) {
+  if (!CanSetGuide(r, "dcmSetShaderIds")) return;
+  Guard(r, [&] {
+    if (!ids) return r->shaderIds.clear();
+    r->shaderIds.assign(ids, ids + size_t(r->width) * size_t(r->height));
+  });
+}
+
+DCM_API void dcmSetTexture(DCMReconstructor r, const float* rgb) {
+  if (!CanSetGuide(r, "dcmSetTexture")) return;
+  Guard(r, [&] {
+    if (!rgb) return r->texture.clear();
+    const size_t n = size_t(r->width) * size_t(r->height);
+    r->texture.resize(n);
+    for (size_t i = 0; i < n; ++i) r->texture[i] = {rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]};
+  });
+}
+
+DCM_API void dcmSetSampleFunction(DCMReconstructor r, DCMSampleFunction fn, void* user, int flags) {
+  if (!r) return SetError(nullptr, DCM_ERROR_INVALID_ARGUMENT, "dcmSetSampleFunction: NULL reconstructor");
+  if (flags & ~(DCM_SAMPLE_THREAD_SAFE | DCM_SAMPLE_SPLIT))
+    return SetError(r, DCM_ERROR_INVALID_ARGUMENT, "dcmSetSampleFunction: unknown flags");
+  r->sample = fn;
+  r->sampleUser = user;
+  r->sampleFlags = flags;
+}
+
+DCM_API void dcmSetProgressFunction(DCMReconstructor r, DCMProgressFunction fn, void* user) {
+  if (!r) return SetError(nullptr, DCM_ERROR_INVALID_ARGUMENT, "dcmSetProgressFunction: NULL reconstructor");
+  r->progress = fn;
+  r->progressUser = user;
+}
+
+DCM_API DCMError dcmExecute(DCMReconstructor r) {
+  if (!r) {
+    SetError(nullptr, DCM_ERROR_INVALID_ARGUMENT, "dcmExecute: NULL reconstructor");
+    return DCM_ERROR_INVALID_ARGUMENT;
+  }
+  DCMError code = DCM_ERROR_NONE;
+  auto fail = [&](DCMError c, const auto& message) noexcept {
+    code = c;
+    SetError(r, c, message);
+  };
+  try {
+    r->hasResult = false;
+    r->result = dcm::Reconstruction{};
+    r->sampleMap.clear();
+    if (r->width <= 0 || r->height <= 0) {
+      fail(DCM_ERROR_INVALID_OPERATION, "dcmExecute: no image size (call dcmSetImageSize())");
+      return code;
+    }
+    if (!r->sample) {
+      fail(DCM_ERROR_INVALID_OPERATION, "dcmExecute: no sample function (call dcmSetSampleFunction())");
+      return code;
+    }
+    if (r->options.downsample > 0 &&
+        (r->width % r->options.downsample != 0 || r->height % r->options.downsample != 0)) {
+      fail(DCM_ERROR_INVALID_ARGUMENT, "dcmExecute: image size " + std::to_string(r->width) + "x" +
+                                           std::to_string(r->height) + " is not a multiple of downsample " +
+                                           std::to_string(r->options.downsample));
+      return code;
+    }
+    CallbackProvider provider(*r);
+    dcm::ReconstructionOptions options = r->options;
+    if (r->progress) {
+      options.progress = [r](float v, std::string_view stage) {
+        const std::string s(stage);
+        r->progress(r->progressUser, v, s.c_str());
+      };
+    }
+    dcm::Status st = dcm::Reconstruct(provider, options, &r->result);
+    if (!st.ok()) {
+      r->result = dcm::Reconstruction{};
+      fail(provider.failed() ? DCM_ERROR_CALLBACK : DCM_ERROR_RECONSTRUCTION, st.message());
+      return code;
+    }
+    r->sampleMap.resize(r->result.sampleMap.size());
+    for (size_t i = 0; i < r->sampleMap.size(); ++i) r->sampleMap[i] = uint8_t(r->result.sampleMap[i]);
+    r->hasResult = true;
+  } catch (const std::bad_alloc&) {
+    r->result = dcm::Reconstruction{};
+    fail(DCM_ERROR_OUT_OF_MEMORY, "dcmExecute: out of memory");
+  } catch (const std::exception& e) {
+    r->result = dcm::Reconstruction{};
+    fail(DCM_ERROR_UNKNOWN, std::string("dcmExecute: internal error: ") + e.what());
+  } catch (...) {
+    r->result = dcm::Reconstruction{};
+    fail(DCM_ERROR_UNKNOWN, "dcmExecute: internal error: unknown exception");
+  }
+  return code;
+}
+
+DCM_API const float* dcmGetImage(DCMReconstructor r, int* width, int* height) {
+  if (width) *width = 0;
+  if (height) *height = 0;
+  if (!r) {
+    SetError(nullptr, DCM_ERROR_INVALID_ARGUMENT, "dcmGetImage: NULL reconstructor");
+    return nullptr;
+  }
+  if (!r->hasResult) {
+    SetError(r, DCM_ERROR_INVALID_OPERATION, "dcmGetImage: no result (dcmExecute() has not succeeded)");
+    return nullptr;
+  }
+  static_assert(sizeof(dcm::RGB) == 3 * sizeof(float), "RGB must be three packed floats");
+  if (width) *width = r->result.width;
+  if (height) *height = r->result.height;
+  return r->result.image.empty() ? nullptr : &r->result.image[0].r;
+}
+
+DCM_API const uint8_t* dcmGetSampleMap(DCMReconstructor r, int* width, int* height) {
+  if (width) *width = 0;
+  if (height) *height = 0;
+  if (!r) {
+    SetError(nullptr, DCM_ERROR_INVALID_ARGUMENT, "dcmGetSampleMap: NULL reconstructor");
+    return nullptr;
+  }
+  if (!r->hasResult) {
+    SetError(r, DCM_ERROR_INVALID_OPERATION, "dcmGetSampleMap: no result (dcmExecute() has not succeeded)");
+    return nullptr;
+  }
+  if (width) *width = r->result.workWidth;
+  if (height) *height = r->result.workHeight;
+  return r->sampleMap.data();
+}
+
+DCM_API double dcmGetStat(DCMReconstructor r, const char* name) {
+  if (!CheckArgs(r, name, "dcmGetStat")) return 0.0;
+  if (!r->hasResult) {
+    SetError(r, DCM_ERROR_INVALID_OPERATION, "dcmGetStat: no result (dcmExecute() has not succeeded)");
+    return 0.0;
+  }
+  const dcm::ReconstructionStats& s = r->result.stats;
+  const std::string_view n(name);
+  if (n == "exact_pixels") return double(s.exactPixels);
+  if (n == "total_pixels") return double(s.totalPixels);
+  if (n == "exact_fraction") return s.exactFraction();
+  if (n == "provider_calls") return double(s.providerCalls);
+  if (n == "non_finite_samples") return double(s.nonFiniteSamples);
+  if (n == "smooth_blocks") return double(s.smoothBlocks);
+  if (n == "simple_edge_blocks") return double(s.simpleEdgeBlocks);
+  if (n == "complex_edge_blocks") return double(s.complexEdgeBlocks);
+  if (n == "fallback_blocks") return double(s.fallbackBlocks);
+  if (n == "time_provider_s") return s.timeProviderS;
+  if (n == "time_guides_s") return s.timeGuidesS;
+  if (n == "time_engine_s") return s.timeEngineS;
+  Guard(r, [&] { SetError(r, DCM_ERROR_INVALID_ARGUMENT, "dcmGetStat: unknown statistic '" + std::string(n) + "'"); });
+  return 0.0;
+}
+
+DCM_API const char* dcmSampleReasonName(int reason) {
+  if (reason < 0 || reason >= dcm::kSampleReasonCount) return "?";
+  // ToString returns views of string literals: NUL-terminated.
+  return dcm::ToString(dcm::SampleReason(reason)).data();
+}
+
+}  // extern "C"

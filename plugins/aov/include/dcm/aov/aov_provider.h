@@ -1,0 +1,143 @@
+// A SampleProvider over multichannel EXR AOVs written by any renderer
+// (Blender Cycles, POV-Ray, a studio pipeline), read with OpenImageIO.
+//
+// Two modes:
+//  - dense: the expensive channels (beauty L, or the split L_i, L_c) exist for
+//    every pixel of the inputs; Evaluate() hands the engine the pixels it asks
+//    for, so that `dcm reconstruct` can tell what DCM would have saved on this
+//    render and at what error;
+//  - sparse (the file-based round trip): the inputs carry only the cheap
+//    guides; the exact samples come from "samples" EXRs that a renderer wrote
+//    for the pixels `dcm plan` asked for (a `mask` channel marks them).
+//    Evaluate() answers Status::Pending when a requested pixel is missing.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "dcm/sample_provider.h"
+#include "dcm/status.h"
+
+namespace dcm::aov {
+
+/// What a channel (or a sum of products of channels) means for the engine.
+enum class Role : int {
+  kObjectId,  ///< "id": integer object ID (or a Cryptomatte layer)
+  kShaderId,  ///< "shader": integer shader/material ID (or a Cryptomatte layer)
+  kU,         ///< "u": texture coordinate, with --texture
+  kV,         ///< "v": texture coordinate, with --texture
+  kTauR, kTauG, kTauB,  ///< "tau.R/G/B": texture value
+  kLiR, kLiG, kLiB,     ///< "Li.R/G/B": radiance before texturing
+  kLcR, kLcG, kLcB,     ///< "Lc.R/G/B": radiance not modulated by the texture
+  kLR, kLG, kLB,        ///< "L.R/G/B": beauty radiance
+  kVarR, kVarG, kVarB,  ///< "var.R/G/B": variance of the estimate of L
+  kMask,      ///< "mask": in a samples EXR, > 0 where the pixel was rendered
+  kCount
+};
+inline constexpr int kRoleCount = int(Role::kCount);
+
+/// The role's name on the command line ("id", "tau.R", "L.G", ...).
+std::string_view RoleName(Role role);
+/// Parses a role name (case-sensitive, as RoleName() writes it; "tau", "Li",
+/// "Lc", "L" and "var" alone are accepted by ParseMapping for all three).
+Status ParseRole(std::string_view name, Role* role);
+
+/// Where the channel names come from.
+enum class Preset {
+  /// Plain names: id, shader, u, v, tau.R/G/B, Li.R/G/B, Lc.R/G/B, beauty
+  /// R/G/B, var.R/G/B, mask.
+  kGeneric,
+  /// Blender Cycles multilayer EXR: <layer>.IndexOB.X, IndexMA.X (or the
+  /// CryptoObject / CryptoMaterial layers), UV.U/V, tau = DiffCol,
+  /// L_i = DiffDir + DiffInd, L = Combined, L_c = L - L_i*tau (so that
+  /// L_i*tau + L_c = Combined; without Combined, L_c is the sum of the
+  /// Gloss, Trans, Volume, Emit and Env contributions).
+  kBlender,
+};
+Status ParsePreset(std::string_view name, Preset* preset);
+
+/// One --map ROLE=EXPR. EXPR is a channel name, a sum of products of channel
+/// names ("DiffDir.R+DiffInd.R", "GlossCol.R*GlossDir.R"), or for the ID roles
+/// "cryptomatte:LAYER" (the layer name as in the EXR metadata, or its suffix).
+/// Channel names must not contain '+' or '*'. A three-channel role given
+/// without its component ("tau=albedo") maps tau.R/G/B to albedo.R/G/B.
+struct Mapping {
+  Role role;
+  std::string expression;
+};
+/// Parses "ROLE=EXPR"; "tau=NAME" style yields three mappings.
+Status ParseMapping(std::string_view text, std::vector<Mapping>* out);
+
+/// One --texture SHADER=FILE: tau(u,v) of pixels whose shader ID is SHADER (a
+/// decimal ID, or a material name from the Cryptomatte manifest) is looked up
+/// in FILE with OpenImageIO's TextureSystem.
+struct TextureBinding {
+  std::string shader;
+  std::string file;
+};
+/// Parses "SHADER=FILE".
+Status ParseTextureBinding(std::string_view text, TextureBinding* out);
+
+struct AovOptions {
+  Preset preset = Preset::kGeneric;
+  std::vector<Mapping> mappings;          ///< override the preset
+  std::vector<TextureBinding> textures;   ///< tau(u,v) from texture files
+  std::string viewLayer;                  ///< Blender: empty = detect
+  /// Sparse mode: the exact samples come from these files only (possibly none
+  /// yet: the first round of `dcm plan`). Dense mode when false.
+  bool sparse = false;
+  std::vector<std::string> samples;       ///< samples EXRs (sparse mode)
+  /// Offer the split (L_i, L_c) when tau is available. In sparse mode this
+  /// decides which channels the samples must carry.
+  bool split = true;
+};
+
+/// The provider. Create with Open(); all data is loaded (and checked) there,
+/// so Guides() and Evaluate() only copy and are thread safe.
+class AovProvider final : public SampleProvider {
+ public:
+  /// Reads `inputs` (one multilayer EXR or several EXRs of one resolution)
+  /// and, in sparse mode, `options.samples`. Errors name the file and channel.
+  static Status Open(const std::vector<std::string>& inputs, const AovOptions& options,
+                     std::unique_ptr<AovProvider>* out);
+  ~AovProvider() override;
+
+  ProviderCapabilities Capabilities() const override;
+  Status Guides(const Bounds2i& region, const GuideRequest& what, GuideImage* out) override;
+  /// Dense mode: the stored samples. Sparse mode: the samples read from the
+  /// samples files; Status::Pending when any requested pixel has none.
+  Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what,
+                  std::span<ExactSample> out) override;
+
+  int width() const;
+  int height() const;
+  /// True when every pixel has an exact sample (dense input).
+  bool dense() const;
+  /// Whether pixel (x, y) has an exact sample.
+  bool HasSample(Point2i p) const;
+  /// Number of pixels with an exact sample.
+  int64_t SampleCount() const;
+  /// Beauty L of every pixel (row-major); pixels without a sample are 0.
+  const std::vector<RGB>& Beauty() const;
+  /// What was found and how it is used (role -> channels, tests switched off);
+  /// printed by -v.
+  const std::vector<std::string>& Notes() const;
+  /// Suspicious data kept as is (NaN/Inf/negative samples, per file and channel).
+  const std::vector<std::string>& Warnings() const;
+  /// The channel names a samples EXR must carry for this configuration
+  /// (including the mask channel), for `dcm plan` to tell the renderer.
+  std::vector<std::string> SampleChannels() const;
+
+  struct Data;
+
+ private:
+  explicit AovProvider(std::unique_ptr<Data> data);
+  std::unique_ptr<Data> d_;
+};
+
+}  // namespace dcm::aov

@@ -1,0 +1,265 @@
+#include "exr_channels.h"
+
+#include <OpenImageIO/strutil.h>
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+
+namespace dcm::aov::detail {
+
+namespace fs = std::filesystem;
+using OIIO::ImageInput;
+using OIIO::ImageSpec;
+using OIIO::TypeDesc;
+
+ChannelSet::ChannelSet() = default;
+ChannelSet::~ChannelSet() = default;
+ChannelSet::ChannelSet(ChannelSet&&) noexcept = default;
+ChannelSet& ChannelSet::operator=(ChannelSet&&) noexcept = default;
+
+namespace {
+
+Status CheckDimensions(const std::string& path, int width, int height) {
+  if (width <= 0 || height <= 0 || width > kMaxSide || height > kMaxSide)
+    return Status::Error(Quote(path) + ": absurd image dimensions " + std::to_string(width) + "x" +
+                         std::to_string(height) + " (at most " + std::to_string(kMaxSide) +
+                         " pixels per side)");
+  const double bytes = double(width) * double(height) * kPlanesPerPixel * 4.0;
+  if (bytes > double(kMaxBytes))
+    return Status::Error(Quote(path) + ": " + std::to_string(width) + "x" +
+                         std::to_string(height) + " pixels would need about " +
+                         std::to_string(int64_t(bytes / double(int64_t(1) << 30))) +
+                         " GiB, more than the limit of " + std::to_string(kMaxBytes >> 30) +
+                         " GiB");
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status ChannelSet::Add(const std::string& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return Status::Error(Quote(path) + ": no such file");
+  if (fs::is_directory(path, ec)) return Status::Error(Quote(path) + ": is a directory");
+  // Identify the format by its magic number, whatever the extension.
+  {
+    auto exr = ImageInput::create("openexr");
+    if (!exr) return Status::Error("OpenImageIO was built without OpenEXR support");
+    if (!exr->valid_file(path)) return Status::Error(Quote(path) + ": not an OpenEXR file");
+  }
+  File f;
+  f.path = path;
+  f.in = ImageInput::create("openexr");
+  ImageSpec spec;
+  if (!f.in || !f.in->open(path, spec)) {
+    std::string err = f.in ? f.in->geterror() : OIIO::geterror();
+    return Status::Error(Quote(path) + ": corrupt or unreadable OpenEXR file: " + err);
+  }
+  for (int s = 0; f.in->seek_subimage(s, 0); ++s) {
+    const ImageSpec& sp = f.in->spec();
+    if (sp.deep) return Status::Error(Quote(path) + ": deep EXR images are not supported");
+    DCM_RETURN_IF_ERROR(CheckDimensions(path, sp.full_width, sp.full_height));
+    DCM_RETURN_IF_ERROR(CheckDimensions(path, sp.width, sp.height));
+    if (sp.x != sp.full_x || sp.y != sp.full_y || sp.width != sp.full_width ||
+        sp.height != sp.full_height)
+      return Status::Error(Quote(path) + ": the data window (" + std::to_string(sp.width) + "x" +
+                           std::to_string(sp.height) + " at " + std::to_string(sp.x) + "," +
+                           std::to_string(sp.y) +
+                           ") differs from the display window; expand it first, e.g. "
+                           "oiiotool IN --fullpixels -o OUT");
+    if (s > 0 && (sp.width != f.specs[0].width || sp.height != f.specs[0].height))
+      return Status::Error(Quote(path) + ": its parts have different resolutions");
+    f.specs.push_back(sp);
+  }
+  (void)f.in->geterror();
+  if (f.specs.empty()) return Status::Error(Quote(path) + ": no image in the file");
+  const int w = f.specs[0].width, h = f.specs[0].height;
+  if (!files_.empty() && (w != width_ || h != height_))
+    return Status::Error("inputs of different resolutions: " + Quote(path) + " is " +
+                         std::to_string(w) + "x" + std::to_string(h) + ", " + Quote(files_[0].path) +
+                         " is " + std::to_string(width_) + "x" + std::to_string(height_));
+  width_ = w;
+  height_ = h;
+  const int fileIndex = int(files_.size());
+  for (int s = 0; s < int(f.specs.size()); ++s) {
+    const ImageSpec& sp = f.specs[size_t(s)];
+    for (int c = 0; c < sp.nchannels; ++c)
+      channels_.emplace(sp.channel_name(c), ChannelRef{fileIndex, s, c, sp.channelformat(c)});
+  }
+  files_.push_back(std::move(f));
+  ScanCrypto(fileIndex);
+  return Status::Ok();
+}
+
+void ChannelSet::ScanCrypto(int file) {
+  const File& f = files_[size_t(file)];
+  for (const ImageSpec& sp : f.specs) {
+    for (const auto& attr : sp.extra_attribs) {
+      const std::string key = attr.name().string();
+      if (!OIIO::Strutil::starts_with(key, "cryptomatte/") || !OIIO::Strutil::ends_with(key, "/name"))
+        continue;
+      const std::string prefix = key.substr(0, key.size() - 4);  // "cryptomatte/<id>/"
+      CryptoLayer layer;
+      layer.name = sp.get_string_attribute(key);
+      if (layer.name.empty()) continue;
+      bool dup = false;
+      for (const auto& l : crypto_) dup |= (l.name == layer.name);
+      if (dup) continue;
+      for (const char* suffix : {"00.R", "00.r", "00.red"}) {
+        auto ref = Find(layer.name + suffix);
+        if (ref) {
+          layer.channel = layer.name + suffix;
+          layer.ref = *ref;
+          break;
+        }
+      }
+      if (layer.channel.empty()) continue;  // metadata without channels: not usable
+      const std::string manifest = sp.get_string_attribute(prefix + "manifest");
+      if (!manifest.empty()) {
+        auto j = nlohmann::json::parse(manifest, nullptr, /*allow_exceptions=*/false);
+        if (j.is_object()) {
+          for (const auto& [name, hex] : j.items()) {
+            if (!hex.is_string()) continue;
+            try {
+              layer.manifest[name] = uint32_t(std::stoul(hex.get<std::string>(), nullptr, 16));
+            } catch (const std::exception&) {
+            }
+          }
+        }
+      }
+      crypto_.push_back(std::move(layer));
+    }
+  }
+}
+
+std::optional<ChannelRef> ChannelSet::Find(const std::string& name) const {
+  auto it = channels_.find(name);
+  if (it == channels_.end()) return std::nullopt;
+  return it->second;
+}
+
+std::vector<std::string> ChannelSet::Names() const {
+  std::vector<std::string> names;
+  for (const auto& [name, ref] : channels_) names.push_back(name);
+  return names;
+}
+
+std::string ChannelSet::Describe() const {
+  std::string s;
+  size_t shown = 0;
+  for (size_t fi = 0; fi < files_.size(); ++fi) {
+    s += (fi ? "; " : "") + Quote(files_[fi].path) + ":";
+    bool first = true;
+    for (const auto& [name, ref] : channels_) {
+      if (ref.file != int(fi)) continue;
+      if (++shown > 100) {
+        s += " ...";
+        return s;
+      }
+      s += (first ? " " : ", ") + name;
+      first = false;
+    }
+    if (first) s += " (no channels)";
+  }
+  return s;
+}
+
+const std::string& ChannelSet::Path(int file) const { return files_[size_t(file)].path; }
+
+std::string ChannelSet::Paths() const {
+  std::string s;
+  for (const auto& f : files_) s += (s.empty() ? "" : ", ") + Quote(f.path);
+  return s;
+}
+
+Status ChannelSet::ReadRef(const ChannelRef& ref, const std::string& name, TypeDesc type,
+                           void* data) const {
+  const File& f = files_[size_t(ref.file)];
+  if (!f.in->read_image(ref.subimage, 0, ref.index, ref.index + 1, type, data))
+    return Status::Error(Quote(f.path) + ": cannot read channel " + Quote(name) +
+                         " (truncated or corrupt file?): " + f.in->geterror());
+  return Status::Ok();
+}
+
+Status ChannelSet::ReadRaw(const std::string& name, TypeDesc type, void* data) const {
+  auto ref = Find(name);
+  if (!ref) return Status::Error("no channel " + Quote(name) + " in " + Describe());
+  return ReadRef(*ref, name, type, data);
+}
+
+Status ChannelSet::ReadFloat(const std::string& name, std::vector<float>* plane) const {
+  plane->assign(pixels(), 0.f);
+  return ReadRaw(name, TypeDesc::FLOAT, plane->data());
+}
+
+Status ChannelSet::ReadId(const std::string& name, std::vector<uint32_t>* plane) const {
+  auto ref = Find(name);
+  if (!ref) return Status::Error("no channel " + Quote(name) + " in " + Describe());
+  plane->assign(pixels(), 0u);
+  const TypeDesc::BASETYPE base = TypeDesc::BASETYPE(ref->format.basetype);
+  if (base == TypeDesc::UINT32 || base == TypeDesc::INT32 || base == TypeDesc::UINT16 ||
+      base == TypeDesc::INT16 || base == TypeDesc::UINT8 || base == TypeDesc::INT8) {
+    // Integer storage: read as integers (a float buffer would normalise them).
+    return ReadRef(*ref, name, TypeDesc::UINT32, plane->data());
+  }
+  std::vector<float> f(pixels());
+  DCM_RETURN_IF_ERROR(ReadRef(*ref, name, TypeDesc::FLOAT, f.data()));
+  for (size_t i = 0; i < f.size(); ++i) {
+    const float v = f[i];
+    // Integers exactly representable in float32 span +-2^24; larger integral
+    // values are accepted as stored (they are still integers).
+    if (!std::isfinite(v) || v != std::floor(v) || v < -2147483648.f || v >= 4294967296.f) {
+      const int x = int(i % size_t(width_)), y = int(i / size_t(width_));
+      return Status::Error(Quote(Path(ref->file)) + ": channel " + Quote(name) +
+                           " holds a non-integer ID " + std::to_string(v) + " at pixel (" +
+                           std::to_string(x) + ", " + std::to_string(y) +
+                           "); IDs must be integers");
+    }
+    (*plane)[i] = v < 0 ? uint32_t(int32_t(v)) : uint32_t(v);
+  }
+  return Status::Ok();
+}
+
+Status ChannelSet::ReadCrypto(const CryptoLayer& layer, std::vector<uint32_t>* plane) const {
+  if (layer.ref.format.basetype != TypeDesc::FLOAT)
+    return Status::Error(Quote(Path(layer.ref.file)) + ": Cryptomatte channel " +
+                         Quote(layer.channel) + " is stored as " + layer.ref.format.c_str() +
+                         "; its IDs need 32-bit float");
+  std::vector<float> f(pixels());
+  DCM_RETURN_IF_ERROR(ReadRef(layer.ref, layer.channel, TypeDesc::FLOAT, f.data()));
+  plane->resize(pixels());
+  static_assert(sizeof(float) == sizeof(uint32_t));
+  std::memcpy(plane->data(), f.data(), f.size() * sizeof(float));
+  return Status::Ok();
+}
+
+Status ChannelSet::FindCrypto(const std::string& name, const CryptoLayer** layer) const {
+  const CryptoLayer* found = nullptr;
+  for (const auto& l : crypto_) {
+    if (l.name == name) {
+      *layer = &l;
+      return Status::Ok();
+    }
+  }
+  for (const auto& l : crypto_) {
+    if (OIIO::Strutil::ends_with(l.name, name)) {
+      if (found)
+        return Status::Error("Cryptomatte layer " + Quote(name) + " is ambiguous in " + Paths() +
+                             ": " + Quote(found->name) + " and " + Quote(l.name));
+      found = &l;
+    }
+  }
+  if (!found) {
+    std::string names;
+    for (const auto& l : crypto_) names += (names.empty() ? "" : ", ") + Quote(l.name);
+    return Status::Error("no Cryptomatte layer " + Quote(name) + " in " + Paths() +
+                         (names.empty() ? " (none found)" : " (layers: " + names + ")"));
+  }
+  *layer = found;
+  return Status::Ok();
+}
+
+}  // namespace dcm::aov::detail

@@ -1,0 +1,107 @@
+// The channels of one or several EXR files of one resolution, looked up by
+// name and read one plane at a time, with the checks every input needs.
+#pragma once
+
+#include <OpenImageIO/imageio.h>
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "dcm/status.h"
+
+namespace dcm::aov::detail {
+
+/// Upper bound on the float data the provider may hold for one image
+/// (width * height * planes * 4 bytes): 8 GiB, checked from the headers
+/// before anything is allocated.
+inline constexpr int64_t kMaxBytes = int64_t(8) << 30;
+/// Upper bound on either side of an image.
+inline constexpr int kMaxSide = 1 << 17;
+/// Planes (RGB roles, IDs, mask, read buffers) the provider may allocate per
+/// pixel, used by the memory guard.
+inline constexpr int kPlanesPerPixel = 24;
+
+/// Where a channel lives.
+struct ChannelRef {
+  int file = 0;
+  int subimage = 0;
+  int index = 0;
+  OIIO::TypeDesc format;
+};
+
+/// A Cryptomatte layer: rank-0 IDs in `<name>00.R` (float bits of a uint32
+/// hash), names in the manifest of the EXR metadata.
+struct CryptoLayer {
+  std::string name;     ///< as in "cryptomatte/<key>/name"
+  std::string channel;  ///< the rank-0 ID channel
+  ChannelRef ref;
+  std::map<std::string, uint32_t> manifest;  ///< object/material name -> ID
+};
+
+class ChannelSet {
+ public:
+  ChannelSet();
+  ~ChannelSet();
+  ChannelSet(ChannelSet&&) noexcept;
+  ChannelSet& operator=(ChannelSet&&) noexcept;
+
+  /// Opens `path`: it must exist, be an OpenEXR file, not deep, with a data
+  /// window equal to its display window, of sane dimensions, and of the same
+  /// resolution as the files added before. Channels already present keep
+  /// their first file.
+  Status Add(const std::string& path);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  size_t pixels() const { return size_t(width_) * size_t(height_); }
+  bool empty() const { return files_.empty(); }
+
+  std::optional<ChannelRef> Find(const std::string& name) const;
+  bool Has(const std::string& name) const { return Find(name).has_value(); }
+  /// Every channel name (sorted).
+  std::vector<std::string> Names() const;
+  /// "'a.exr': R, G, B; 'b.exr': id" (at most ~100 names), for messages.
+  std::string Describe() const;
+  const std::string& Path(int file) const;
+  /// The files, for messages ("'a.exr'" or "'a.exr', 'b.exr'").
+  std::string Paths() const;
+
+  /// Reads a channel as float (any stored format).
+  Status ReadFloat(const std::string& name, std::vector<float>* plane) const;
+  /// Reads an ID channel: uint channels as UINT32, float/half channels as
+  /// float checked to hold integers (negative integers wrap to uint32).
+  Status ReadId(const std::string& name, std::vector<uint32_t>* plane) const;
+  /// Reads a Cryptomatte rank-0 channel: the float bits as uint32.
+  Status ReadCrypto(const CryptoLayer& layer, std::vector<uint32_t>* plane) const;
+
+  /// The Cryptomatte layers found in the metadata.
+  const std::vector<CryptoLayer>& Crypto() const { return crypto_; }
+  /// The layer whose name equals `name` or ends with it; error when none or
+  /// ambiguous.
+  Status FindCrypto(const std::string& name, const CryptoLayer** layer) const;
+
+ private:
+  struct File {
+    std::string path;
+    std::unique_ptr<OIIO::ImageInput> in;
+    std::vector<OIIO::ImageSpec> specs;  ///< per subimage (EXR part)
+  };
+  Status ReadRaw(const std::string& name, OIIO::TypeDesc type, void* data) const;
+  Status ReadRef(const ChannelRef& ref, const std::string& name, OIIO::TypeDesc type,
+                 void* data) const;
+  void ScanCrypto(int file);
+
+  int width_ = 0, height_ = 0;
+  std::vector<File> files_;
+  std::map<std::string, ChannelRef> channels_;
+  std::vector<CryptoLayer> crypto_;
+};
+
+/// "'name'" quoted for messages.
+inline std::string Quote(const std::string& s) { return "'" + s + "'"; }
+
+}  // namespace dcm::aov::detail

@@ -1,0 +1,439 @@
+// `dcm reconstruct` and `dcm plan` as a user runs them: the built binary on
+// EXRs the tests write.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <OpenImageIO/imageio.h>
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <set>
+#include <sstream>
+
+#include "common/metrics.h"
+#include "common/sample_map.h"
+#include "test_util.h"
+
+namespace dcm::aov::test {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::Not;
+namespace fs = std::filesystem;
+
+nlohmann::json ReadJson(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+std::vector<RGB> SceneBeauty(const Scene& sc) {
+  std::vector<RGB> v;
+  for (int y = 0; y < sc.height; ++y)
+    for (int x = 0; x < sc.width; ++x) v.push_back(sc.L(x, y));
+  return v;
+}
+
+TEST(DcmReconstruct, DenseOutputsStatsAndMetrics) {
+  ScratchDir dir;
+  Scene sc{64, 48};
+  WriteExr(dir / "in.exr", sc.width, sc.height, sc.GenericChannels(true));
+  auto r = RunDcm({"reconstruct", dir / "in.exr", "-o", dir / "out.exr", "--stats", dir / "s.json",
+                   "--sample-map", dir / "map.png", "--preview", dir / "prev.png", "--error-map",
+                   dir / "err.png", "--threads", "2"},
+                  dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("exact pixels"));
+
+  int w = 0, h = 0;
+  const auto out = ReadRgbExr(dir / "out.exr", &w, &h);
+  ASSERT_EQ(w, 64);
+  ASSERT_EQ(h, 48);
+  auto in = OIIO::ImageInput::open(dir / "out.exr");
+  ASSERT_TRUE(in);
+  EXPECT_EQ(in->spec().format, OIIO::TypeDesc::FLOAT);
+  const float metaFraction = in->spec().get_float_attribute("dcm:exact_fraction", -1.f);
+  EXPECT_THAT(in->spec().get_string_attribute("dcm:settings"), HasSubstr("\"object_test\""));
+  in->close();
+
+  const auto s = ReadJson(dir / "s.json");
+  const int64_t exact = s["exact_pixels"], total = s["total_pixels"];
+  EXPECT_EQ(total, 64 * 48);
+  EXPECT_GT(exact, 0);
+  EXPECT_LT(exact, total);
+  EXPECT_DOUBLE_EQ(double(s["exact_fraction"]), double(exact) / double(total));
+  EXPECT_FLOAT_EQ(metaFraction, float(double(exact) / double(total)));
+  EXPECT_GE(double(s["time_s"]), 0.0);
+  int64_t byReason = 0;
+  for (const auto& [name, count] : s["by_reason"].items())
+    if (name != "interpolated") byReason += int64_t(count);
+  EXPECT_EQ(byReason, exact);
+  EXPECT_EQ(s["mode"], "dense");
+  EXPECT_TRUE(bool(s["used"]["split"]));
+  EXPECT_TRUE(bool(s["capabilities"]["object_id"]));
+  EXPECT_EQ(s["options"]["threads"], 2);
+
+  // The reference error is that of the output against the full input,
+  // recomputed here from the files.
+  const auto ref = SceneBeauty(sc);
+  const auto e = toolkit::Compare(out, ref, 64, 48);
+  ASSERT_TRUE(s["reference"]["psnr"].is_number());
+  EXPECT_NEAR(double(s["reference"]["psnr"]), e.psnr, 1e-9);
+  EXPECT_NEAR(double(s["reference"]["rmse"]), e.rmse, 1e-12);
+  EXPECT_NEAR(double(s["reference"]["relmse"]), e.relmse, 1e-12);
+  // Wiring errors (a channel swapped, tau not applied, the wrong role) put the
+  // error above 0.05 RMS; a working reconstruction of this smooth scene with
+  // exact IDs is far below.
+  EXPECT_LT(e.rmse, 0.05);
+  // Exact pixels are exact.
+  // The sample map marks exactly `exact` pixels.
+  auto map = OIIO::ImageInput::open(dir / "map.png");
+  ASSERT_TRUE(map);
+  ASSERT_EQ(map->spec().width, 64);
+  std::vector<uint8_t> px(size_t(64 * 48 * 3));
+  ASSERT_TRUE(map->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, px.data()));
+  const auto gray = toolkit::ReasonColor(SampleReason::kInterpolated);
+  int64_t marked = 0;
+  for (size_t i = 0; i < px.size(); i += 3) marked += !(px[i] == gray[0] && px[i + 1] == gray[1] && px[i + 2] == gray[2]);
+  EXPECT_EQ(marked, exact);
+  for (const char* f : {"prev.png", "err.png"}) {
+    auto img = OIIO::ImageInput::open(dir / f);
+    ASSERT_TRUE(img) << f;
+    EXPECT_EQ(img->spec().width, 64);
+    EXPECT_EQ(img->spec().height, 48);
+  }
+  // Exactly the requested files, no temporaries.
+  EXPECT_EQ(dir.Files(), (std::vector<std::string>{"err.png", "in.exr", "map.png", "out.exr", "prev.png", "s.json"}));
+}
+
+TEST(DcmReconstruct, FullEvaluationReproducesTheInput) {
+  ScratchDir dir;
+  Scene sc{32, 32};
+  WriteExr(dir / "in.exr", 32, 32, sc.GenericChannels(false));
+  auto r = RunDcm({"reconstruct", dir / "in.exr", "--full", "-o", dir / "out.exr", "--stats", dir / "s.json", "--quiet"}, dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(r.err, "") << "--quiet";
+  const auto s = ReadJson(dir / "s.json");
+  EXPECT_EQ(s["exact_fraction"], 1.0);
+  EXPECT_TRUE(s["reference"]["psnr"].is_null()) << "identical: infinite PSNR";
+  EXPECT_EQ(s["reference"]["rmse"], 0.0);
+  EXPECT_EQ(ReadRgbExr(dir / "out.exr"), SceneBeauty(sc));
+}
+
+TEST(DcmReconstruct, DownsampleComparesAtOutputResolution) {
+  ScratchDir dir;
+  Scene sc{64, 64};
+  WriteExr(dir / "in.exr", 64, 64, sc.GenericChannels(false));
+  auto r = RunDcm({"reconstruct", dir / "in.exr", "--downsample", "2", "--full", "-o", dir / "out.exr",
+                   "--stats", dir / "s.json", "--quiet"},
+                  dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  int w = 0, h = 0;
+  const auto out = ReadRgbExr(dir / "out.exr", &w, &h);
+  EXPECT_EQ(w, 32);
+  EXPECT_EQ(h, 32);
+  const auto s = ReadJson(dir / "s.json");
+  EXPECT_EQ(s["total_pixels"], 64 * 64);
+  EXPECT_EQ(s["width"], 32);
+  // Full evaluation, downsampled by the engine and by the tool's reference:
+  // the same 2x2 means up to float summation order (RMSE below 1e-6).
+  EXPECT_LT(double(s["reference"]["rmse"]), 1e-6);
+}
+
+TEST(DcmReconstruct, VerboseSaysWhichTestsAreOff) {
+  ScratchDir dir;
+  Scene sc{16, 16};
+  auto ch = sc.GenericChannels(false);
+  WriteExr(dir / "beauty.exr", 16, 16, {ch[2], ch[3], ch[4]});
+  auto r = RunDcm({"reconstruct", dir / "beauty.exr", "-o", dir / "out.exr", "-v"}, dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("contrast only"));
+  EXPECT_THAT(r.err, HasSubstr("no tau: the texture split is off"));
+}
+
+TEST(DcmReconstruct, PresetAndMapOnTheCommandLine) {
+  ScratchDir dir;
+  Scene sc{32, 16};
+  std::vector<TestChannel> ch;
+  ch.push_back(Fill("ViewLayer.IndexOB.X", 32, 16, [&](int x, int y) { return float(sc.ObjectId(x, y)); }));
+  const char* comp[3] = {"R", "G", "B"};
+  for (int c = 0; c < 3; ++c) {
+    ch.push_back(Fill(std::string("ViewLayer.DiffCol.") + comp[c], 32, 16, [&](int x, int y) { return sc.Tau(x, y)[c]; }));
+    ch.push_back(Fill(std::string("ViewLayer.DiffDir.") + comp[c], 32, 16, [&](int x, int y) { return sc.Li(x, y)[c]; }));
+    ch.push_back(Fill(std::string("ViewLayer.DiffInd.") + comp[c], 32, 16, [](int, int) { return 0.f; }));
+    ch.push_back(Fill(std::string("ViewLayer.Combined.") + comp[c], 32, 16, [&](int x, int y) { return sc.L(x, y)[c]; }));
+  }
+  ch.push_back(Fill("mat", 32, 16, [&](int x, int y) { return float(sc.ShaderId(x, y)); }));
+  WriteExr(dir / "b.exr", 32, 16, ch);
+  auto r = RunDcm({"reconstruct", dir / "b.exr", "--preset", "blender", "--map", "shader=mat", "-o",
+                   dir / "out.exr", "--stats", dir / "s.json", "-v"},
+                  dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("shader ID: channel 'mat'"));
+  EXPECT_THAT(r.err, HasSubstr("Blender view layer 'ViewLayer'"));
+  const auto s = ReadJson(dir / "s.json");
+  EXPECT_TRUE(bool(s["capabilities"]["shader_id"]));
+  EXPECT_TRUE(bool(s["capabilities"]["split_radiance"]));
+  EXPECT_LT(double(s["reference"]["rmse"]), 0.05);  // see DenseOutputsStatsAndMetrics
+}
+
+/// The scripted renderer: renders the pixels of a plan list into a samples EXR.
+void RenderList(const Scene& sc, bool split, const std::string& list, const std::string& out,
+                std::set<std::pair<int, int>>* rendered) {
+  const int w = sc.width, h = sc.height;
+  std::vector<TestChannel> ch;
+  const char* comp[3] = {"R", "G", "B"};
+  auto zero = [&](const std::string& name) { return Fill(name, w, h, [](int, int) { return 0.f; }); };
+  if (split) {
+    for (int c = 0; c < 3; ++c) ch.push_back(zero(std::string("Li.") + comp[c]));
+    for (int c = 0; c < 3; ++c) ch.push_back(zero(std::string("Lc.") + comp[c]));
+  } else {
+    for (int c = 0; c < 3; ++c) ch.push_back(zero(comp[c]));
+  }
+  ch.push_back(zero("mask"));
+  std::istringstream in(ReadText(list));
+  std::string line;
+  int count = 0;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    int x = -1, y = -1;
+    std::istringstream(line) >> x >> y;
+    ASSERT_TRUE(x >= 0 && x < w && y >= 0 && y < h) << line;
+    EXPECT_TRUE(rendered->insert({x, y}).second) << "pixel asked for twice: " << line;
+    const size_t i = size_t(y) * size_t(w) + size_t(x);
+    for (int c = 0; c < 3; ++c) {
+      if (split) {
+        ch[size_t(c)].values[i] = sc.Li(x, y)[c];
+        ch[size_t(3 + c)].values[i] = sc.Lc(x, y)[c];
+      } else {
+        ch[size_t(c)].values[i] = sc.L(x, y)[c];
+      }
+    }
+    ch.back().values[i] = 1.f;
+    ++count;
+  }
+  EXPECT_GT(count, 0);
+  WriteExr(out, w, h, ch);
+}
+
+class PlanRoundTrip : public ::testing::TestWithParam<bool> {};
+
+TEST_P(PlanRoundTrip, SameImageAsDenseBitForBit) {
+  const bool split = GetParam();
+  ScratchDir dir;
+  Scene sc{72, 56};  // not a multiple of the 64-pixel tile: clipped tiles too
+  WriteExr(dir / "dense.exr", sc.width, sc.height, sc.GenericChannels(split));
+  WriteExr(dir / "guides.exr", sc.width, sc.height, sc.GenericChannels(split, /*guidesOnly=*/true));
+  const std::vector<std::string> engine = {"--threads", "2", "--quiet"};
+  auto dense = engine;
+  dense.insert(dense.begin(), {"reconstruct", dir / "dense.exr", "-o", dir / "dense_out.exr", "--stats", dir / "dense.json"});
+  auto r = RunDcm(dense, dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+
+  std::vector<std::string> samples;
+  std::set<std::pair<int, int>> rendered;
+  bool done = false;
+  for (int round = 0; round < 64 && !done; ++round) {
+    std::vector<std::string> plan = {"plan", dir / "guides.exr", "--list", dir / "next.txt", "--mask", dir / "next.exr"};
+    for (const auto& s : samples) plan.insert(plan.end(), {"--samples", s});
+    plan.insert(plan.end(), engine.begin(), engine.end());
+    r = RunDcm(plan, dir);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    if (r.out == "done\n") {
+      done = true;
+      break;
+    }
+    ASSERT_THAT(r.out, HasSubstr("pending "));
+    // The text list and the EXR mask name the same pixels.
+    auto mask = OIIO::ImageInput::open(dir / "next.exr");
+    ASSERT_TRUE(mask);
+    std::vector<float> m(size_t(sc.width * sc.height));
+    ASSERT_TRUE(mask->read_image(0, 0, 0, 1, OIIO::TypeDesc::FLOAT, m.data()));
+    int64_t masked = 0;
+    for (float v : m) masked += v > 0.f;
+    EXPECT_EQ("pending " + std::to_string(masked) + "\n", r.out);
+    EXPECT_THAT(ReadText(dir / "next.txt"), HasSubstr(split ? "Li.R,Li.G,Li.B,Lc.R" : "R,G,B,mask"));
+    const std::string s = dir / ("samples_" + std::to_string(round) + ".exr");
+    RenderList(sc, split, dir / "next.txt", s, &rendered);
+    samples.push_back(s);
+  }
+  ASSERT_TRUE(done) << "plan did not finish in 64 rounds";
+
+  std::vector<std::string> rec = {"reconstruct", dir / "guides.exr", "-o", dir / "sparse_out.exr", "--stats", dir / "sparse.json"};
+  for (const auto& s : samples) rec.insert(rec.end(), {"--samples", s});
+  rec.insert(rec.end(), engine.begin(), engine.end());
+  r = RunDcm(rec, dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+
+  const auto a = ReadRgbExr(dir / "dense_out.exr"), b = ReadRgbExr(dir / "sparse_out.exr");
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_EQ(a.size(), size_t(sc.width * sc.height));
+  EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(RGB)), 0) << "not bit-identical";
+  const auto ds = ReadJson(dir / "dense.json"), ss = ReadJson(dir / "sparse.json");
+  EXPECT_EQ(ds["exact_pixels"], ss["exact_pixels"]);
+  EXPECT_EQ(ss["mode"], "sparse");
+  // The renderer rendered exactly the exact pixels, each once.
+  EXPECT_EQ(int64_t(rendered.size()), int64_t(ds["exact_pixels"]));
+}
+
+INSTANTIATE_TEST_SUITE_P(BeautyAndSplit, PlanRoundTrip, ::testing::Values(false, true),
+                         [](const auto& p) { return p.param ? "Split" : "Beauty"; });
+
+TEST(DcmReconstruct, IncompleteSamplesAskForPlan) {
+  ScratchDir dir;
+  Scene sc{32, 32};
+  WriteExr(dir / "guides.exr", 32, 32, sc.GenericChannels(false, true));
+  auto all = sc.GenericChannels(false);
+  WriteExr(dir / "s.exr", 32, 32, {all[2], all[3], all[4], Fill("mask", 32, 32, [](int x, int) { return x < 3 ? 1.f : 0.f; })});
+  auto r = RunDcm({"reconstruct", dir / "guides.exr", "--samples", dir / "s.exr", "-o", dir / "out.exr"}, dir);
+  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_THAT(r.err, HasSubstr("dcm plan"));
+  EXPECT_FALSE(fs::exists(dir / "out.exr"));
+}
+
+/// Bad input: exit code 1, a message naming the file (and channel), and no
+/// output file of any kind left behind.
+struct BadCase {
+  const char* name;
+  std::function<void(const ScratchDir&)> make;
+  std::vector<std::string> extraArgs;
+  std::vector<std::string> messageParts;
+};
+
+class BadInput : public ::testing::TestWithParam<int> {};
+
+std::vector<BadCase> BadCases() {
+  Scene sc{16, 16};
+  return {
+      {"MissingFile", [](const ScratchDir&) {}, {}, {"in.exr': no such file"}},
+      {"NotAnExr",
+       [](const ScratchDir& d) {
+         const std::vector<uint8_t> rgb(16 * 16 * 3, 128);
+         auto out = OIIO::ImageOutput::create(d / "in.png");
+         OIIO::ImageSpec spec(16, 16, 3, OIIO::TypeDesc::UINT8);
+         out->open(d / "in.png", spec);
+         out->write_image(OIIO::TypeDesc::UINT8, rgb.data());
+         out->close();
+         fs::rename(d / "in.png", d / "in.exr");
+       },
+       {},
+       {"in.exr': not an OpenEXR file"}},
+      {"TruncatedExr",
+       [sc](const ScratchDir& d) {
+         WriteExr(d / "in.exr", 64, 64, Scene{64, 64}.GenericChannels(false));
+         fs::resize_file(d / "in.exr", fs::file_size(d / "in.exr") * 2 / 3);
+       },
+       {},
+       {"in.exr", "truncated or corrupt"}},
+      {"AbsentChannel",
+       [sc](const ScratchDir& d) { WriteExr(d / "in.exr", 16, 16, sc.GenericChannels(false)); },
+       {"--map", "id=objectid"},
+       {"no channel 'objectid'", "in.exr", "shader"}},
+      {"DifferentResolutions",
+       [sc](const ScratchDir& d) {
+         WriteExr(d / "in.exr", 16, 16, sc.GenericChannels(false));
+         WriteExr(d / "in2.exr", 16, 12, {Fill("u", 16, 12, [](int, int) { return 0.f; })});
+       },
+       {"INPUT2"},
+       {"different resolutions", "in2.exr' is 16x12"}},
+      {"NonIntegerIds",
+       [sc](const ScratchDir& d) {
+         auto ch = sc.GenericChannels(false);
+         ch[0].values[17] = 1.25f;
+         WriteExr(d / "in.exr", 16, 16, ch);
+       },
+       {},
+       {"in.exr", "channel 'id'", "non-integer ID 1.25"}},
+      {"AbsurdDimensions", [](const ScratchDir& d) { MakeHugeExr(d / "in.exr", 100000); }, {}, {"in.exr", "100000x100000"}},
+      {"BadSamplesFile",
+       [sc](const ScratchDir& d) {
+         WriteExr(d / "in.exr", 16, 16, sc.GenericChannels(false, true));
+         WriteExr(d / "samples.exr", 16, 16, {Fill("R", 16, 16, [](int, int) { return 0.f; })});
+       },
+       {"--samples", "SAMPLES"},
+       {"samples.exr", "mask"}},
+  };
+}
+
+TEST_P(BadInput, FailsCleanly) {
+  const BadCase c = BadCases()[size_t(GetParam())];
+  ScratchDir dir;
+  c.make(dir);
+  const auto before = dir.Files();
+  std::vector<std::string> args = {"reconstruct", dir / "in.exr"};
+  for (const auto& a : c.extraArgs)
+    args.push_back(a == "INPUT2" ? dir / "in2.exr" : a == "SAMPLES" ? dir / "samples.exr" : a);
+  args.insert(args.end(), {"-o", dir / "out.exr", "--stats", dir / "s.json", "--sample-map", dir / "m.png",
+                           "--preview", dir / "p.png"});
+  auto r = RunDcm(args, dir);
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("dcm reconstruct: error: "));
+  for (const auto& part : c.messageParts) EXPECT_THAT(r.err, HasSubstr(part));
+  EXPECT_EQ(dir.Files(), before) << "an output or temporary file was left behind";
+}
+
+INSTANTIATE_TEST_SUITE_P(Cases, BadInput, ::testing::Range(0, int(BadCases().size())),
+                         [](const auto& p) { return std::string(BadCases()[size_t(p.param)].name); });
+
+TEST(DcmReconstruct, NonFiniteSamplesAreReportedAndNotSpread) {
+  ScratchDir dir;
+  Scene sc{48, 48};
+  auto ch = sc.GenericChannels(false);
+  // A NaN on a lattice corner (always evaluated) and an Inf and a negative
+  // value elsewhere.
+  ch[2].values[size_t(8 * 48 + 8)] = std::numeric_limits<float>::quiet_NaN();
+  ch[3].values[size_t(20 * 48 + 30)] = std::numeric_limits<float>::infinity();
+  ch[4].values[size_t(40 * 48 + 5)] = -1.f;
+  WriteExr(dir / "in.exr", 48, 48, ch);
+  auto r = RunDcm({"reconstruct", dir / "in.exr", "-o", dir / "out.exr", "--stats", dir / "s.json"}, dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("channel 'R': 1 NaN/Inf"));
+  EXPECT_THAT(r.err, HasSubstr("channel 'G': 1 NaN/Inf"));
+  EXPECT_THAT(r.err, HasSubstr("channel 'B': 1 negative"));
+  const auto out = ReadRgbExr(dir / "out.exr");
+  std::set<size_t> nonFinite;
+  for (size_t i = 0; i < out.size(); ++i)
+    if (!IsFinite(out[i])) nonFinite.insert(i);
+  EXPECT_TRUE(nonFinite.count(8 * 48 + 8)) << "the NaN corner stays in its pixel";
+  for (size_t i : nonFinite) EXPECT_TRUE(i == 8 * 48 + 8 || i == 20 * 48 + 30) << "spread to pixel " << i;
+  const auto s = ReadJson(dir / "s.json");
+  EXPECT_GE(int64_t(s["non_finite_samples"]), 1);
+  EXPECT_EQ(s["reference"]["non_finite_pixels"], int64_t(nonFinite.size()));
+}
+
+TEST(DcmReconstruct, UsageErrorsExitWith2) {
+  ScratchDir dir;
+  Scene sc{16, 16};
+  WriteExr(dir / "in.exr", 16, 16, sc.GenericChannels(false));
+  const std::vector<std::vector<std::string>> cases = {
+      {"reconstruct", dir / "in.exr", "--preset", "maya", "-o", dir / "out.exr"},
+      {"reconstruct", dir / "in.exr", "--map", "idchannel", "-o", dir / "out.exr"},
+      {"reconstruct", dir / "in.exr", "--map", "colour=R", "-o", dir / "out.exr"},
+      {"reconstruct", dir / "in.exr", "--block", "6", "-o", dir / "out.exr"},
+      {"reconstruct", dir / "in.exr"},
+      {"plan", dir / "in.exr"},
+  };
+  for (const auto& args : cases) {
+    auto r = RunDcm(args, dir);
+    EXPECT_EQ(r.exitCode, 2) << args[2] << ": " << r.err;
+    EXPECT_FALSE(fs::exists(dir / "out.exr"));
+  }
+}
+
+TEST(DcmReconstruct, UnwritableOutputLeavesNothing) {
+  ScratchDir dir;
+  Scene sc{16, 16};
+  WriteExr(dir / "in.exr", 16, 16, sc.GenericChannels(false));
+  // The EXR can be written, the stats cannot: the EXR goes again.
+  auto r = RunDcm({"reconstruct", dir / "in.exr", "-o", dir / "out.exr", "--stats", dir / "nodir/s.json"}, dir);
+  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_THAT(r.err, HasSubstr("nodir/s.json"));
+  EXPECT_EQ(dir.Files(), std::vector<std::string>{"in.exr"});
+}
+
+}  // namespace
+}  // namespace dcm::aov::test

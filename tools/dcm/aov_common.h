@@ -1,0 +1,111 @@
+// What `dcm reconstruct` and `dcm plan` share: the AOV input flags, opening
+// the provider with its notes and warnings, and running the engine with
+// progress. Header-only so that both cmd_*.cpp files build only with dcm_aov.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "commands.h"
+#include "common/progress.h"
+#include "dcm/aov/aov_provider.h"
+#include "dcm/reconstructor.h"
+#include "engine_flags.h"
+
+namespace dcm::cli::aov_common {
+
+/// The AOV input flags as parsed.
+struct AovFlags {
+  std::vector<std::string> inputs;
+  std::string preset = "generic";
+  std::vector<std::string> maps;
+  std::vector<std::string> textures;
+  std::string layer;
+  std::vector<std::string> samples;
+};
+
+/// Adds INPUT... and --preset, --map, --texture, --layer, --samples.
+inline void AddAovFlags(CLI::App* app, AovFlags* f, bool samplesHelpForPlan) {
+  app->add_option("inputs", f->inputs, "input EXR files (one multilayer EXR or several EXRs of one size)")
+      ->required();
+  app->add_option("--preset", f->preset, "channel names: generic (default) or blender (Cycles passes)")
+      ->check(CLI::IsMember({"generic", "blender"}));
+  app->add_option("--map", f->maps,
+                  "ROLE=CHANNEL: override a role (id, shader, u, v, tau, Li, Lc, L, var, mask or one "
+                  "component like tau.R); CHANNEL may be A+B, A*B or cryptomatte:LAYER")
+      ->allow_extra_args(false);
+  app->add_option("--texture", f->textures,
+                  "SHADER=FILE: evaluate tau(u,v) of that shader ID (or Cryptomatte material name) "
+                  "from a texture file")
+      ->allow_extra_args(false);
+  app->add_option("--layer", f->layer, "Blender view layer (default: the only one in the file)");
+  app->add_option("--samples", f->samples,
+                  samplesHelpForPlan
+                      ? "samples EXR rendered for an earlier plan (repeatable; with a 'mask' channel)"
+                      : "sparse round trip: samples EXRs rendered for `dcm plan` (repeatable); the "
+                        "inputs then carry the guides only")
+      ->allow_extra_args(false);
+}
+
+/// The provider options the flags select; the message names the flag at fault.
+inline Status ToAovOptions(const AovFlags& f, bool sparse, bool split, aov::AovOptions* o) {
+  DCM_RETURN_IF_ERROR(aov::ParsePreset(f.preset, &o->preset));
+  for (const auto& m : f.maps) DCM_RETURN_IF_ERROR(aov::ParseMapping(m, &o->mappings));
+  for (const auto& t : f.textures) {
+    aov::TextureBinding b;
+    DCM_RETURN_IF_ERROR(aov::ParseTextureBinding(t, &b));
+    o->textures.push_back(b);
+  }
+  o->viewLayer = f.layer;
+  o->sparse = sparse;
+  o->samples = f.samples;
+  o->split = split;
+  return Status::Ok();
+}
+
+/// Prints "dcm CMD: error: MESSAGE" on stderr and returns `code`.
+inline int Fail(const std::string& cmd, const std::string& message, int code = kExitFailure) {
+  std::cerr << "dcm " << cmd << ": error: " << message << "\n";
+  return code;
+}
+
+/// Opens the provider and prints its notes (-v) and warnings (unless --quiet).
+inline Status OpenProvider(const std::string& cmd, const AovFlags& flags, const aov::AovOptions& options,
+                           const EngineFlags& engine, std::unique_ptr<aov::AovProvider>* provider) {
+  DCM_RETURN_IF_ERROR(aov::AovProvider::Open(flags.inputs, options, provider));
+  if (engine.verbose) {
+    const auto caps = (*provider)->Capabilities();
+    std::cerr << "dcm " << cmd << ": " << caps.width << "x" << caps.height << ", "
+              << ((*provider)->dense() ? "dense" : "sparse") << " input\n";
+    for (const auto& n : (*provider)->Notes()) std::cerr << "dcm " << cmd << ": " << n << "\n";
+  }
+  if (!engine.quiet)
+    for (const auto& w : (*provider)->Warnings()) std::cerr << "dcm " << cmd << ": warning: " << w << "\n";
+  return Status::Ok();
+}
+
+/// Runs the engine with progress on stderr.
+inline Status Run(aov::AovProvider& provider, ReconstructionOptions options, const EngineFlags& engine,
+                  Reconstruction* result, std::vector<Point2i>* pending) {
+  toolkit::Progress progress(!engine.quiet);
+  options.progress = [&progress](float f, std::string_view stage) { progress.Update(f, stage); };
+  Status st = Reconstruct(provider, options, result, pending);
+  progress.Done();
+  return st;
+}
+
+/// Removes the files written so far (after a later output failed).
+inline void RemoveAll(const std::vector<std::string>& paths) {
+  for (const auto& p : paths) {
+    std::error_code ec;
+    std::filesystem::remove(p, ec);
+  }
+}
+
+}  // namespace dcm::cli::aov_common

@@ -1,0 +1,163 @@
+// dcm plan: one round of the file-based round trip.
+//
+//   dcm plan GUIDES.exr [--samples S1.exr ...] --mask NEXT.exr --list NEXT.txt
+//
+// Runs the engine on the guides and the samples rendered so far (the engine is
+// deterministic, so every round starts from the beginning) and writes the
+// pixels it needs next: an EXR mask (channel "mask", 1 where requested) and a
+// text list ("x y" per line, '#' comments). The renderer renders those pixels
+// into a samples EXR (the channels plan names, plus "mask"); repeat with all
+// samples files until plan prints "done"; then `dcm reconstruct GUIDES.exr
+// --samples ...` gives the same image as dense mode.
+//
+// stdout is one word for scripts: "pending N" or "done".
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <fstream>
+#include <iostream>
+#include <memory>
+
+#include "aov_common.h"
+#include "common/image_io.h"
+#include "common/stats_json.h"
+
+namespace dcm::cli {
+namespace {
+
+struct PlanFlags {
+  aov_common::AovFlags aov;
+  EngineFlags engine;
+  std::string mask, list, stats;
+};
+
+Status WriteMask(const std::string& path, int width, int height, const std::vector<Point2i>& pixels,
+                 const std::vector<std::string>& channels) {
+  std::vector<float> mask(size_t(width) * size_t(height), 0.f);
+  for (const auto& p : pixels) mask[size_t(p.y) * size_t(width) + size_t(p.x)] = 1.f;
+  OIIO::ImageSpec spec(width, height, 1, OIIO::TypeDesc::FLOAT);
+  spec.channelnames = {"mask"};
+  spec.attribute("compression", "zip");
+  std::string names;
+  for (const auto& c : channels) names += (names.empty() ? "" : ",") + c;
+  spec.attribute("dcm:channels", names);
+  spec.attribute("dcm:pending", int(pixels.size()));
+  return toolkit::WriteAtomically(path, [&](const std::string& tmp) -> Status {
+    auto out = OIIO::ImageOutput::create(tmp);
+    if (!out) return Status::Error("cannot write '" + path + "': " + OIIO::geterror());
+    if (!out->open(tmp, spec)) return Status::Error("cannot write '" + path + "': " + out->geterror());
+    bool ok = out->write_image(OIIO::TypeDesc::FLOAT, mask.data());
+    std::string err = ok ? "" : out->geterror();
+    if (!out->close() && ok) {
+      ok = false;
+      err = out->geterror();
+    }
+    return ok ? Status::Ok() : Status::Error("cannot write '" + path + "': " + err);
+  });
+}
+
+Status WriteList(const std::string& path, int width, int height, const std::vector<Point2i>& pixels,
+                 const std::vector<std::string>& channels) {
+  return toolkit::WriteAtomically(path, [&](const std::string& tmp) -> Status {
+    std::ofstream out(tmp, std::ios::trunc);
+    if (!out) return Status::Error("cannot write '" + path + "': cannot create a file in its folder");
+    std::string names;
+    for (const auto& c : channels) names += (names.empty() ? "" : ",") + c;
+    out << "# dcm plan: " << pixels.size() << " pixels of " << width << "x" << height
+        << " to render; samples EXR channels: " << names << "\n";
+    for (const auto& p : pixels) out << p.x << ' ' << p.y << '\n';
+    out.close();
+    if (!out) return Status::Error("cannot write '" + path + "': write failed");
+    return Status::Ok();
+  });
+}
+
+int RunPlan(const PlanFlags& f) {
+  const std::string cmd = "plan";
+  ReconstructionOptions options;
+  Status st = ToOptions(f.engine, &options);
+  if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
+  if (f.mask.empty() && f.list.empty())
+    return aov_common::Fail(cmd, "give --list and/or --mask for the pixels to render", kExitUsage);
+  aov::AovOptions aovOptions;
+  st = aov_common::ToAovOptions(f.aov, /*sparse=*/true, options.textureSplit, &aovOptions);
+  if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
+
+  std::unique_ptr<aov::AovProvider> provider;
+  st = aov_common::OpenProvider(cmd, f.aov, aovOptions, f.engine, &provider);
+  if (!st.ok()) return aov_common::Fail(cmd, st.message());
+
+  Reconstruction r;
+  std::vector<Point2i> pending;
+  st = aov_common::Run(*provider, options, f.engine, &r, &pending);
+  if (!st.ok() && !st.pending()) return aov_common::Fail(cmd, st.message());
+  const bool done = st.ok();
+  std::vector<Point2i> next;
+  if (!done) {
+    // The engine reports every pixel of the phase it could not finish; the
+    // ones already rendered need not be rendered again.
+    for (const auto& p : pending)
+      if (!provider->HasSample(p)) next.push_back(p);
+    std::sort(next.begin(), next.end(),
+              [](const Point2i& a, const Point2i& b) { return a.y != b.y ? a.y < b.y : a.x < b.x; });
+    next.erase(std::unique(next.begin(), next.end()), next.end());
+    if (next.empty())
+      return aov_common::Fail(cmd, "the engine is pending on pixels that all have samples: " + st.message());
+  }
+  const int w = provider->width(), h = provider->height();
+  const auto channels = provider->SampleChannels();
+
+  std::vector<std::string> written;
+  auto check = [&](const std::string& path, Status s) -> int {
+    if (!s.ok()) {
+      aov_common::RemoveAll(written);
+      return aov_common::Fail(cmd, s.message());
+    }
+    written.push_back(path);
+    return kExitOk;
+  };
+  int rc = kExitOk;
+  if (!f.mask.empty() && (rc = check(f.mask, WriteMask(f.mask, w, h, next, channels)))) return rc;
+  if (!f.list.empty() && (rc = check(f.list, WriteList(f.list, w, h, next, channels)))) return rc;
+  if (!f.stats.empty()) {
+    nlohmann::json j;
+    j["command"] = cmd;
+    j["done"] = done;
+    j["pending"] = next.size();
+    j["samples_present"] = provider->SampleCount();
+    j["total_pixels"] = int64_t(w) * h;
+    j["channels"] = channels;
+    j["options"] = toolkit::OptionsToJson(options);
+    if (done) j["result"] = toolkit::StatsToJson(r.stats);
+    if ((rc = check(f.stats, toolkit::WriteJson(f.stats, j)))) return rc;
+  }
+  if (!f.engine.quiet) {
+    std::string names;
+    for (const auto& c : channels) names += (names.empty() ? "" : ",") + c;
+    if (done)
+      std::cerr << "dcm plan: done: the " << provider->SampleCount()
+                << " samples rendered suffice; run `dcm reconstruct` with them\n";
+    else
+      std::cerr << "dcm plan: " << next.size() << " pixels to render (samples EXR channels: " << names
+                << "); " << provider->SampleCount() << " rendered so far\n";
+  }
+  if (done)
+    std::cout << "done\n";
+  else
+    std::cout << "pending " << next.size() << "\n";
+  return kExitOk;
+}
+
+Registration reg("plan", "Plan the next round of a file-based round trip (pixels to render)",
+                 [](CLI::App* app) -> std::function<int()> {
+                   auto f = std::make_shared<PlanFlags>();
+                   aov_common::AddAovFlags(app, &f->aov, true);
+                   app->add_option("--mask", f->mask, "output EXR mask of the pixels to render");
+                   app->add_option("--list", f->list, "output text list of the pixels to render ('x y' lines)");
+                   app->add_option("--stats", f->stats, "round summary as JSON");
+                   AddEngineFlags(app, &f->engine);
+                   return [f] { return RunPlan(*f); };
+                 });
+
+}  // namespace
+}  // namespace dcm::cli

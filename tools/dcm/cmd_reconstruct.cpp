@@ -1,0 +1,191 @@
+// dcm reconstruct: DCM reconstruction from a renderer's EXR AOVs.
+//
+//   dcm reconstruct IN.exr [IN2.exr ...] [--preset blender|generic] [--map ROLE=CH]
+//       -o OUT.exr [--stats S.json] [--sample-map M.png] [--preview P.png]
+//       [--error-map E.png] [--reference REF.exr] [--samples S.exr ...] + engine flags
+//
+// Dense input (the expensive channels for every pixel): reconstructs from the
+// pixels the engine asks for and reports the error against the full input.
+// With --samples (the file-based round trip): the inputs carry the guides and
+// the samples files the pixels rendered for `dcm plan`.
+#include <chrono>
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "aov_common.h"
+#include "common/image_io.h"
+#include "common/metrics.h"
+#include "common/preview.h"
+#include "common/sample_map.h"
+#include "common/stats_json.h"
+
+namespace dcm::cli {
+namespace {
+
+struct ReconstructFlags {
+  aov_common::AovFlags aov;
+  EngineFlags engine;
+  std::string output, stats, sampleMap, preview, errorMap, reference;
+  bool alpha = false;
+};
+
+nlohmann::json ErrorJson(const toolkit::ImageError& e) {
+  nlohmann::json j;
+  auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  j["psnr"] = num(e.psnr);  // null: identical images (infinite PSNR)
+  j["rmse"] = num(e.rmse);
+  j["relmse"] = num(e.relmse);
+  j["ssim"] = num(e.ssim);
+  j["non_finite_pixels"] = e.nonFinite;
+  return j;
+}
+
+std::string PsnrText(double psnr) {
+  if (std::isinf(psnr)) return "inf (identical)";
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(2) << psnr << " dB";
+  return s.str();
+}
+
+int RunReconstruct(const ReconstructFlags& f) {
+  const std::string cmd = "reconstruct";
+  ReconstructionOptions options;
+  Status st = ToOptions(f.engine, &options);
+  if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
+  const bool sparse = !f.aov.samples.empty();
+  aov::AovOptions aovOptions;
+  st = aov_common::ToAovOptions(f.aov, sparse, options.textureSplit, &aovOptions);
+  if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
+  if (sparse && !f.errorMap.empty() && f.reference.empty())
+    return aov_common::Fail(cmd, "--error-map needs dense input or --reference", kExitUsage);
+
+  std::unique_ptr<aov::AovProvider> provider;
+  st = aov_common::OpenProvider(cmd, f.aov, aovOptions, f.engine, &provider);
+  if (!st.ok()) return aov_common::Fail(cmd, st.message());
+
+  // An explicit reference is read (and checked) before the work starts.
+  std::vector<RGB> reference;
+  int refW = 0, refH = 0;
+  if (!f.reference.empty()) {
+    st = toolkit::ReadRgb(f.reference, &refW, &refH, &reference);
+    if (!st.ok()) return aov_common::Fail(cmd, st.message());
+  }
+
+  Reconstruction r;
+  std::vector<Point2i> pending;
+  const auto t0 = std::chrono::steady_clock::now();
+  st = aov_common::Run(*provider, options, f.engine, &r, &pending);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (st.pending()) {
+    int64_t missing = 0;
+    for (const auto& p : pending) missing += provider->HasSample(p) ? 0 : 1;
+    return aov_common::Fail(cmd, "the samples lack " + std::to_string(missing) +
+                                     " pixels the engine needs; run `dcm plan` with the same inputs, "
+                                     "flags and samples, render what it asks for, and repeat");
+  }
+  if (!st.ok()) return aov_common::Fail(cmd, st.message());
+
+  // The error against the full input (dense mode) or an explicit reference,
+  // at the output resolution.
+  bool haveRef = false;
+  if (!reference.empty()) {
+    if (refW != r.width || refH != r.height)
+      return aov_common::Fail(cmd, "reference '" + f.reference + "' is " + std::to_string(refW) + "x" +
+                                       std::to_string(refH) + ", the output is " +
+                                       std::to_string(r.width) + "x" + std::to_string(r.height));
+    haveRef = true;
+  } else if (provider->dense()) {
+    int w = 0, h = 0;
+    reference = toolkit::BoxDownsample(provider->Beauty(), provider->width(), provider->height(),
+                                       options.downsample, &w, &h);
+    haveRef = (w == r.width && h == r.height);
+  }
+  toolkit::ImageError error;
+  if (haveRef) error = toolkit::Compare(r.image, reference, r.width, r.height);
+
+  nlohmann::json stats = toolkit::StatsToJson(r.stats);
+  stats["command"] = cmd;
+  stats["inputs"] = f.aov.inputs;
+  if (sparse) stats["samples"] = f.aov.samples;
+  stats["mode"] = provider->dense() ? "dense" : "sparse";
+  stats["method"] = f.engine.method;
+  stats["width"] = r.width;
+  stats["height"] = r.height;
+  stats["work_width"] = r.workWidth;
+  stats["work_height"] = r.workHeight;
+  stats["time_reconstruct_s"] = wall;
+  stats["options"] = toolkit::OptionsToJson(options);
+  const auto caps = provider->Capabilities();
+  stats["capabilities"] = {{"object_id", caps.objectId}, {"shader_id", caps.shaderId},
+                           {"texture", caps.texture},    {"split_radiance", caps.splitRadiance},
+                           {"variance", caps.variance}};
+  stats["warnings"] = provider->Warnings();
+  if (haveRef) stats["reference"] = ErrorJson(error);
+
+  toolkit::Metadata meta;
+  meta.strings.push_back({"Software", std::string("dcm ") + DCM_VERSION});
+  meta.strings.push_back({"dcm:method", f.engine.method});
+  meta.strings.push_back({"dcm:mode", provider->dense() ? "dense" : "sparse"});
+  meta.strings.push_back({"dcm:settings", toolkit::OptionsToJson(options).dump()});
+  std::string inputs;
+  for (const auto& in : f.aov.inputs) inputs += (inputs.empty() ? "" : " ") + in;
+  meta.strings.push_back({"dcm:inputs", inputs});
+  meta.floats.push_back({"dcm:exact_fraction", float(r.stats.exactFraction())});
+  if (haveRef && std::isfinite(error.psnr)) meta.floats.push_back({"dcm:psnr", float(error.psnr)});
+
+  // Every output is atomic; if a later one fails, the earlier ones go too.
+  std::vector<std::string> written;
+  auto write = [&](const std::string& path, Status s) -> int {
+    if (!s.ok()) {
+      aov_common::RemoveAll(written);
+      return aov_common::Fail(cmd, s.message());
+    }
+    written.push_back(path);
+    return kExitOk;
+  };
+  int rc = write(f.output, toolkit::WriteRgbExr(f.output, r.width, r.height, r.image, meta, f.alpha));
+  if (rc) return rc;
+  if (!f.sampleMap.empty() && (rc = write(f.sampleMap, toolkit::WriteSampleMap(f.sampleMap, r)))) return rc;
+  if (!f.preview.empty() &&
+      (rc = write(f.preview, toolkit::WritePreview(f.preview, r.width, r.height, r.image))))
+    return rc;
+  if (!f.errorMap.empty() &&
+      (rc = write(f.errorMap, toolkit::WriteErrorMap(f.errorMap, r.image, reference, r.width, r.height))))
+    return rc;
+  if (!f.stats.empty() && (rc = write(f.stats, toolkit::WriteJson(f.stats, stats)))) return rc;
+
+  if (!f.engine.quiet) {
+    std::ostringstream s;
+    s << "dcm " << cmd << ": " << r.workWidth << "x" << r.workHeight << ", " << r.stats.exactPixels
+      << " exact pixels (" << std::fixed << std::setprecision(2) << 100.0 * r.stats.exactFraction()
+      << " %)";
+    if (haveRef) s << ", PSNR " << PsnrText(error.psnr) << ", RMSE " << std::setprecision(5) << error.rmse;
+    s << ", engine " << std::setprecision(3) << r.stats.timeEngineS << " s -> " << f.output;
+    std::cerr << s.str() << "\n";
+    if (r.stats.nonFiniteSamples)
+      std::cerr << "dcm " << cmd << ": warning: " << r.stats.nonFiniteSamples
+                << " exact samples are NaN/Inf (kept to their pixels)\n";
+  }
+  return kExitOk;
+}
+
+Registration reg("reconstruct", "Reconstruct an image from a renderer's EXR AOVs with DCM",
+                 [](CLI::App* app) -> std::function<int()> {
+                   auto f = std::make_shared<ReconstructFlags>();
+                   aov_common::AddAovFlags(app, &f->aov, false);
+                   app->add_option("-o,--output", f->output, "output EXR (float RGB)")->required();
+                   app->add_option("--stats", f->stats, "statistics as JSON");
+                   app->add_option("--sample-map", f->sampleMap, "PNG: which pixels were exact and why");
+                   app->add_option("--preview", f->preview, "PNG through OpenColorIO ($OCIO or sRGB)");
+                   app->add_option("--error-map", f->errorMap, "PNG heat map of the error (dense or --reference)");
+                   app->add_option("--reference", f->reference, "compare with this EXR instead of the full input");
+                   app->add_flag("--alpha", f->alpha, "write RGBA with A = 1");
+                   AddEngineFlags(app, &f->engine);
+                   return [f] { return RunReconstruct(*f); };
+                 });
+
+}  // namespace
+}  // namespace dcm::cli
