@@ -90,8 +90,11 @@ TEST(Invariants, ReasonsAddUpAndExactPixelsHoldTheirSamples) {
   for (int64_t c : r.stats.byReason) sum += c;
   EXPECT_EQ(sum, r.stats.totalPixels);
   const auto full = p.FullRender();
-  for (size_t i = 0; i < full.size(); ++i)
-    if (r.sampleMap[i] != SampleReason::kInterpolated) ASSERT_EQ(r.workImage[i], full[i]) << i;
+  for (size_t i = 0; i < full.size(); ++i) {
+    if (r.sampleMap[i] != SampleReason::kInterpolated) {
+      ASSERT_EQ(r.workImage[i], full[i]) << i;
+    }
+  }
   EXPECT_GT(r.stats.byReason[size_t(SampleReason::kCorner)], 0);
   EXPECT_GT(r.stats.byReason[size_t(SampleReason::kBorder)], 0);
   EXPECT_GT(r.stats.byReason[size_t(SampleReason::kThinObject)], 0);

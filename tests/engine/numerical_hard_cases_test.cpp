@@ -140,7 +140,9 @@ TEST(HardCases, TinyAndOddImages) {
       ASSERT_EQ(r.width, w);
       ASSERT_EQ(r.height, h);
       for (const RGB& c : r.image) ASSERT_TRUE(IsFinite(c));
-      if (w * h <= 4) EXPECT_EQ(r.stats.exactPixels, w * h) << w << "x" << h;
+      if (w * h <= 4) {
+        EXPECT_EQ(r.stats.exactPixels, w * h) << w << "x" << h;
+      }
     }
   }
 }
