@@ -131,6 +131,10 @@ class Engine {
   /// finite samples. Returns the reason q must be exact, or kInterpolated.
   SampleReason Resolve(Point2i q, Interpolant* in) const;
   void WriteSmooth(const Leaf& leaf);
+  /// The image as this level knows it, for progressive output: settled leaves,
+  /// blocks split further interpolated bilinearly, edge blocks along their
+  /// direction. Later passes overwrite every preview value.
+  void WritePreview(int level, std::vector<Block>& splitSmooth, std::vector<EdgeBlock>& edges);
   void WriteOriented(const Leaf& leaf);
   void RecordLeaves(Reconstruction* out);
 
@@ -290,6 +294,17 @@ void Engine::WriteOriented(const Leaf& leaf) {
     }
 }
 
+void Engine::WritePreview(int level, std::vector<Block>& splitSmooth, std::vector<EdgeBlock>& edges) {
+  ForEach(smoothLeaves_, [&](Leaf& l, size_t) { WriteSmooth(l); });
+  ForEach(splitSmooth, [&](Block& b, size_t) { WriteSmooth(MakeLeaf(b, BlockType::kSmooth)); });
+  ForEach(edges, [&](EdgeBlock& e, size_t) {
+    WriteSmooth(MakeLeaf(e.block, BlockType::kSmooth));  // where the oriented pass skips a pixel
+    WriteOriented(MakeLeaf(e.block, BlockType::kComplexEdge, e.direction.index));
+  });
+  ForEach(orientedLeaves_, [&](Leaf& l, size_t) { WriteOriented(l); });
+  opt_.onLevel(level, store_.width(), store_.height(), store_.radiance());
+}
+
 Status Engine::EvaluateBordersAdaptively(const std::vector<Block>& edges) {
   // The sides of all edge blocks of this level, each once: blocks of one level
   // sit on one lattice, so two sides are equal or share at most an end. A side
@@ -393,7 +408,7 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
       DCM_RETURN_IF_ERROR(Flush());
       std::vector<uint8_t> smooth(classify.size());
       ForEach(classify, [&](Block& b, size_t i) { smooth[i] = IsSmooth(b); });
-      std::vector<Block> probe;
+      std::vector<Block> probe, splitSmooth;  // splitSmooth: for progressive previews
       for (size_t i = 0; i < classify.size(); ++i) {
         const Block& b = classify[i];
         if (!smooth[i]) {
@@ -403,6 +418,7 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
           smoothLeaves_.push_back(MakeLeaf(b, BlockType::kSmooth));
         } else if (opt_.smoothRefinement == SmoothRefinement::kAlways) {
           ChildBlocks(b, size / 2, W, H, &nextClassify);
+          splitSmooth.push_back(b);
         } else {
           probe.push_back(b);
         }
@@ -417,8 +433,12 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
           split[i] = contrast_.Differ(At(b.Centre()), Bilinear(store_, b, b.Centre()));
         });
         for (size_t i = 0; i < probe.size(); ++i) {
-          if (split[i]) ChildBlocks(probe[i], size / 2, W, H, &nextClassify);
-          else smoothLeaves_.push_back(MakeLeaf(probe[i], BlockType::kSmooth));
+          if (split[i]) {
+            ChildBlocks(probe[i], size / 2, W, H, &nextClassify);
+            splitSmooth.push_back(probe[i]);
+          } else {
+            smoothLeaves_.push_back(MakeLeaf(probe[i], BlockType::kSmooth));
+          }
         }
       }
 
@@ -537,6 +557,7 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
           (fallback[i] ? fallbackLeaves_ : orientedLeaves_).push_back(MakeLeaf(e.block, type, e.direction.index));
         }
       }
+      if (opt_.onLevel && !finest) WritePreview(level, splitSmooth, eb);
       classify = std::move(nextClassify);
       edges = std::move(nextEdges);
     }
@@ -568,6 +589,7 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
     Progress(0.95f, "interpolation");
     ForEach(smoothLeaves_, [&](Leaf& l, size_t) { WriteSmooth(l); });
     ForEach(orientedLeaves_, [&](Leaf& l, size_t) { WriteOriented(l); });
+    if (opt_.onLevel) opt_.onLevel(levels - 1, W, H, store_.radiance());
     stats_.smoothBlocks = int64_t(smoothLeaves_.size());
     stats_.fallbackBlocks = int64_t(fallbackLeaves_.size());
   }

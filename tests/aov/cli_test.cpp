@@ -437,3 +437,26 @@ TEST(DcmReconstruct, UnwritableOutputLeavesNothing) {
 
 }  // namespace
 }  // namespace dcm::aov::test
+
+namespace dcm::aov::test {
+namespace {
+
+// --progressive writes a usable image after each refinement level; the last
+// one is the result.
+TEST(DcmReconstruct, ProgressiveWritesOneImagePerLevel) {
+  ScratchDir dir;
+  Scene sc{64, 48};
+  WriteExr(dir / "in.exr", sc.width, sc.height, sc.GenericChannels(true));
+  auto r = RunDcm({"reconstruct", dir / "in.exr", "-o", dir / "out.exr", "--block", "16", "--min-block", "4",
+                   "--progressive", dir / "levels", "--quiet"},
+                  dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  // Levels of 16, 8 and 4 pixels.
+  for (int level = 0; level < 3; ++level)
+    EXPECT_TRUE(std::filesystem::exists(dir / ("levels/level_" + std::to_string(level) + ".exr"))) << level;
+  EXPECT_FALSE(std::filesystem::exists(dir / "levels/level_3.exr"));
+  EXPECT_EQ(ReadRgbExr(dir / "levels/level_2.exr"), ReadRgbExr(dir / "out.exr"));
+}
+
+}  // namespace
+}  // namespace dcm::aov::test

@@ -1,5 +1,11 @@
 #include "engine_flags.h"
 
+#include <cstdio>
+#include <filesystem>
+
+#include "common/image_io.h"
+#include "common/metrics.h"
+
 namespace dcm::cli {
 
 void AddEngineFlags(CLI::App* app, EngineFlags* f) {
@@ -21,6 +27,8 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
   app->add_option("--downsample", f->downsample, "the input is supersampled N times per axis; box-filter the result down");
   app->add_option("--threads", f->threads, "worker threads (0: all cores)");
   app->add_option("--tile", f->tile, "tile size in pixels for parallel work");
+  app->add_option("--progressive", f->progressive,
+                  "write DIR/level_N.exr after each refinement level (an early, usable picture)");
   app->add_flag("-v,--verbose", f->verbose, "say more");
   app->add_flag("--quiet", f->quiet, "no progress on stderr");
 }
@@ -45,6 +53,24 @@ Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {
   o->downsample = f.downsample;
   o->threads = f.threads;
   if (f.tile) o->tileSize = f.tile;
+  if (!f.progressive.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(f.progressive, ec);
+    if (ec) return Status::Error("--progressive: cannot create folder '" + f.progressive + "': " + ec.message());
+    const std::string dir = f.progressive;
+    const int s = o->downsample;
+    const bool quiet = f.quiet;
+    o->onLevel = [dir, s, quiet](int level, int w, int h, const std::vector<RGB>& work) {
+      int ow = w, oh = h;
+      const std::vector<RGB> image = toolkit::BoxDownsample(work, w, h, s, &ow, &oh);
+      const std::string path = dir + "/level_" + std::to_string(level) + ".exr";
+      toolkit::Metadata meta;
+      meta.floats.push_back({"dcm:level", float(level)});
+      const Status st = toolkit::WriteRgbExr(path, ow, oh, image, meta);
+      if (!st.ok()) std::fprintf(stderr, "dcm: warning: progressive image: %s\n", st.message().c_str());
+      else if (!quiet) std::fprintf(stderr, "dcm: wrote %s\n", path.c_str());
+    };
+  }
   return o->Validate();
 }
 

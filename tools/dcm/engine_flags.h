@@ -19,12 +19,14 @@ struct EngineFlags {
   std::string objectTest;      ///< none | id | id+shader
   std::string thinTest;        ///< off | none-matches | any-differs
   std::string contrast;        ///< mitchell | display
+  std::string progressive;     ///< folder for an image after each refinement level
   bool verbose = false, quiet = false;
 };
 
 /// Adds --method, --threshold, --block, --min-block, --directions, --no-thin,
 /// --thin-test, --no-texture-split, --object-test, --contrast, --no-lazy,
-/// --no-fallback, --no-surface-aware, --downsample, --threads, --tile, -v, --quiet.
+/// --no-fallback, --no-surface-aware, --downsample, --threads, --tile,
+/// --progressive, -v, --quiet.
 void AddEngineFlags(CLI::App* app, EngineFlags* flags);
 
 /// The options the flags select. The message names the flag at fault.

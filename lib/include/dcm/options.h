@@ -5,7 +5,9 @@
 #include <functional>
 #include <string>
 #include <string_view>
+#include <vector>
 
+#include "dcm/color.h"
 #include "dcm/status.h"
 
 namespace dcm {
@@ -91,6 +93,11 @@ struct ReconstructionOptions {
 
   /// Progress in [0,1] with the name of the stage; called from the calling thread.
   std::function<void(float, std::string_view)> progress;
+  /// Progressive output (paper 1: "meaningful early images"): after each
+  /// refinement level, a usable working-resolution image built from the
+  /// samples so far (blocks not settled yet are interpolated from what their
+  /// level knows). Costs one extra pass over the image per level when set.
+  std::function<void(int level, int width, int height, const std::vector<RGB>& workImage)> onLevel;
 
   /// Guo 1998 as described in section 2 of the paper: no thin-object test,
   /// object-ID test, no texture split, interpolation blind to surfaces.
