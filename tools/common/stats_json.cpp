@@ -36,12 +36,14 @@ nlohmann::json OptionsToJson(const ReconstructionOptions& o) {
   j["surface_aware"] = o.surfaceAware;
   j["texture_split"] = o.textureSplit;
   j["smooth_refinement"] = std::string(ToString(o.smoothRefinement));
+  j["adaptive_borders"] = o.adaptiveBorders;
   j["zero_order_test"] = o.zeroOrderTest;
   j["gradient_blocks_simple"] = o.gradientBlocksSimple;
   j["first_order_test"] = o.firstOrderTest;
   j["lazy_evaluation"] = o.lazyEvaluation;
   j["fallback"] = o.fallback;
   j["fallback_max_changes"] = o.fallbackMaxChanges;
+  j["finest_centre_probe"] = o.finestCentreProbe;
   j["downsample"] = o.downsample;
   j["full_evaluation"] = o.fullEvaluation;
   j["threads"] = o.threads;
