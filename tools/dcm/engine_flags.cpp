@@ -23,6 +23,9 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
   app->add_flag("--no-lazy", f->noLazy, "full border evaluation for children of simple edge blocks");
   app->add_flag("--no-fallback", f->noFallback, "never fall back to exact evaluation of a block interior");
   app->add_flag("--no-surface-aware", f->noSurfaceAware, "interpolate across surfaces (Guo)");
+  app->add_flag("--no-adaptive-borders", f->noAdaptiveBorders, "evaluate every border pixel of edge blocks (the paper)");
+  app->add_flag("--no-centre-probe", f->noCentreProbe, "no centre probe of the finest edge blocks");
+  app->add_option("--smooth-refinement", f->smoothRefinement, "always (the paper) | centre-probe | never");
   app->add_flag("--full", f->full, "evaluate every pixel exactly (the baseline)");
   app->add_option("--downsample", f->downsample, "the input is supersampled N times per axis; box-filter the result down");
   app->add_option("--threads", f->threads, "worker threads (0: all cores)");
@@ -49,6 +52,9 @@ Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {
   if (f.noLazy) o->lazyEvaluation = false;
   if (f.noFallback) o->fallback = false;
   if (f.noSurfaceAware) o->surfaceAware = false;
+  if (f.noAdaptiveBorders) o->adaptiveBorders = false;
+  if (f.noCentreProbe) o->finestCentreProbe = false;
+  if (!f.smoothRefinement.empty()) DCM_RETURN_IF_ERROR(Parse(f.smoothRefinement, &o->smoothRefinement));
   if (f.full) o->fullEvaluation = true;
   o->downsample = f.downsample;
   o->threads = f.threads;
