@@ -598,7 +598,7 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
   out->workWidth = W;
   out->workHeight = H;
   out->workImage = store_.TakeRadiance();
-  out->sampleMap = store_.reasons();
+  out->sampleMap = store_.TakeReasons();
   out->image = BoxDownsample(out->workImage, W, H, opt_.downsample, &out->width, &out->height);
   RecordLeaves(out);
   stats_.totalPixels = int64_t(W) * H;

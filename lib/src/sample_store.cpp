@@ -22,7 +22,7 @@ SampleStore::SampleStore(int width, int height, bool split)
 
 void SampleStore::SetGuides(GuideImage guides, ObjectTest test) {
   guides_ = std::move(guides);
-  if (split_) tau_ = guides_.texture;
+  if (split_) tau_ = std::move(guides_.texture);
   const uint32_t* obj = (test != ObjectTest::kNone && !guides_.objectId.empty()) ? guides_.objectId.data() : nullptr;
   const uint32_t* shader = (obj && test == ObjectTest::kObjectAndShader && !guides_.shaderId.empty())
                                ? guides_.shaderId.data() : nullptr;

@@ -86,6 +86,7 @@ class SampleStore {
   const std::vector<RGB>& radiance() const { return out_; }
   std::vector<RGB> TakeRadiance() { return std::move(out_); }
   const std::vector<SampleReason>& reasons() const { return reason_; }
+  std::vector<SampleReason> TakeReasons() { return std::move(reason_); }
 
  private:
   int width_, height_;
