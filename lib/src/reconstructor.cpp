@@ -135,7 +135,9 @@ class Engine {
   /// blocks split further interpolated bilinearly, edge blocks along their
   /// direction. Later passes overwrite every preview value.
   void WritePreview(int level, std::vector<Block>& splitSmooth, std::vector<EdgeBlock>& edges);
-  void WriteOriented(const Leaf& leaf);
+  /// `final`: pixels it cannot interpolate are requested exactly (a preview
+  /// leaves them as they are).
+  void WriteOriented(const Leaf& leaf, bool final = true);
   void RecordLeaves(Reconstruction* out);
 
   SampleProvider& provider_;
@@ -178,6 +180,12 @@ Status Engine::LoadGuides() {
   DCM_RETURN_IF_ERROR(check(want.objectId, g.objectId.size(), "object ID"));
   DCM_RETURN_IF_ERROR(check(want.shaderId, g.shaderId.size(), "shader ID"));
   DCM_RETURN_IF_ERROR(check(want.texture, g.texture.size(), "texture"));
+  // A pixel whose tau is not finite cannot be reconstructed as L_i*tau + L_c:
+  // it is evaluated exactly.
+  if (want.texture)
+    for (int64_t i = 0; i < int64_t(n); ++i)
+      if (!IsFinite(g.texture[size_t(i)]))
+        store_.Request(int(i % caps_.width), int(i / caps_.width), SampleReason::kFallback);
   store_.SetGuides(std::move(g), want.objectId ? opt_.objectTest : ObjectTest::kNone);
   return Status::Ok();
 }
@@ -195,7 +203,10 @@ bool Engine::HasSurfaceChange(const Block& b) const {
 }
 
 bool Engine::IsSmooth(const Block& b) const {
-  const Value corners[4] = {At({b.x0, b.y0}), At({b.x1, b.y0}), At({b.x0, b.y1}), At({b.x1, b.y1})};
+  const Point2i p[4] = {{b.x0, b.y0}, {b.x1, b.y0}, {b.x0, b.y1}, {b.x1, b.y1}};
+  for (Point2i c : p)
+    if (!store_.IsFinite(store_.Index(c.x, c.y))) return false;  // never interpolate from it
+  const Value corners[4] = {At(p[0]), At(p[1]), At(p[2]), At(p[3])};
   return !contrast_.IsEdge(corners) && !HasSurfaceChange(b);
 }
 
@@ -266,7 +277,7 @@ void Engine::WriteSmooth(const Leaf& leaf) {
   }
 }
 
-void Engine::WriteOriented(const Leaf& leaf) {
+void Engine::WriteOriented(const Leaf& leaf, bool final) {
   const Block& b = leaf.block;
   const Direction d = Direction::Of(leaf.direction, opt_.directions);
   const bool lazy = leaf.type == BlockType::kLazy;
@@ -276,8 +287,12 @@ void Engine::WriteOriented(const Leaf& leaf) {
       const int64_t i = store_.Index(x, y);
       if (store_.IsExact(i)) continue;
       Interpolant in;
-      if (!OrientedInterpolant(store_, b, {x, y}, d, &in) || Resolve({x, y}, &in) != SampleReason::kInterpolated)
-        continue;  // cannot happen after the thin-object pass; keep the pixel untouched
+      if (!OrientedInterpolant(store_, b, {x, y}, d, &in) || Resolve({x, y}, &in) != SampleReason::kInterpolated) {
+        // Safety net: a pixel the thin-object pass did not foresee is
+        // evaluated exactly in one last round rather than left unwritten.
+        if (final) store_.Request(x, y, SampleReason::kFallback);
+        continue;
+      }
       Value v = Evaluate(store_, in);
       if (lazy) {
         // The centre sample corrects the parent's interpolation with a tent
@@ -299,9 +314,9 @@ void Engine::WritePreview(int level, std::vector<Block>& splitSmooth, std::vecto
   ForEach(splitSmooth, [&](Block& b, size_t) { WriteSmooth(MakeLeaf(b, BlockType::kSmooth)); });
   ForEach(edges, [&](EdgeBlock& e, size_t) {
     WriteSmooth(MakeLeaf(e.block, BlockType::kSmooth));  // where the oriented pass skips a pixel
-    WriteOriented(MakeLeaf(e.block, BlockType::kComplexEdge, e.direction.index));
+    WriteOriented(MakeLeaf(e.block, BlockType::kComplexEdge, e.direction.index), false);
   });
-  ForEach(orientedLeaves_, [&](Leaf& l, size_t) { WriteOriented(l); });
+  ForEach(orientedLeaves_, [&](Leaf& l, size_t) { WriteOriented(l, false); });
   opt_.onLevel(level, store_.width(), store_.height(), store_.radiance());
 }
 
@@ -347,7 +362,9 @@ Status Engine::EvaluateBordersAdaptively(const std::vector<Block>& edges) {
       int last = 0;
       for (int k = 1; k <= s.length; ++k) {
         if (!store_.IsExact(index(s, k))) continue;
-        if (k > last + 1 && contrast_.Differ(store_.ValueAt(index(s, last)), store_.ValueAt(index(s, k)))) {
+        const bool usable = store_.IsFinite(index(s, last)) && store_.IsFinite(index(s, k));
+        if (k > last + 1 &&
+            (!usable || contrast_.Differ(store_.ValueAt(index(s, last)), store_.ValueAt(index(s, k))))) {
           const int mid = (last + k) / 2;
           store_.Request(s.a.x + mid * s.step.x, s.a.y + mid * s.step.y, SampleReason::kBorder);
           ++requested;
@@ -430,7 +447,8 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
         DCM_RETURN_IF_ERROR(Flush());
         std::vector<uint8_t> split(probe.size());
         ForEach(probe, [&](Block& b, size_t i) {
-          split[i] = contrast_.Differ(At(b.Centre()), Bilinear(store_, b, b.Centre()));
+          split[i] = !store_.IsFinite(store_.Index(b.Centre().x, b.Centre().y)) ||
+                     contrast_.Differ(At(b.Centre()), Bilinear(store_, b, b.Centre()));
         });
         for (size_t i = 0; i < probe.size(); ++i) {
           if (split[i]) {
@@ -493,7 +511,7 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
               Resolve(c, &in) != SampleReason::kInterpolated)
             return;
           const Value predicted = Evaluate(store_, in), exact = At(c);
-          if (contrast_.Differ(exact, predicted)) return;
+          if (!store_.IsFinite(store_.Index(c.x, c.y)) || contrast_.Differ(exact, predicted)) return;
           Leaf& leaf = lazy[i];
           leaf = MakeLeaf(b, BlockType::kLazy, e.direction.index);
           leaf.centre = c;
@@ -547,7 +565,7 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
             // A centre on another surface than its interpolants is the thin
             // object test's business, not a miss.
             if (Resolve(c, &in) != SampleReason::kInterpolated) return;
-            fallback[i] = contrast_.Differ(At(c), Evaluate(store_, in));
+            fallback[i] = !store_.IsFinite(store_.Index(c.x, c.y)) || contrast_.Differ(At(c), Evaluate(store_, in));
           });
         }
         for (size_t i = 0; i < eb.size(); ++i) {
@@ -568,6 +586,9 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
       for (int y = l.block.y0; y <= l.block.y1; ++y)
         for (int x = l.block.x0; x <= l.block.x1; ++x) store_.Request(x, y, SampleReason::kFallback);
     });
+    // Flushed before the thin-object pass: a fallback block's border is also
+    // its neighbours' border, and what the pass decides depends on it.
+    DCM_RETURN_IF_ERROR(Flush());
     // Thin objects (3.1): interior pixels whose interpolants lie on another surface.
     Progress(0.9f, "thin objects");
     ForEach(orientedLeaves_, [&](Leaf& l, size_t) {
@@ -589,6 +610,7 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
     Progress(0.95f, "interpolation");
     ForEach(smoothLeaves_, [&](Leaf& l, size_t) { WriteSmooth(l); });
     ForEach(orientedLeaves_, [&](Leaf& l, size_t) { WriteOriented(l); });
+    DCM_RETURN_IF_ERROR(Flush());
     if (opt_.onLevel) opt_.onLevel(levels - 1, W, H, store_.radiance());
     stats_.smoothBlocks = int64_t(smoothLeaves_.size());
     stats_.fallbackBlocks = int64_t(fallbackLeaves_.size());

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <limits>
 
 namespace dcm::detail {
 
@@ -27,6 +29,12 @@ void SampleStore::SetGuides(GuideImage guides, ObjectTest test) {
   const uint32_t* shader = (obj && test == ObjectTest::kObjectAndShader && !guides_.shaderId.empty())
                                ? guides_.shaderId.data() : nullptr;
   surfaces_ = SurfaceTest(obj, shader);
+}
+
+bool SampleStore::TauRecoverable(RGB tau) {
+  for (int c = 0; c < 3; ++c)
+    if (!std::isfinite(tau[c]) || std::fabs(tau[c]) < std::numeric_limits<float>::min()) return false;
+  return true;
 }
 
 void SampleStore::SetInterpolated(int64_t i, const Value& v) {
@@ -98,8 +106,10 @@ Status SampleStore::Flush(SampleProvider& provider, const SampleRequest& what, i
       b_[i] = s.Lc;
     }
     const bool finite = dcm::IsFinite(s.L) && (!split_ || (dcm::IsFinite(s.Li) && dcm::IsFinite(s.Lc)));
-    finite_[i] = finite ? 1 : 0;
     if (!finite) ++stats->nonFiniteSamples;
+    // Where tau is zero or denormal, L_i = L_t / tau is not recoverable: the
+    // sample keeps its own exact L but never serves to interpolate others.
+    finite_[i] = (finite && (!split_ || TauRecoverable(tau_[i]))) ? 1 : 0;
   }
   return Status::Ok();
 }

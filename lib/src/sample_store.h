@@ -51,7 +51,11 @@ class SampleStore {
   int64_t Index(int x, int y) const { return int64_t(y) * width_ + x; }
 
   bool IsExact(int64_t i) const { return reason_[i] != SampleReason::kInterpolated; }
+  /// The exact sample at i may serve to interpolate others: its values are
+  /// finite and, with the split, its tau is neither zero, denormal nor
+  /// non-finite (L_i = L_t / tau is meaningless there).
   bool IsFinite(int64_t i) const { return finite_[i] != 0; }
+  static bool TauRecoverable(RGB tau);
   /// Without the split the interpolated quantity is L itself, stored once.
   Value ValueAt(int64_t i) const { return split_ ? Value{a_[i], b_[i]} : Value{out_[i], RGB{}}; }
   RGB Tau(int64_t i) const { return tau_.empty() ? RGB::Gray(1.f) : tau_[i]; }

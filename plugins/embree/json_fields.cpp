@@ -1,9 +1,21 @@
 #include "embree/json_fields.h"
 
 #include <cmath>
+#include <limits>
 #include <utility>
 
 namespace dcm::embree {
+
+namespace {
+/// A JSON number that fits a float (finite, |v| <= FLT_MAX).
+bool AsFiniteFloat(const Json& e, float* out) {
+  if (!e.is_number()) return false;
+  const double d = e.get<double>();
+  if (!std::isfinite(d) || std::fabs(d) > double(std::numeric_limits<float>::max())) return false;
+  *out = float(d);
+  return true;
+}
+}  // namespace
 
 Status FieldError(const std::string& file, const std::string& path, const std::string& message) {
   std::string m;
@@ -47,6 +59,11 @@ Status ParseJsonText(std::string_view text, const std::string& file, Json* out) 
     if (auto colon = what.find(": "); colon != std::string::npos) what = what.substr(colon + 2);
     return Status::Error(file + ":" + std::to_string(line) + ":" + std::to_string(column) +
                          ": syntax error: " + what);
+  } catch (const Json::exception& e) {
+    // e.g. out_of_range 406: a number literal beyond double range ("1e400").
+    std::string what = e.what();
+    if (auto bracket = what.find("] "); bracket != std::string::npos) what = what.substr(bracket + 2);
+    return Status::Error(file + ": " + what);
   }
   return Status::Ok();
 }
@@ -159,11 +176,10 @@ void FieldReader::Vector3(std::string_view key, Vec3* out, bool required) {
   Vec3 r;
   for (int i = 0; i < 3; ++i) {
     const Json& e = (*v)[size_t(i)];
-    if (!e.is_number() || !std::isfinite(e.get<double>())) {
+    if (!AsFiniteFloat(e, &r[i])) {
       return Fail(std::string(key) + "[" + std::to_string(i) + "]",
-                  "expected a finite number, found " + TypeName(e));
+                  "expected a finite number within float range, found " + (e.is_number() ? e.dump() : TypeName(e)));
     }
-    r[i] = e.get<float>();
   }
   *out = r;
 }
@@ -171,15 +187,16 @@ void FieldReader::Vector3(std::string_view key, Vec3* out, bool required) {
 void FieldReader::Vector2(std::string_view key, Vec2* out) {
   const Json* v = Get(key);
   if (!ok() || !v) return;
-  if (v->is_number()) {
-    float f = v->get<float>();
-    *out = {f, f};
+  float a = 0, b = 0;
+  if (AsFiniteFloat(*v, &a)) {
+    *out = {a, a};
     return;
   }
-  if (!v->is_array() || v->size() != 2 || !(*v)[0].is_number() || !(*v)[1].is_number()) {
-    return Fail(key, "expected a number or an array of 2 numbers, found " + TypeName(*v));
+  if (!v->is_array() || v->size() != 2 || !AsFiniteFloat((*v)[0], &a) || !AsFiniteFloat((*v)[1], &b)) {
+    return Fail(key, "expected a finite number or an array of 2 finite numbers, found " +
+                         (v->is_number() ? v->dump() : TypeName(*v)));
   }
-  *out = {(*v)[0].get<float>(), (*v)[1].get<float>()};
+  *out = {a, b};
 }
 
 void FieldReader::Color(std::string_view key, RGB* out, bool required) {

@@ -1,5 +1,7 @@
 #include "embree/scene_file.h"
 
+#include <limits>
+
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -146,7 +148,8 @@ Status ReadTransform(const Json& j, const std::string& path, const std::string& 
                      TransformDesc* t) {
   FieldReader r(j, path, file);
   if (const Json* s = r.Get("scale"); s && s->is_number()) {
-    float f = s->get<float>();
+    float f = 1.f;
+    r.Float("scale", &f, true, -std::numeric_limits<float>::max(), std::numeric_limits<float>::max());
     t->scale = {f, f, f};
   } else {
     r.Vector3("scale", &t->scale);

@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (fuzz/, clang-14) and runs each for SECONDS
+# (default 60) on its seed corpus. Exits non-zero when a build fails or a
+# target finds a crash, a sanitizer report, a timeout, an out-of-memory or a
+# violated contract; the reproducer is left in the build dir (crash-*, oom-*,
+# timeout-*) and its path printed.
+#
+#   scripts/fuzz.sh [SECONDS]
+#   DCM_FUZZ_BUILD_DIR=/x scripts/fuzz.sh 300
+#
+# Packages: clang-14 and libclang-rt-14-dev (libFuzzer and the sanitizer
+# runtimes), plus dcm's own build dependencies (scripts/install-deps.sh).
+set -euo pipefail
+seconds=${1:-60}
+here=$(cd "$(dirname "$0")/.." && pwd)
+build=${DCM_FUZZ_BUILD_DIR:-$here/build-fuzz}
+cxx=${CXX_FUZZ:-clang++-14}
+
+if ! command -v "$cxx" >/dev/null; then
+  echo "fuzz.sh: $cxx not found (apt-get install clang-14 libclang-rt-14-dev)" >&2
+  exit 2
+fi
+cmake -S "$here/fuzz" -B "$build" -G Ninja -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+cmake --build "$build" -j"${DCM_JOBS:-2}"
+
+# The targets check their own contracts and abort on a violation; sanitizer
+# reports abort too. Leaks count as findings. -timeout=60: an EXR header may
+# declare an attribute of ~2 GB that OpenEXR allocates before it finds the
+# file short (seconds on a loaded machine under ASan; see docs/FUZZING.md).
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+
+status=0
+for target in fuzz_scene fuzz_exr; do
+  corpus="$build/corpus/$target"   # grows during the run; the seeds stay in the repo
+  mkdir -p "$corpus" "$build/artifacts/$target"
+  seeds="$here/fuzz/corpus/${target#fuzz_}"
+  dict=()
+  [ -f "$here/fuzz/${target#fuzz_}.dict" ] && dict=(-dict="$here/fuzz/${target#fuzz_}.dict")
+  echo "fuzz.sh: $target for ${seconds} s"
+  set +e
+  "$build/$target" "$corpus" "$seeds" "${dict[@]}" \
+    -max_total_time="$seconds" -timeout=60 -rss_limit_mb=2560 -malloc_limit_mb=2048 \
+    -max_len=65536 -print_final_stats=1 \
+    -artifact_prefix="$build/artifacts/$target/" >"$build/$target.log" 2>&1
+  rc=$?
+  set -e
+  grep -E '^stat::number_of_executed_units|^#[0-9]+.*DONE' "$build/$target.log" | tail -2 || true
+  if [ $rc -ne 0 ]; then
+    echo "fuzz.sh: $target FAILED (exit $rc); log: $build/$target.log" >&2
+    grep -E 'ERROR|SUMMARY|violates|does not name|terminate called|what\(\)|Test unit written' "$build/$target.log" | head -20 >&2 || true
+    status=1
+  fi
+done
+exit $status

@@ -1,0 +1,401 @@
+// Bad scene input through the `dcm render` binary (run as a subprocess, its
+// path in DCM_BINARY): syntax and schema errors, missing and corrupt meshes
+// and textures, degenerate and non-finite geometry, a camera inside an object,
+// no lights. Each must give a clear message naming the file and the key, exit
+// with a code != 0 (and not by a signal), create no output file, and leave an
+// existing output file byte-for-byte as it was (atomic writes), with no
+// temporary files left behind.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cctype>
+#include <cerrno>
+#include <csignal>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#ifndef DCM_BINARY
+#error "DCM_BINARY must name the dcm executable"
+#endif
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// A fresh folder, removed at the end of the test.
+class TempDir {
+ public:
+  TempDir() {
+    std::string tmpl = (fs::temp_directory_path() / "dcm_robustness_XXXXXX").string();
+    if (!::mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
+    path_ = tmpl;
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  fs::path path() const { return path_; }
+  std::string Write(const std::string& name, const std::string& bytes) const {
+    const fs::path p = path_ / name;
+    std::ofstream out(p, std::ios::binary);
+    out.write(bytes.data(), std::streamsize(bytes.size()));
+    return p.string();
+  }
+  std::set<std::string> Files() const {
+    std::set<std::string> names;
+    for (const auto& e : fs::directory_iterator(path_)) names.insert(e.path().filename().string());
+    return names;
+  }
+
+ private:
+  fs::path path_;
+};
+
+std::string ReadAll(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+struct Result {
+  bool exited = false;  ///< false: killed by a signal
+  int code = -1;        ///< exit code, or the signal number
+  std::string output;   ///< stdout and stderr
+  std::string Describe() const {
+    return (exited ? "exit code " + std::to_string(code) : "killed by signal " + std::to_string(code) + " (" +
+                                                              strsignal(code) + ")") +
+           ", output:\n" + output;
+  }
+};
+
+/// Runs `dcm args...` in `cwd`, stdout and stderr into one capture.
+Result RunDcm(const fs::path& cwd, const std::vector<std::string>& args) {
+  const fs::path log = cwd / ".dcm_test_output.log";
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    if (::chdir(cwd.c_str()) != 0) _exit(127);
+    FILE* f = std::freopen(log.c_str(), "w", stdout);
+    if (!f || ::dup2(::fileno(stdout), 2) < 0) _exit(127);
+    std::vector<char*> argv;
+    std::string bin = DCM_BINARY;
+    argv.push_back(bin.data());
+    std::vector<std::string> copy = args;
+    for (auto& a : copy) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    ::execv(bin.c_str(), argv.data());
+    _exit(127);
+  }
+  Result r;
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  r.exited = WIFEXITED(status);
+  r.code = r.exited ? WEXITSTATUS(status) : WTERMSIG(status);
+  r.output = ReadAll(log);
+  std::error_code ec;
+  fs::remove(log, ec);
+  return r;
+}
+
+/// Whether `text` contains a match of `pattern`, where '*' stands for any
+/// characters and '#' for one or more digits; everything else is literal.
+bool MatchHere(const char* t, const char* p) {
+  if (*p == '\0') return true;
+  if (*p == '*') {
+    for (const char* u = t;; ++u) {
+      if (MatchHere(u, p + 1)) return true;
+      if (*u == '\0') return false;
+    }
+  }
+  if (*p == '#') {
+    if (!std::isdigit(static_cast<unsigned char>(*t))) return false;
+    for (const char* u = t; std::isdigit(static_cast<unsigned char>(*u)); ++u)
+      if (MatchHere(u + 1, p + 1)) return true;
+    return false;
+  }
+  return *t != '\0' && *t == *p && MatchHere(t + 1, p + 1);
+}
+bool Contains(const std::string& text, const std::string& pattern) {
+  for (size_t i = 0; i <= text.size(); ++i)
+    if (MatchHere(text.c_str() + i, pattern.c_str())) return true;
+  return false;
+}
+
+const char* kPrecious = "an earlier render: must survive a failed run\n";
+
+/// A 16x16 scene: one diffuse material "m", the given objects and lights.
+std::string Scene(const std::string& objects,
+                  const std::string& lights = R"([{"type": "point", "position": [0, 3, 2], "intensity": 10}])",
+                  const std::string& camera = R"({"position": [0, 1, 4], "look_at": [0, 0.5, 0], "resolution": [16, 16]})",
+                  const std::string& materials = R"({"m": {"type": "diffuse"}})") {
+  return "{\n  \"camera\": " + camera + ",\n  \"render\": {\"shadow_rays\": 1},\n  \"materials\": " + materials +
+         ",\n  \"objects\": " + objects + ",\n  \"lights\": " + lights + "\n}\n";
+}
+
+const std::string kBox = R"([{"type": "box", "material": "m", "min": [-1, 0, -1], "max": [1, 1, 1]}])";
+
+/// Renders `scene.json` twice: once to a fresh output name (must not appear,
+/// nor the stats/sample-map/preview outputs), once over an existing output
+/// (must be unchanged). Checks the exit and that `expected` (a regex) matches
+/// the message (a Contains() pattern). Returns the first run's result.
+Result ExpectRejected(const TempDir& dir, const std::string& expected) {
+  const std::set<std::string> before = dir.Files();
+  Result r = RunDcm(dir.path(), {"render", "scene.json", "-o", "fresh.exr", "--stats", "fresh.json",
+                                 "--sample-map", "fresh_map.png", "--preview", "fresh.png", "--quiet"});
+  EXPECT_TRUE(r.exited) << r.Describe();
+  EXPECT_NE(r.code, 0) << r.Describe();
+  EXPECT_TRUE(Contains(r.output, expected)) << "expected '" << expected << "' in: " << r.Describe();
+  EXPECT_EQ(dir.Files(), before) << "files appeared (outputs or temporaries); " << r.Describe();
+
+  dir.Write("existing.exr", kPrecious);
+  const std::set<std::string> before2 = dir.Files();
+  Result r2 = RunDcm(dir.path(), {"render", "scene.json", "-o", "existing.exr", "--quiet"});
+  EXPECT_TRUE(r2.exited && r2.code != 0) << r2.Describe();
+  const std::string after = ReadAll(dir.path() / "existing.exr");
+  EXPECT_TRUE(after == kPrecious) << "existing output replaced or truncated (now " << after.size() << " bytes, "
+                                  << (after.rfind("v/1\x01", 0) == 0 ? "an EXR" : "not an EXR") << "); "
+                                  << r2.Describe();
+  EXPECT_EQ(dir.Files(), before2) << r2.Describe();
+  fs::remove(dir.path() / "existing.exr");
+  return r;
+}
+
+// The harness itself: a good scene renders, creates every output and replaces
+// an existing output atomically. Without this the rejection tests could pass
+// against a binary that never writes anything.
+TEST(RenderBadInput, ControlGoodSceneWritesItsOutputs) {
+  TempDir dir;
+  dir.Write("scene.json", Scene(kBox));
+  Result r = RunDcm(dir.path(), {"render", "scene.json", "-o", "fresh.exr", "--stats", "fresh.json", "--sample-map",
+                                 "fresh_map.png", "--preview", "fresh.png", "--quiet"});
+  ASSERT_TRUE(r.exited && r.code == 0) << r.Describe();
+  for (const char* f : {"fresh.exr", "fresh.json", "fresh_map.png", "fresh.png"})
+    EXPECT_TRUE(fs::is_regular_file(dir.path() / f)) << f;
+  dir.Write("existing.exr", kPrecious);
+  r = RunDcm(dir.path(), {"render", "scene.json", "-o", "existing.exr", "--quiet"});
+  ASSERT_TRUE(r.exited && r.code == 0) << r.Describe();
+  EXPECT_EQ(ReadAll(dir.path() / "existing.exr").substr(0, 4), std::string("\x76\x2f\x31\x01", 4))
+      << "not replaced by an EXR";
+  EXPECT_EQ(dir.Files(), (std::set<std::string>{"scene.json", "fresh.exr", "fresh.json", "fresh_map.png",
+                                                "fresh.png", "existing.exr"}));
+}
+
+TEST(RenderBadInput, MissingSceneFile) {
+  TempDir dir;
+  ExpectRejected(dir, "scene.json");
+}
+
+TEST(RenderBadInput, EmptySceneFile) {
+  TempDir dir;
+  dir.Write("scene.json", "");
+  ExpectRejected(dir, "scene.json:1:#: syntax error");
+}
+
+TEST(RenderBadInput, SyntaxErrorGivesLineAndColumn) {
+  TempDir dir;
+  std::string text = Scene(kBox);
+  // Drop the comma after the camera (end of line 2): the unexpected token is
+  // "render" on line 3, columns 3-10; the parser stops on its last character.
+  const size_t comma = text.find("},\n  \"render\"");
+  ASSERT_NE(comma, std::string::npos);
+  text.erase(comma + 1, 1);
+  dir.Write("scene.json", text);
+  ExpectRejected(dir, "scene.json:3:10: syntax error");
+}
+
+TEST(RenderBadInput, TruncatedSceneFile) {
+  TempDir dir;
+  const std::string text = Scene(kBox);
+  dir.Write("scene.json", text.substr(0, text.size() / 2));
+  ExpectRejected(dir, "scene.json:#:#: syntax error");
+}
+
+// A number beyond double's range is a JSON syntax matter: the message must
+// name the file (and ideally the line), like any other syntax error.
+TEST(RenderBadInput, NumberOverflowNamesTheFile) {
+  TempDir dir;
+  dir.Write("scene.json", Scene(R"([{"type": "box", "material": "m", "min": [-1, 0, -1], "max": [1e400, 1, 1]}])"));
+  ExpectRejected(dir, "scene.json*1e400");
+}
+
+TEST(RenderBadInput, SchemaErrorsNameTheKeyPath) {
+  struct Case {
+    std::string scene, expected;
+  };
+  const std::vector<Case> cases = {
+      {Scene(R"([{"type": "sphere", "material": "m", "radius": 1, "radiuss": 2}])"),
+       "scene.json: objects[0].radiuss: unknown key"},
+      {Scene(kBox, R"([{"type": "point", "position": [0, 3, 2], "intensity": "bright"}])"),
+       "scene.json: lights[0].intensity: "},
+      {Scene(kBox, R"([{"type": "point", "position": [0, 3, 2], "intensity": 10}])",
+             R"({"position": [0, 1, 4], "look_at": [0, 0.5, 0], "fov": "wide"})"),
+       "scene.json: camera.fov: expected a number"},
+      {Scene(kBox, R"([{"type": "point", "position": [0, 3, 2], "intensity": 10}])",
+             R"({"position": [0, 1, 4], "look_at": [0, 0.5, 0], "resolution": [0, 16]})"),
+       "scene.json: camera.resolution: "},
+      {Scene(R"([{"type": "box", "material": "nope", "min": [-1, 0, -1], "max": [1, 1, 1]}])"),
+       "scene.json: objects[0].material: unknown material 'nope'"},
+      {Scene(kBox, R"([{"type": "point", "position": [0, 3, 2], "intensity": 10}])",
+             R"({"position": [0, 1, 4], "look_at": [0, 0.5, 0]})",
+             R"({"m": {"type": "diffuse", "texture": {"type": "checker", "color0": [1, -1, 0]}}})"),
+       "scene.json: materials.m.texture.color0: "},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.expected);
+    TempDir dir;
+    dir.Write("scene.json", c.scene);
+    ExpectRejected(dir, c.expected);
+  }
+}
+
+TEST(RenderBadInput, ZeroLights) {
+  TempDir dir;
+  dir.Write("scene.json", Scene(kBox, "[]"));
+  ExpectRejected(dir, "scene.json: lights: the scene has no lights");
+}
+
+TEST(RenderBadInput, MissingMesh) {
+  TempDir dir;
+  dir.Write("scene.json", Scene(R"([{"type": "mesh", "material": "m", "file": "gone.obj"}])"));
+  ExpectRejected(dir, "scene.json: objects[0].file: file '*gone.obj' not found");
+}
+
+const std::string kObj = "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nv 0 1 0\n"
+                         "f 1 2 5\nf 2 3 5\nf 3 4 5\nf 4 1 5\nf 1 3 2\nf 1 4 3\n";
+
+/// A mesh file written by the test: each must be rejected with a message that
+/// names the object's key and the file.
+void ExpectMeshRejected(const std::string& name, const std::string& bytes) {
+  SCOPED_TRACE(name);
+  TempDir dir;
+  dir.Write(name, bytes);
+  dir.Write("scene.json", Scene(R"([{"type": "mesh", "material": "m", "file": ")" + name + R"("}])"));
+  ExpectRejected(dir, "scene.json: objects[0].file: *" + name);
+}
+
+TEST(RenderBadInput, TruncatedObj) {
+  // Cut inside the face list: the last face refers to vertices the file no
+  // longer has, or no faces remain.
+  ExpectMeshRejected("cut.obj", kObj.substr(0, kObj.find("f 1 2 5") + 5));
+  ExpectMeshRejected("cut_vertices.obj", "v -1 0 -1\nv 1 0\n");
+  ExpectMeshRejected("badindex.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
+}
+
+TEST(RenderBadInput, CorruptObj) {
+  static const char kGarbage[] = "\x7f" "ELF\x02\x01\x01\x00\x00\xff\xfe this is no mesh\n";
+  ExpectMeshRejected("garbage.obj", std::string(kGarbage, sizeof kGarbage - 1));
+}
+
+TEST(RenderBadInput, TruncatedPly) {
+  const std::string header =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  // Three vertices need 36 bytes and the face 13: give 20.
+  ExpectMeshRejected("cut.ply", header + std::string(20, '\0'));
+  ExpectMeshRejected("cut_ascii.ply",
+                     "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                     "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0\n");
+}
+
+TEST(RenderBadInput, TruncatedGltf) {
+  const std::string gltf =
+      R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+          "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+          "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                         "min": [0, 0, 0], "max": [1, 1, 0]}],
+          "bufferViews": [{"buffer": 0, "byteLength": 36}],
+          "buffers": [{"byteLength": 36, "uri": "tri.bin"}]})";
+  // The JSON cut in half.
+  ExpectMeshRejected("cut.gltf", gltf.substr(0, gltf.size() / 2));
+  // Complete JSON, but its buffer file holds 12 of the 36 bytes it declares.
+  {
+    SCOPED_TRACE("short buffer");
+    TempDir dir;
+    dir.Write("tri.gltf", gltf);
+    dir.Write("tri.bin", std::string(12, '\0'));
+    dir.Write("scene.json", Scene(R"([{"type": "mesh", "material": "m", "file": "tri.gltf"}])"));
+    ExpectRejected(dir, "scene.json: objects[0].file: *tri.gltf");
+  }
+  // Complete JSON whose buffer file is missing.
+  {
+    SCOPED_TRACE("missing buffer");
+    TempDir dir;
+    dir.Write("tri.gltf", gltf);
+    dir.Write("scene.json", Scene(R"([{"type": "mesh", "material": "m", "file": "tri.gltf"}])"));
+    ExpectRejected(dir, "scene.json: objects[0].file: *tri.gltf");
+  }
+}
+
+// A mesh whose every triangle has zero area cannot be rendered: nothing of it
+// would be visible. (A few degenerate triangles in a good mesh are harmless
+// and may be dropped silently; this is the all-degenerate case.)
+TEST(RenderBadInput, AllTrianglesDegenerate) {
+  ExpectMeshRejected("flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 4 4 1\n");
+}
+
+// Non-finite vertex coordinates reach Embree as NaN/Inf geometry.
+TEST(RenderBadInput, NaNCoordinatesInMesh) {
+  ExpectMeshRejected("nan.obj", "v nan 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n");
+  ExpectMeshRejected("inf.obj", "v 0 0 0\nv inf 0 0\nv 0 1 0\nf 1 2 3\n");
+}
+
+// Coordinates finite as JSON doubles but beyond float's range become +-Inf
+// after conversion (and Embree aborts on a non-finite ray); scale and rotation
+// likewise make the geometry non-finite.
+TEST(RenderBadInput, CoordinatesBeyondFloatRange) {
+  struct Case {
+    std::string scene, expected;
+  };
+  const std::vector<Case> cases = {
+      {Scene(kBox, R"([{"type": "point", "position": [0, 3, 2], "intensity": 10}])",
+             R"({"position": [1e300, 1, 4], "look_at": [0, 0.5, 0], "resolution": [16, 16]})"),
+       "scene.json: camera.position"},
+      {Scene(R"([{"type": "box", "material": "m", "min": [-1, 0, -1], "max": [1, 1, 1],
+                  "transform": {"scale": 1e300}}])"),
+       "scene.json: objects[0].transform.scale"},
+      {Scene(R"([{"type": "box", "material": "m", "min": [-1, 0, -1], "max": [1, 1, 1],
+                  "transform": {"rotate": [1e39, 0, 0]}}])"),
+       "scene.json: objects[0].transform.rotate"},
+      {Scene(R"([{"type": "sphere", "material": "m", "center": [0, -4e38, 0], "radius": 1}])"),
+       "scene.json: objects[0].center"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.expected);
+    TempDir dir;
+    dir.Write("scene.json", c.scene);
+    ExpectRejected(dir, c.expected);
+  }
+}
+
+TEST(RenderBadInput, MissingTexture) {
+  TempDir dir;
+  dir.Write("scene.json", Scene(kBox, R"([{"type": "point", "position": [0, 3, 2], "intensity": 10}])",
+                                R"({"position": [0, 1, 4], "look_at": [0, 0.5, 0], "resolution": [16, 16]})",
+                                R"({"m": {"type": "diffuse", "texture": {"type": "image", "file": "wood.png"}}})"));
+  ExpectRejected(dir, "scene.json: materials.m.texture.file: file '*wood.png' not found");
+}
+
+TEST(RenderBadInput, CorruptAndTruncatedTexture) {
+  // A PNG signature and the start of an IHDR chunk, then nothing.
+  const std::string truncatedPng("\x89PNG\r\n\x1a\n\x00\x00\x00\x0dIHDR\x00\x00\x00\x10", 20);
+  for (const auto& [name, bytes] : {std::pair<std::string, std::string>{"wood.png", "not an image at all"},
+                                    {"cut.png", truncatedPng}, {"cut.exr", std::string("\x76\x2f\x31\x01\x02\x00", 6)}}) {
+    SCOPED_TRACE(name);
+    TempDir dir;
+    dir.Write(name, bytes);
+    dir.Write("scene.json",
+              Scene(kBox, R"([{"type": "point", "position": [0, 3, 2], "intensity": 10}])",
+                    R"({"position": [0, 1, 4], "look_at": [0, 0.5, 0], "resolution": [16, 16]})",
+                    R"({"m": {"type": "diffuse", "texture": {"type": "image", "file": ")" + name + R"("}}})"));
+    ExpectRejected(dir, "scene.json: materials.m.texture");
+  }
+}
+}  // namespace
