@@ -1,0 +1,406 @@
+# Builds a small furnished room procedurally and renders its AOVs with Cycles
+# (CPU) into one multilayer EXR that `dcm reconstruct --preset blender` reads.
+#
+#   blender -b --factory-startup --python make_and_render.py -- \
+#       --out out/room_a.exr [--view a|b|c] [--res 256] [--samples 128] \
+#       [--threads 2] [--save-blend out/room.blend]
+#
+# Blender 3.4 (Debian 12's package). Everything is made in this script: the
+# geometry, the materials, the floor planks and the rug checker (image
+# textures generated here and saved next to the EXR), the lights.
+#
+# What dcm needs, and what this script sets:
+#  - passes: Combined, IndexOB, IndexMA, UV, DiffCol/Dir/Ind, GlossCol/Dir/Ind,
+#    TransCol/Dir/Ind, Emit, Env, Cryptomatte object + material;
+#  - object.pass_index and material.pass_index (IndexOB/IndexMA are 0 otherwise;
+#    dcm prefers the Cryptomatte layers anyway);
+#  - a (near) point-sampled beauty: Blender's index and UV passes are not
+#    anti-aliased, so the pixel filter is made minimal (box, 0.01 px) and the
+#    beauty, the guides and the light passes all describe the pixel centre;
+#  - adaptive sampling and denoising off (the reference must be a plain
+#    Monte-Carlo estimate at every pixel).
+import argparse
+import math
+import os
+import sys
+
+import bpy
+
+
+def parse_args():
+    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    ap = argparse.ArgumentParser(prog="make_and_render.py")
+    ap.add_argument("--out", required=True, help="multilayer EXR to write")
+    ap.add_argument("--view", default="a", choices=["a", "b", "c"], help="camera / variant")
+    ap.add_argument("--res", type=int, default=256, help="square resolution")
+    ap.add_argument("--samples", type=int, default=128, help="Cycles samples per pixel")
+    ap.add_argument("--seed", type=int, default=1, help="Cycles seed")
+    ap.add_argument("--threads", type=int, default=2, help="render threads (0: all)")
+    ap.add_argument("--save-blend", default="", help="also save the scene as .blend")
+    return ap.parse_args(argv)
+
+
+# ---------------------------------------------------------------- textures --
+
+def hash01(i, j=0, k=0):
+    """Deterministic pseudo-random number in [0, 1)."""
+    h = (i * 374761393 + j * 668265263 + k * 2147483647) & 0xFFFFFFFF
+    h = ((h ^ (h >> 13)) * 1274126177) & 0xFFFFFFFF
+    return ((h ^ (h >> 16)) & 0xFFFFFF) / float(1 << 24)
+
+
+def make_image(name, size, texel, path):
+    """An sRGB image texture from texel(x, y) -> (r, g, b) in [0,1], saved as PNG."""
+    img = bpy.data.images.new(name, width=size, height=size, alpha=False)
+    px = [0.0] * (size * size * 4)
+    for y in range(size):
+        for x in range(size):
+            r, g, b = texel(x, y)
+            o = (y * size + x) * 4
+            px[o], px[o + 1], px[o + 2], px[o + 3] = r, g, b, 1.0
+    img.pixels.foreach_set(px)
+    img.filepath_raw = path
+    img.file_format = "PNG"
+    img.save()
+    return img
+
+
+def planks_texel(size):
+    rows = 8                       # planks across the texture
+    row_h = size / rows
+    def texel(x, y):
+        row = int(y // row_h)
+        plank_len = size / 2
+        off = (hash01(row, 7) * plank_len)
+        col = int((x + off) // plank_len)
+        base = 0.55 + 0.35 * hash01(row, col)        # per-plank tone
+        v = y - row * row_h
+        u = (x + off) - col * plank_len
+        grain = 0.08 * math.sin(0.35 * x + 3.0 * math.sin(0.05 * x + row) + 6.0 * hash01(row, col, 3))
+        seam = 0.35 if (v < 1.5 or u < 1.5) else 1.0   # dark gaps between planks
+        s = base * (1.0 + grain) * seam
+        return (0.62 * s, 0.40 * s, 0.22 * s)
+    return texel
+
+
+def checker_texel(size, n=8):
+    cell = size // n
+    def texel(x, y):
+        if ((x // cell) + (y // cell)) % 2:
+            return (0.75, 0.72, 0.62)
+        return (0.20, 0.28, 0.45)
+    return texel
+
+
+# --------------------------------------------------------------- materials --
+
+def principled(name, index, color=(0.8, 0.8, 0.8), rough=0.5, metal=0.0, spec=0.5,
+               image=None, emission=None, strength=0.0):
+    m = bpy.data.materials.new(name)
+    m.use_nodes = True
+    m.pass_index = index
+    nt = m.node_tree
+    bsdf = nt.nodes["Principled BSDF"]
+    bsdf.inputs["Base Color"].default_value = (*color, 1.0)
+    bsdf.inputs["Roughness"].default_value = rough
+    bsdf.inputs["Metallic"].default_value = metal
+    bsdf.inputs["Specular"].default_value = spec
+    if image is not None:
+        tex = nt.nodes.new("ShaderNodeTexImage")
+        tex.image = image
+        tex.extension = "REPEAT"
+        nt.links.new(tex.outputs["Color"], bsdf.inputs["Base Color"])
+    if emission is not None:
+        bsdf.inputs["Emission"].default_value = (*emission, 1.0)
+        bsdf.inputs["Emission Strength"].default_value = strength
+    return m
+
+
+# ---------------------------------------------------------------- geometry --
+
+def box(name, loc, dims, mat):
+    bpy.ops.mesh.primitive_cube_add(size=1.0, location=loc)
+    o = bpy.context.active_object
+    o.name = name
+    o.scale = dims
+    bpy.ops.object.transform_apply(scale=True)
+    o.data.materials.append(mat)
+    return o
+
+
+def cyl(name, loc, radius, depth, mat, verts=16, rot=(0, 0, 0)):
+    bpy.ops.mesh.primitive_cylinder_add(vertices=verts, radius=radius, depth=depth,
+                                        location=loc, rotation=rot)
+    o = bpy.context.active_object
+    o.name = name
+    o.data.materials.append(mat)
+    return o
+
+
+def join(name, parts, index):
+    """Joins parts into one object (one Cryptomatte / IndexOB entry) with pass_index."""
+    bpy.ops.object.select_all(action="DESELECT")
+    for p in parts:
+        p.select_set(True)
+    bpy.context.view_layer.objects.active = parts[0]
+    if len(parts) > 1:
+        bpy.ops.object.join()
+    o = bpy.context.view_layer.objects.active
+    o.name = name
+    o.pass_index = index
+    return o
+
+
+def scale_uv(obj, k):
+    for loop in obj.data.uv_layers.active.data:
+        loop.uv = (loop.uv[0] * k, loop.uv[1] * k)
+
+
+def table(x, y, wood, idx):
+    top_h = 0.75
+    parts = [box("table_top", (x, y, top_h - 0.02), (1.4, 0.8, 0.04), wood)]
+    for sx in (-1, 1):
+        for sy in (-1, 1):
+            parts.append(cyl("table_leg", (x + sx * 0.62, y + sy * 0.33, (top_h - 0.04) / 2),
+                             0.025, top_h - 0.04, wood))
+    return join("Table", parts, idx)
+
+
+def chair(name, x, y, yaw, wood, fabric, idx):
+    c, s = math.cos(yaw), math.sin(yaw)
+    def at(dx, dy, z):
+        return (x + c * dx - s * dy, y + s * dx + c * dy, z)
+    seat_h = 0.45
+    parts = [box(name + "_seat", at(0, 0, seat_h), (0.44, 0.42, 0.04), fabric)]
+    parts[-1].rotation_euler[2] = yaw
+    for sx in (-1, 1):
+        for sy in (-1, 1):
+            parts.append(cyl(name + "_leg", at(sx * 0.19, sy * 0.18, seat_h / 2 - 0.01),
+                             0.014, seat_h - 0.02, wood, verts=12))
+    # back: two thin posts, a top rail and three spindles (sub-pixel at 256²)
+    for sx in (-1, 1):
+        parts.append(cyl(name + "_post", at(sx * 0.19, 0.19, seat_h + 0.23), 0.014, 0.46, wood, verts=12))
+    rail = box(name + "_rail", at(0, 0.19, seat_h + 0.43), (0.40, 0.025, 0.06), wood)
+    rail.rotation_euler[2] = yaw
+    parts.append(rail)
+    for k in (-1, 0, 1):
+        parts.append(cyl(name + "_spindle", at(k * 0.09, 0.19, seat_h + 0.21), 0.006, 0.38, wood, verts=8))
+    return join(name, parts, idx)
+
+
+def floor_lamp(x, y, metal, shade, idx):
+    parts = [cyl("lamp_base", (x, y, 0.015), 0.16, 0.03, metal, verts=24),
+             cyl("lamp_pole", (x, y, 0.75), 0.011, 1.45, metal, verts=12)]
+    bpy.ops.mesh.primitive_cone_add(vertices=32, radius1=0.24, radius2=0.14, depth=0.26,
+                                    end_fill_type="NOTHING", location=(x, y, 1.42))
+    sh = bpy.context.active_object
+    sh.data.materials.append(shade)
+    parts.append(sh)
+    o = join("FloorLamp", parts, idx)
+    # The shade glows but is not sampled as a light, and there is no bulb:
+    # Cycles 3.4 picks one light per bounce, so every extra light adds noise
+    # wherever several lights contribute.
+    shade.cycles.sample_as_light = False
+    return o
+
+
+# ------------------------------------------------------------------- scene --
+
+def build(outdir):
+    for o in list(bpy.data.objects):
+        bpy.data.objects.remove(o, do_unlink=True)
+
+    planks = make_image("planks", 512, planks_texel(512), os.path.join(outdir, "planks.png"))
+    checker = make_image("checker", 256, checker_texel(256), os.path.join(outdir, "checker.png"))
+
+    m_floor = principled("Floor", 1, image=planks, rough=0.35, spec=0.4)
+    m_wall = principled("Wall", 2, color=(0.78, 0.76, 0.70), rough=0.9, spec=0.3)
+    m_wood = principled("Wood", 3, color=(0.35, 0.20, 0.10), rough=0.45, spec=0.5)
+    m_fabric = principled("Fabric", 4, color=(0.15, 0.35, 0.30), rough=1.0, spec=0.2)
+    m_metal = principled("BrushedMetal", 5, color=(0.85, 0.85, 0.82), rough=0.25, metal=1.0)
+    m_chrome = principled("Chrome", 6, color=(0.95, 0.93, 0.90), rough=0.05, metal=1.0)
+    m_ceramic = principled("RedCeramic", 7, color=(0.60, 0.06, 0.04), rough=0.08, spec=0.6)
+    m_shade = principled("LampShade", 8, color=(0.9, 0.85, 0.7), rough=0.8,
+                         emission=(1.0, 0.85, 0.6), strength=3.0)
+    m_rug = principled("Rug", 9, image=checker, rough=1.0, spec=0.2)
+    m_frame = principled("Frame", 10, color=(0.05, 0.05, 0.05), rough=0.3, spec=0.5)
+
+    # Room 5 x 4 x 2.7 m: floor z=0, x in [-2.5, 2.5], y in [-2, 2]. The camera
+    # side (y = -2) is open; the back wall (y = 2) has a window.
+    bpy.ops.mesh.primitive_plane_add(size=1.0, location=(0, 0, 0))
+    floor = bpy.context.active_object
+    floor.name = "Floor"
+    floor.scale = (5.0, 4.0, 1.0)
+    bpy.ops.object.transform_apply(scale=True)
+    scale_uv(floor, 1.0)
+    for loop in floor.data.uv_layers.active.data:        # planks 0.5 m long, UV 1 = 1.25 m
+        loop.uv = (loop.uv[0] * 4.0, loop.uv[1] * 3.2)
+    floor.data.materials.append(m_floor)
+    floor.pass_index = 1
+
+    h, t = 2.7, 0.1
+    walls = [box("wall_left", (-2.5 - t / 2, 0, h / 2), (t, 4.0, h), m_wall),
+             box("wall_right", (2.5 + t / 2, 0, h / 2), (t, 4.0, h), m_wall),
+             box("ceiling", (0, 0, h + t / 2), (5.2, 4.0, t), m_wall)]
+    # back wall with a window opening x in [0.2, 1.6], z in [0.9, 2.1]
+    wy = 2.0 + t / 2
+    walls += [box("wall_back_l", ((-2.6 + 0.2) / 2, wy, h / 2), (2.8, t, h), m_wall),
+              box("wall_back_r", ((1.6 + 2.6) / 2, wy, h / 2), (1.0, t, h), m_wall),
+              box("wall_back_b", (0.9, wy, 0.45), (1.4, t, 0.9), m_wall),
+              box("wall_back_t", (0.9, wy, (2.1 + h) / 2), (1.4, t, h - 2.1), m_wall)]
+    join("Walls", walls, 2)
+    # window frame: thin mullions (dark) in the opening
+    fr = [box("mullion_v", (0.9, wy, 1.5), (0.04, 0.06, 1.2), m_frame),
+          box("mullion_h", (0.9, wy, 1.5), (1.4, 0.06, 0.04), m_frame)]
+    join("WindowFrame", fr, 3)
+
+    table(0.0, 0.6, m_wood, 4)
+    chair("ChairA", -0.35, -0.05, 0.0 + math.pi, m_wood, m_fabric, 5)
+    chair("ChairB", 0.45, -0.05, math.pi + 0.15, m_wood, m_fabric, 6)
+    chair("ChairC", 0.95, 0.75, math.pi / 2, m_wood, m_fabric, 7)
+    floor_lamp(-1.9, 1.5, m_metal, m_shade, 8)
+
+    # rug under the table (checker image texture)
+    bpy.ops.mesh.primitive_plane_add(size=1.0, location=(0.1, 0.4, 0.004))
+    rug = bpy.context.active_object
+    rug.name = "Rug"
+    rug.scale = (2.2, 1.6, 1.0)
+    bpy.ops.object.transform_apply(scale=True)
+    rug.data.materials.append(m_rug)
+    rug.pass_index = 9
+
+    # glossy objects on the table: a chrome sphere and a red ceramic vase
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=48, ring_count=24, radius=0.14, location=(-0.3, 0.55, 0.87))
+    s = bpy.context.active_object
+    s.name = "ChromeBall"
+    bpy.ops.object.shade_smooth()
+    s.data.materials.append(m_chrome)
+    s.pass_index = 10
+    bpy.ops.mesh.primitive_cylinder_add(vertices=48, radius=0.08, depth=0.30, location=(0.3, 0.7, 0.88))
+    v = bpy.context.active_object
+    v.name = "Vase"
+    bpy.ops.object.shade_smooth()
+    v.data.materials.append(m_ceramic)
+    v.pass_index = 11
+
+    # a sideboard against the right wall, and a picture (checker) above it
+    box("Sideboard", (2.2, 0.0, 0.4), (0.5, 1.6, 0.8), m_wood).pass_index = 12
+    pic = box("Picture", (2.44, 0.0, 1.6), (0.02, 0.9, 0.6), m_rug)
+    pic.pass_index = 13
+
+    # lights: a ceiling area light, a sun through the window, a sky
+    bpy.ops.object.light_add(type="AREA", location=(0.0, 0.2, h - 0.02))
+    a = bpy.context.active_object
+    a.name = "CeilingLight"
+    a.data.shape = "RECTANGLE"
+    a.data.size, a.data.size_y = 1.2, 0.6
+    a.data.energy = 150.0
+    bpy.ops.object.light_add(type="SUN", location=(0, 4, 4),
+                             rotation=(math.radians(-55), 0.0, math.radians(200)))
+    sun = bpy.context.active_object
+    sun.name = "Sun"
+    sun.data.energy = 3.0
+    sun.data.angle = math.radians(1.5)
+    sun.data.color = (1.0, 0.93, 0.82)
+
+    world = bpy.data.worlds.new("Sky")
+    world.use_nodes = True
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.45, 0.62, 0.95, 1.0)
+    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 1.0
+    bpy.context.scene.world = world
+
+
+VIEWS = {
+    # name: (location, look-at, focal length mm)
+    "a": ((-1.2, -3.4, 1.45), (0.25, 0.9, 0.55), 26.0),   # from the open side, window behind the table
+    "b": ((1.9, -1.3, 0.55), (-0.4, 0.6, 0.35), 24.0),   # low, across the chair legs to the lamp
+    "c": ((1.0, -1.1, 1.9), (-0.05, 0.6, 0.7), 30.0),    # down onto the table: chrome, ceramic, rug
+}
+
+
+def camera(view):
+    loc, target, lens = VIEWS[view]
+    bpy.ops.object.camera_add(location=loc)
+    cam = bpy.context.active_object
+    cam.data.lens = lens
+    cam.data.clip_start = 0.05
+    d = [target[i] - loc[i] for i in range(3)]
+    yaw = math.atan2(d[1], d[0]) - math.pi / 2
+    pitch = math.atan2(d[2], math.hypot(d[0], d[1]))
+    cam.rotation_euler = (math.pi / 2 + pitch, 0.0, yaw)
+    bpy.context.scene.camera = cam
+
+
+def setup_render(args):
+    sc = bpy.context.scene
+    sc.render.engine = "CYCLES"
+    sc.cycles.device = "CPU"
+    sc.cycles.samples = args.samples
+    sc.cycles.use_adaptive_sampling = False
+    sc.cycles.use_denoising = False
+    sc.cycles.max_bounces = 4
+    sc.cycles.diffuse_bounces = 2
+    sc.cycles.glossy_bounces = 2
+    sc.cycles.transmission_bounces = 4
+    # production noise controls: no caustics, blurred glossy after diffuse
+    # bounces, indirect clamping (the reference is this same estimator)
+    sc.cycles.sample_clamp_indirect = 1.0
+    sc.cycles.sample_clamp_direct = 8.0
+    sc.cycles.caustics_reflective = False
+    sc.cycles.caustics_refractive = False
+    sc.cycles.blur_glossy = 1.0
+    sc.cycles.seed = args.seed
+    # (near) point sampling: the index and UV passes are not anti-aliased.
+    # Gaussian, not Box: Cycles ignores the width of the Box filter (it always
+    # spreads the samples over the whole pixel).
+    sc.cycles.pixel_filter_type = "GAUSSIAN"
+    sc.cycles.filter_width = 0.01
+    sc.render.resolution_x = sc.render.resolution_y = args.res
+    sc.render.resolution_percentage = 100
+    sc.render.film_transparent = False
+    sc.render.use_compositing = False       # write the passes as rendered
+    sc.render.use_sequencer = False
+    sc.view_settings.view_transform = "Standard"
+    if args.threads > 0:
+        sc.render.threads_mode = "FIXED"
+        sc.render.threads = args.threads
+
+    vl = sc.view_layers[0]
+    vl.name = "ViewLayer"
+    vl.use_pass_combined = True
+    vl.use_pass_z = True
+    vl.use_pass_normal = True
+    vl.use_pass_object_index = True
+    vl.use_pass_material_index = True
+    vl.use_pass_uv = True
+    for kind in ("diffuse", "glossy", "transmission"):
+        for part in ("color", "direct", "indirect"):
+            setattr(vl, "use_pass_%s_%s" % (kind, part), True)
+    vl.use_pass_emit = True
+    vl.use_pass_environment = True
+    vl.use_pass_cryptomatte_object = True
+    vl.use_pass_cryptomatte_material = True
+    vl.pass_cryptomatte_depth = 2
+
+    im = sc.render.image_settings
+    im.file_format = "OPEN_EXR_MULTILAYER"
+    im.color_depth = "32"                   # float: IDs and UVs exact
+    im.exr_codec = "ZIP"
+    sc.render.use_file_extension = False
+    sc.render.filepath = os.path.abspath(args.out)
+
+
+def main():
+    args = parse_args()
+    outdir = os.path.dirname(os.path.abspath(args.out))
+    os.makedirs(outdir, exist_ok=True)
+    build(outdir)
+    camera(args.view)
+    setup_render(args)
+    if args.save_blend:
+        bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(args.save_blend))
+    bpy.ops.render.render(write_still=True)
+    print("wrote", os.path.abspath(args.out))
+
+
+main()
