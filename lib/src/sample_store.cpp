@@ -1,6 +1,7 @@
 #include "sample_store.h"
 
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <chrono>
@@ -72,7 +73,13 @@ Status SampleStore::Flush(SampleProvider& provider, const SampleRequest& what, i
   if (pixels.empty()) return Status::Ok();
 
   std::vector<ExactSample> samples(pixels.size());
-  const size_t batch = size_t(std::max(1, batchSize));
+  // Batches of at most batchSize, and small enough that a short phase still
+  // keeps every worker busy (results do not depend on the batching).
+  size_t batch = size_t(std::max(1, batchSize));
+  if (parallel) {
+    const size_t workers = size_t(std::max(1, tbb::this_task_arena::max_concurrency()));
+    batch = std::min(batch, std::max<size_t>(16, (pixels.size() + 4 * workers - 1) / (4 * workers)));
+  }
   const size_t nbatches = (pixels.size() + batch - 1) / batch;
   std::vector<Status> results(nbatches);
   auto run = [&](size_t bi) {

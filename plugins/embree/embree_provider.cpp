@@ -2,6 +2,8 @@
 
 #include "embree/scene_file.h"
 
+#include <tbb/parallel_for.h>
+
 namespace dcm::embree {
 
 std::vector<std::string> Effects::Names() const {
@@ -118,8 +120,9 @@ Status EmbreeProvider::Guides(const Bounds2i& region, const GuideRequest& what, 
   const bool tau = what.texture && effects_.textures;
   out->texture.assign(what.texture ? n : 0, RGB::Gray(1.f));
   if (!what.objectId && !what.shaderId && !tau) return Status::Ok();
-  RayCounts counts;
-  for (int y = region.min.y; y < region.max.y; ++y) {
+  // Rows in parallel: primary rays are independent and deterministic.
+  tbb::parallel_for(region.min.y, region.max.y, [&](int y) {
+    RayCounts counts;
     for (int x = region.min.x; x < region.max.x; ++x) {
       PixelGuide g = integrator_->Guide(x, y, tau, &counts);
       size_t i = size_t(region.offset({x, y}));
@@ -127,8 +130,8 @@ Status EmbreeProvider::Guides(const Bounds2i& region, const GuideRequest& what, 
       if (what.shaderId) out->shaderId[i] = g.shaderId;
       if (tau) out->texture[i] = g.tau;
     }
-  }
-  AddCounts(counts);
+    AddCounts(counts);
+  });
   return Status::Ok();
 }
 
