@@ -1,0 +1,89 @@
+// A SampleProvider served by a child process (an out-of-process renderer) over
+// its stdin/stdout with the dcm-pipe protocol (plugins/pipe/PROTOCOL.md).
+#pragma once
+
+#include <memory>
+#include <mutex>
+#include <span>
+#include <string>
+
+#include "dcm/sample_provider.h"
+#include "dcm/status.h"
+
+namespace dcm::pipe {
+
+/// The version of the dcm-pipe protocol this library speaks.
+inline constexpr int kProtocolVersion = 1;
+
+/// How to start and talk to the child.
+struct PipeOptions {
+  /// Shell command line of the provider, run as `/bin/sh -c COMMAND` in its own
+  /// process group; its stderr goes to ours.
+  std::string command;
+  /// Longest wait for the handshake, in seconds: the child starts up and may
+  /// load its scene first.
+  double startupTimeoutSeconds = 600.0;
+  /// Longest wait for any later answer (guides, a batch of samples) and for
+  /// the child to exit after "quit", in seconds.
+  double timeoutSeconds = 600.0;
+};
+
+class ChildProcess;
+
+/// Starts the child, performs the handshake and serves its guides and samples
+/// to the engine. Every failure of the child (it crashes, exits early, sends
+/// garbage or wrong counts, or does not answer in time) becomes an error
+/// Status that names the command and what went wrong; after the first failure
+/// the child is killed and every later call returns the same error.
+/// Not thread safe for the engine (Capabilities().threadSafe is false); calls
+/// are serialised by a mutex in any case.
+class PipeProvider final : public SampleProvider {
+ public:
+  /// Starts `options.command` and reads its handshake. On error `*out` is
+  /// untouched and the child is gone.
+  static Status Start(const PipeOptions& options, std::unique_ptr<PipeProvider>* out);
+
+  /// Ends the child if Finish() was not called: sends "quit" and kills the
+  /// child when it has not exited 2 s later.
+  ~PipeProvider() override;
+
+  PipeProvider(const PipeProvider&) = delete;
+  PipeProvider& operator=(const PipeProvider&) = delete;
+
+  /// What the child announced in its handshake; threadSafe is always false.
+  ProviderCapabilities Capabilities() const override;
+
+  /// Asks the child for the guides of `region` ("guides" request).
+  Status Guides(const Bounds2i& region, const GuideRequest& what, GuideImage* out) override;
+
+  /// Asks the child to evaluate `pixels` ("eval" request).
+  Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what,
+                  std::span<ExactSample> out) override;
+
+  /// Sends "quit", closes the child's stdin and waits for it to exit. An exit
+  /// status other than 0 (or a signal) is an error. Idempotent: returns the
+  /// first outcome again.
+  Status Finish();
+
+  /// The protocol version the child announced.
+  int childProtocolVersion() const { return childVersion_; }
+
+ private:
+  PipeProvider(PipeOptions options, std::unique_ptr<ChildProcess> child);
+  Status Handshake();
+  /// Records the first failure, kills the child and returns the failure.
+  Status Fail(const std::string& what);
+  /// Prefixes messages with the provider's command.
+  std::string Prefix() const;
+
+  PipeOptions options_;
+  std::unique_ptr<ChildProcess> child_;
+  ProviderCapabilities caps_;
+  int childVersion_ = 0;
+  std::mutex mutex_;
+  Status broken_;  ///< the first failure; OK while healthy
+  bool finished_ = false;
+  Status finishStatus_;
+};
+
+}  // namespace dcm::pipe

@@ -1,0 +1,360 @@
+// PipeProvider: the dcm-pipe protocol (PROTOCOL.md) over a child's stdin/stdout.
+#include "dcm/pipe/pipe_provider.h"
+
+#include <bit>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+#include "child_process.h"
+
+namespace dcm::pipe {
+
+static_assert(std::endian::native == std::endian::little, "the dcm-pipe payloads are little-endian");
+
+namespace {
+
+using Clock = ChildProcess::Clock;
+
+/// Longest line of the protocol.
+constexpr size_t kMaxLine = 4096;
+/// Largest side of the image a child may announce.
+constexpr int kMaxSide = 1 << 17;
+
+std::vector<std::string> Split(const std::string& s, char sep) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : s) {
+    if (c == sep) {
+      if (!cur.empty()) out.push_back(std::move(cur));
+      cur.clear();
+    } else {
+      cur += c;
+    }
+  }
+  if (!cur.empty()) out.push_back(std::move(cur));
+  return out;
+}
+
+bool ParseInt(const std::string& s, int64_t* v) {
+  const char* end = s.data() + s.size();
+  auto [p, ec] = std::from_chars(s.data(), end, *v);
+  return ec == std::errc() && p == end;
+}
+
+/// A line of the child quoted for a message: printable ASCII, at most 60 characters.
+std::string Quote(const std::string& line) {
+  std::string q;
+  for (unsigned char c : line) {
+    if (q.size() >= 60) {
+      q += "...";
+      break;
+    }
+    if (c >= 32 && c < 127) {
+      q += char(c);
+    } else {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      q += buf;
+    }
+  }
+  return "'" + q + "'";
+}
+
+std::string Seconds(double s) {
+  std::ostringstream o;
+  o << s << " s";
+  return o.str();
+}
+
+}  // namespace
+
+PipeProvider::PipeProvider(PipeOptions options, std::unique_ptr<ChildProcess> child)
+    : options_(std::move(options)), child_(std::move(child)) {}
+
+PipeProvider::~PipeProvider() {
+  if (finished_ || !broken_.ok()) return;  // the child is gone (reaped, or killed by Fail)
+  // Not finished: ask the child to quit, but do not wait long for it.
+  const std::string quit = "quit\n";
+  (void)child_->Write(quit.data(), quit.size(), Clock::now() + std::chrono::seconds(1));
+  child_->CloseInput();
+  if (!child_->WaitExit(Clock::now() + std::chrono::seconds(2))) child_->Kill();
+}
+
+Status PipeProvider::Start(const PipeOptions& options, std::unique_ptr<PipeProvider>* out) {
+  if (options.command.empty()) return Status::Error("provider command is empty");
+  if (!(options.timeoutSeconds > 0) || !(options.startupTimeoutSeconds > 0))
+    return Status::Error("provider timeouts must be > 0 seconds");
+  std::unique_ptr<ChildProcess> child;
+  if (Status st = ChildProcess::Spawn(options.command, &child); !st.ok())
+    return Status::Error("provider '" + options.command + "': " + st.message());
+  std::unique_ptr<PipeProvider> p(new PipeProvider(options, std::move(child)));
+  DCM_RETURN_IF_ERROR(p->Handshake());
+  *out = std::move(p);
+  return Status::Ok();
+}
+
+std::string PipeProvider::Prefix() const {
+  std::string c = options_.command;
+  if (c.size() > 80) c = c.substr(0, 77) + "...";
+  return "provider '" + c + "'";
+}
+
+Status PipeProvider::Fail(const std::string& what) {
+  if (!broken_.ok()) return broken_;
+  child_->Kill();
+  broken_ = Status::Error(Prefix() + ": " + what);
+  return broken_;
+}
+
+/// Reads the header line of an answer to `request` that must start with
+/// `keyword`; handles "error MESSAGE", end of file, timeouts and garbage.
+static Status ReadAnswer(ChildProcess& child, const std::string& request, const std::string& keyword,
+                         double timeoutS, std::vector<std::string>* tokens, std::string* failure) {
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeoutS));
+  std::string line;
+  Status st = child.ReadLine(&line, kMaxLine, deadline);
+  if (!st.ok()) {
+    if (st.message() == "end of file") {
+      child.WaitExit(Clock::now() + std::chrono::seconds(2));
+      *failure = "closed its output instead of answering '" + request + "' (it " + child.ExitDescription() + ")";
+    } else if (st.message() == "timeout") {
+      *failure = "did not answer '" + request + "' within " + Seconds(timeoutS) + " (killed)";
+    } else if (st.message() == "line too long") {
+      *failure = "sent a line longer than " + std::to_string(kMaxLine) + " bytes in answer to '" + request +
+                 "' (not a dcm-pipe provider?)";
+    } else {
+      *failure = "reading its answer to '" + request + "': " + st.message();
+    }
+    return Status::Error(*failure);
+  }
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  if (line.rfind("error", 0) == 0 && (line.size() == 5 || line[5] == ' ')) {
+    *failure = "reported an error: " + (line.size() > 6 ? line.substr(6) : std::string("(no message)"));
+    return Status::Error(*failure);
+  }
+  *tokens = Split(line, ' ');
+  if (tokens->empty() || (*tokens)[0] != keyword) {
+    *failure = "sent " + Quote(line) + " in answer to '" + request + "' (expected '" + keyword + " ...')";
+    return Status::Error(*failure);
+  }
+  return Status::Ok();
+}
+
+/// Reads `size` payload bytes of the answer to `request`.
+static Status ReadPayload(ChildProcess& child, void* data, size_t size, const std::string& request, double timeoutS,
+                          std::string* failure) {
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeoutS));
+  Status st = child.Read(data, size, deadline);
+  if (st.ok()) return st;
+  if (st.message() == "end of file") {
+    child.WaitExit(Clock::now() + std::chrono::seconds(2));
+    *failure = "closed its output in the middle of its answer to '" + request + "' (" + std::to_string(size) +
+               " bytes expected; it " + child.ExitDescription() + ")";
+  } else if (st.message() == "timeout") {
+    *failure = "did not send all of its answer to '" + request + "' within " + Seconds(timeoutS) + " (killed)";
+  } else {
+    *failure = "reading its answer to '" + request + "': " + st.message();
+  }
+  return Status::Error(*failure);
+}
+
+Status PipeProvider::Handshake() {
+  const std::string hello = "dcm-pipe " + std::to_string(kProtocolVersion) + "\n";
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                           std::chrono::duration<double>(options_.startupTimeoutSeconds));
+  std::string failure;
+  // A child that exits without reading its input fails the write; its answer
+  // (or end of file) says more, so read it in any case.
+  Status written = child_->Write(hello.data(), hello.size(), deadline);
+  std::vector<std::string> t;
+  if (!ReadAnswer(*child_, "dcm-pipe " + std::to_string(kProtocolVersion), "dcm-pipe", options_.startupTimeoutSeconds,
+                  &t, &failure)
+           .ok()) {
+    return Fail(failure);
+  }
+  if (!written.ok()) return Fail("handshake: " + written.message());
+  int64_t version = 0;
+  if (t.size() < 2 || !ParseInt(t[1], &version)) return Fail("handshake without a protocol version");
+  if (version != kProtocolVersion) {
+    return Fail("speaks dcm-pipe protocol version " + std::to_string(version) + ", dcm speaks version " +
+                std::to_string(kProtocolVersion));
+  }
+  childVersion_ = int(version);
+  caps_ = ProviderCapabilities{};
+  caps_.threadSafe = false;
+  bool haveW = false, haveH = false;
+  for (size_t i = 2; i < t.size(); ++i) {
+    const size_t eq = t[i].find('=');
+    if (eq == std::string::npos) return Fail("handshake: expected key=value, got " + Quote(t[i]));
+    const std::string key = t[i].substr(0, eq), value = t[i].substr(eq + 1);
+    int64_t v = 0;
+    if (key == "width" || key == "height") {
+      if (!ParseInt(value, &v) || v < 1 || v > kMaxSide)
+        return Fail("handshake: " + key + " must be from 1 to " + std::to_string(kMaxSide) + ", got " + Quote(value));
+      (key == "width" ? caps_.width : caps_.height) = int(v);
+      (key == "width" ? haveW : haveH) = true;
+    } else if (key == "caps") {
+      for (const std::string& c : Split(value, ',')) {
+        if (c == "object_id") caps_.objectId = true;
+        else if (c == "shader_id") caps_.shaderId = true;
+        else if (c == "texture") caps_.texture = true;
+        else if (c == "split") caps_.splitRadiance = true;
+        // Unknown capabilities are ignored (newer providers).
+      }
+    } else if (key == "name") {
+      caps_.name = value;
+    }
+    // Unknown keys are ignored (newer providers).
+  }
+  if (!haveW || !haveH) return Fail("handshake without width= and height=");
+  if (caps_.name.empty()) caps_.name = "pipe";
+  return Status::Ok();
+}
+
+ProviderCapabilities PipeProvider::Capabilities() const { return caps_; }
+
+Status PipeProvider::Guides(const Bounds2i& region, const GuideRequest& what, GuideImage* out) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!broken_.ok()) return broken_;
+  if (finished_) return Status::Error(Prefix() + ": guides requested after Finish()");
+  const Bounds2i all{{0, 0}, {caps_.width, caps_.height}};
+  if (region.empty() || Intersect(region, all) != region)
+    return Status::Error(Prefix() + ": guide region outside the image");
+  const bool ids = what.objectId && caps_.objectId, shaders = what.shaderId && caps_.shaderId,
+             tex = what.texture && caps_.texture;
+  std::string kinds;
+  auto add = [&](bool on, const char* name) {
+    if (!on) return;
+    if (!kinds.empty()) kinds += ',';
+    kinds += name;
+  };
+  add(ids, "object_id");
+  add(shaders, "shader_id");
+  add(tex, "texture");
+  out->region = region;
+  out->objectId.clear();
+  out->shaderId.clear();
+  out->texture.clear();
+  if (kinds.empty()) return Status::Ok();
+
+  const std::string request = "guides " + std::to_string(region.min.x) + " " + std::to_string(region.min.y) + " " +
+                              std::to_string(region.max.x) + " " + std::to_string(region.max.y) + " " + kinds;
+  const auto deadline =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.timeoutSeconds));
+  const std::string line = request + "\n";
+  Status written = child_->Write(line.data(), line.size(), deadline);
+  std::vector<std::string> t;
+  std::string failure;
+  if (!ReadAnswer(*child_, request, "guides", options_.timeoutSeconds, &t, &failure).ok()) return Fail(failure);
+  if (!written.ok()) return Fail("request '" + request + "': " + written.message());
+  const int64_t n = region.area();
+  int64_t count = -1;
+  if (t.size() != 2 || !ParseInt(t[1], &count))
+    return Fail("sent a malformed answer to '" + request + "' (expected 'guides " + std::to_string(n) + "')");
+  if (count != n) {
+    return Fail("answered 'guides " + std::to_string(count) + "' to '" + request + "', which asks for " +
+                std::to_string(n) + " pixels");
+  }
+  if (ids) {
+    out->objectId.resize(size_t(n));
+    if (!ReadPayload(*child_, out->objectId.data(), size_t(n) * 4, request, options_.timeoutSeconds, &failure).ok())
+      return Fail(failure);
+  }
+  if (shaders) {
+    out->shaderId.resize(size_t(n));
+    if (!ReadPayload(*child_, out->shaderId.data(), size_t(n) * 4, request, options_.timeoutSeconds, &failure).ok())
+      return Fail(failure);
+  }
+  if (tex) {
+    std::vector<float> f(size_t(n) * 3);
+    if (!ReadPayload(*child_, f.data(), f.size() * 4, request, options_.timeoutSeconds, &failure).ok())
+      return Fail(failure);
+    out->texture.resize(size_t(n));
+    for (size_t i = 0; i < size_t(n); ++i) out->texture[i] = {f[3 * i], f[3 * i + 1], f[3 * i + 2]};
+  }
+  return Status::Ok();
+}
+
+Status PipeProvider::Evaluate(std::span<const Point2i> pixels, const SampleRequest& what,
+                              std::span<ExactSample> out) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!broken_.ok()) return broken_;
+  if (finished_) return Status::Error(Prefix() + ": samples requested after Finish()");
+  if (out.size() != pixels.size()) return Status::Error(Prefix() + ": output span of the wrong size");
+  if (pixels.empty()) return Status::Ok();
+  if (pixels.size() > size_t(std::numeric_limits<int32_t>::max() / 2))
+    return Status::Error(Prefix() + ": batch too large");
+  const bool split = what.split && caps_.splitRadiance;
+  const size_t n = pixels.size();
+  const std::string request = "eval " + std::to_string(n) + (split ? " L,split" : " L");
+  std::vector<char> message(request.size() + 1 + n * 8);
+  std::memcpy(message.data(), request.data(), request.size());
+  message[request.size()] = '\n';
+  std::vector<int32_t> xy(2 * n);
+  for (size_t i = 0; i < n; ++i) {
+    xy[2 * i] = pixels[i].x;
+    xy[2 * i + 1] = pixels[i].y;
+  }
+  std::memcpy(message.data() + request.size() + 1, xy.data(), n * 8);
+  const auto deadline =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.timeoutSeconds));
+  Status written = child_->Write(message.data(), message.size(), deadline);
+  std::vector<std::string> t;
+  std::string failure;
+  if (!ReadAnswer(*child_, request, "samples", options_.timeoutSeconds, &t, &failure).ok()) return Fail(failure);
+  if (!written.ok()) return Fail("request '" + request + "': " + written.message());
+  int64_t count = -1;
+  if (t.size() != 2 || !ParseInt(t[1], &count))
+    return Fail("sent a malformed answer to '" + request + "' (expected 'samples " + std::to_string(n) + "')");
+  if (count != int64_t(n)) {
+    return Fail("answered 'samples " + std::to_string(count) + "' to '" + request + "', which asks for " +
+                std::to_string(n) + " pixels");
+  }
+  const size_t perPixel = split ? 9 : 3;
+  std::vector<float> f(n * perPixel);
+  if (!ReadPayload(*child_, f.data(), f.size() * 4, request, options_.timeoutSeconds, &failure).ok())
+    return Fail(failure);
+  for (size_t i = 0; i < n; ++i) {
+    const float* p = &f[i * perPixel];
+    out[i].L = {p[0], p[1], p[2]};
+    if (split) {
+      out[i].Li = {p[3], p[4], p[5]};
+      out[i].Lc = {p[6], p[7], p[8]};
+    }
+  }
+  return Status::Ok();
+}
+
+Status PipeProvider::Finish() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (finished_) return finishStatus_;
+  finished_ = true;
+  if (!broken_.ok()) {
+    finishStatus_ = broken_;
+    return finishStatus_;
+  }
+  const auto deadline =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.timeoutSeconds));
+  const std::string quit = "quit\n";
+  (void)child_->Write(quit.data(), quit.size(), deadline);  // a child that already left is judged by its exit status
+  child_->CloseInput();
+  if (!child_->WaitExit(deadline)) {
+    child_->Kill();
+    finishStatus_ = Status::Error(Prefix() + ": did not exit within " + Seconds(options_.timeoutSeconds) +
+                                  " after 'quit' (killed)");
+  } else if (!child_->exitedCleanly()) {
+    finishStatus_ = Status::Error(Prefix() + ": " + child_->ExitDescription() + " after 'quit'");
+  } else {
+    finishStatus_ = Status::Ok();
+  }
+  broken_ = finishStatus_;
+  return finishStatus_;
+}
+
+}  // namespace dcm::pipe

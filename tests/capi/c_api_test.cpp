@@ -1,0 +1,344 @@
+// The C API through libdcm.so only (the engine's C++ symbols are hidden there).
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "dcm/dcm.h"
+
+namespace {
+
+/// A scene of two surfaces: a smooth ramp with a vertical step at x = split.
+struct Scene {
+  int width = 64, height = 48, split = 29;
+  std::atomic<long> evaluated{0};
+  std::atomic<int> inFlight{0};
+  std::atomic<int> maxInFlight{0};
+  std::atomic<bool> sawSplitBuffers{false};
+  std::atomic<bool> sawOutOfRange{false};
+  int failWith = 0;
+
+  void Truth(int x, int y, float* L) const {
+    const float base = x < split ? 0.2f : 0.7f;
+    L[0] = base + 0.002f * float(y);
+    L[1] = base * 0.5f + 0.001f * float(x);
+    L[2] = 0.1f;
+  }
+};
+
+int Evaluate(void* user, const int* xy, int count, float* rgb, float* li, float* lc) {
+  auto* s = static_cast<Scene*>(user);
+  const int now = ++s->inFlight;
+  int seen = s->maxInFlight.load();
+  while (now > seen && !s->maxInFlight.compare_exchange_weak(seen, now)) {
+  }
+  if (li || lc) s->sawSplitBuffers = true;
+  for (int i = 0; i < count; ++i) {
+    const int x = xy[2 * i], y = xy[2 * i + 1];
+    if (x < 0 || y < 0 || x >= s->width || y >= s->height) s->sawOutOfRange = true;
+    s->Truth(x, y, rgb + 3 * i);
+    if (li && lc) {
+      for (int c = 0; c < 3; ++c) {
+        li[3 * i + c] = rgb[3 * i + c];
+        lc[3 * i + c] = 0.f;
+      }
+    }
+  }
+  s->evaluated += count;
+  --s->inFlight;
+  return s->failWith;
+}
+
+std::string TakeError(DCMReconstructor r, DCMError* code = nullptr) {
+  const char* m = nullptr;
+  const DCMError e = dcmGetError(r, &m);
+  if (code) *code = e;
+  return m ? m : "(null)";
+}
+
+/// A reconstructor set up for `scene` with object IDs.
+DCMReconstructor Make(Scene& scene, int flags = DCM_SAMPLE_THREAD_SAFE) {
+  DCMReconstructor r = dcmNewReconstructor();
+  std::vector<uint32_t> ids(size_t(scene.width * scene.height));
+  for (int y = 0; y < scene.height; ++y)
+    for (int x = 0; x < scene.width; ++x) ids[size_t(y * scene.width + x)] = x < scene.split ? 1u : 2u;
+  dcmSetImageSize(r, scene.width, scene.height);
+  dcmSetObjectIds(r, ids.data());
+  dcmSetSampleFunction(r, Evaluate, &scene, flags);
+  return r;
+}
+
+TEST(CApi, VersionMatchesHeader) {
+  EXPECT_EQ(dcmGetApiVersion(), DCM_C_API_VERSION);
+  EXPECT_STRNE(dcmGetVersionString(), "unknown");
+  EXPECT_STREQ(dcmSampleReasonName(DCM_REASON_CORNER), "corner");
+  EXPECT_STREQ(dcmSampleReasonName(DCM_REASON_INTERPOLATED), "interpolated");
+  EXPECT_STREQ(dcmSampleReasonName(DCM_REASON_COUNT), "?");
+  EXPECT_STREQ(dcmSampleReasonName(-1), "?");
+}
+
+TEST(CApi, MethodPresetsResetEveryOption) {
+  DCMReconstructor r = dcmNewReconstructor();
+  ASSERT_NE(r, nullptr);
+  // dcm's defaults (whatever their values) are what method "dcm" restores.
+  const int block = dcmGetInt(r, "elementary_block");
+  const float threshold = dcmGetFloat(r, "contrast_threshold");
+  EXPECT_EQ(dcmGetBool(r, "surface_aware"), 1);
+  EXPECT_EQ(dcmGetBool(r, "adaptive_borders"), 1);
+  dcmSetInt(r, "elementary_block", block * 2);
+  dcmSetFloat(r, "contrast_threshold", threshold + 1.f);
+  dcmSetBool(r, "surface_aware", 0);
+  dcmSetString(r, "method", "dcm");
+  EXPECT_EQ(dcmGetInt(r, "elementary_block"), block) << "a preset resets overrides";
+  EXPECT_EQ(dcmGetFloat(r, "contrast_threshold"), threshold);
+  EXPECT_EQ(dcmGetBool(r, "surface_aware"), 1);
+  // The published methods (Guo 1998; Scheel et al. 2001).
+  dcmSetString(r, "method", "paper");
+  EXPECT_EQ(dcmGetBool(r, "surface_aware"), 0);
+  EXPECT_EQ(dcmGetBool(r, "texture_split"), 1);
+  EXPECT_EQ(dcmGetBool(r, "fallback"), 1);
+  EXPECT_EQ(dcmGetBool(r, "adaptive_borders"), 0);
+  dcmSetString(r, "method", "guo");
+  EXPECT_EQ(dcmGetBool(r, "surface_aware"), 0);
+  EXPECT_EQ(dcmGetBool(r, "texture_split"), 0);
+  EXPECT_EQ(dcmGetBool(r, "fallback"), 0);
+  DCMError code;
+  EXPECT_EQ(TakeError(r, &code), "");
+  EXPECT_EQ(code, DCM_ERROR_NONE);
+  dcmReleaseReconstructor(r);
+}
+
+TEST(CApi, SettersMapToOptions) {
+  DCMReconstructor r = dcmNewReconstructor();
+  dcmSetInt(r, "min_block", 2);
+  dcmSetFloat(r, "contrast_threshold", 0.125f);
+  dcmSetFloat(r, "batch_size", 512.f);
+  dcmSetBool(r, "lazy_evaluation", 0);
+  dcmSetInt(r, "full_evaluation", 1);
+  EXPECT_EQ(dcmGetInt(r, "min_block"), 2);
+  EXPECT_FLOAT_EQ(dcmGetFloat(r, "contrast_threshold"), 0.125f);
+  EXPECT_EQ(dcmGetInt(r, "batch_size"), 512);
+  EXPECT_EQ(dcmGetBool(r, "lazy_evaluation"), 0);
+  EXPECT_EQ(dcmGetBool(r, "full_evaluation"), 1);
+  EXPECT_EQ(TakeError(r), "");
+  dcmSetFloat(r, "batch_size", 1.5f);
+  DCMError code;
+  EXPECT_NE(TakeError(r, &code).find("whole number"), std::string::npos);
+  EXPECT_EQ(code, DCM_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(dcmGetInt(r, "batch_size"), 512);
+  dcmReleaseReconstructor(r);
+}
+
+TEST(CApi, UnknownNamesAndValuesAreErrorsOnTheHandle) {
+  DCMReconstructor r = dcmNewReconstructor();
+  dcmSetInt(r, "no_such_option", 3);
+  dcmSetString(r, "object_test", "bogus");  // second error: the first one is kept
+  DCMError code;
+  const std::string m = TakeError(r, &code);
+  EXPECT_EQ(code, DCM_ERROR_INVALID_ARGUMENT);
+  EXPECT_NE(m.find("no_such_option"), std::string::npos) << m;
+  EXPECT_EQ(TakeError(r, &code), "") << "dcmGetError clears the error";
+  EXPECT_EQ(code, DCM_ERROR_NONE);
+  dcmSetString(r, "object_test", "bogus");
+  EXPECT_NE(TakeError(r, &code).find("bogus"), std::string::npos);
+  dcmSetString(r, "thin_objects", nullptr);
+  EXPECT_NE(TakeError(r, &code).find("NULL value"), std::string::npos);
+  dcmSetBool(r, "elementary_block", 1);  // not a bool option
+  EXPECT_EQ(code, DCM_ERROR_INVALID_ARGUMENT);
+  EXPECT_NE(TakeError(r, &code).find("unknown bool option"), std::string::npos);
+  EXPECT_EQ(dcmGetFloat(r, "surface_aware"), 0.f);
+  EXPECT_NE(TakeError(r, &code).find("unknown float option"), std::string::npos);
+  dcmSetString(r, nullptr, "x");
+  EXPECT_NE(TakeError(r, &code).find("NULL option name"), std::string::npos);
+  dcmReleaseReconstructor(r);
+}
+
+TEST(CApi, NullHandleErrorsArePerThread) {
+  DCMError code;
+  TakeError(nullptr);
+  dcmSetInt(nullptr, "threads", 1);
+  dcmExecute(nullptr);
+  const std::string m = TakeError(nullptr, &code);
+  EXPECT_EQ(code, DCM_ERROR_INVALID_ARGUMENT);
+  EXPECT_NE(m.find("dcmSetInt: NULL reconstructor"), std::string::npos) << m;
+  EXPECT_EQ(TakeError(nullptr, &code), "");
+  EXPECT_EQ(code, DCM_ERROR_NONE);
+  EXPECT_EQ(dcmGetImage(nullptr, nullptr, nullptr), nullptr);
+  EXPECT_EQ(TakeError(nullptr, &code).find("dcmGetImage"), 0u);
+  dcmReleaseReconstructor(nullptr);  // ignored
+  EXPECT_EQ(TakeError(nullptr, &code), "");
+}
+
+TEST(CApi, ExecuteNeedsSizeAndSampleFunction) {
+  DCMReconstructor r = dcmNewReconstructor();
+  EXPECT_EQ(dcmExecute(r), DCM_ERROR_INVALID_OPERATION);
+  EXPECT_NE(TakeError(r).find("dcmSetImageSize"), std::string::npos);
+  uint32_t id = 1;
+  dcmSetObjectIds(r, &id);
+  EXPECT_NE(TakeError(r).find("call dcmSetImageSize() first"), std::string::npos);
+  dcmSetImageSize(r, 0, 5);
+  EXPECT_NE(TakeError(r).find("unusable size 0x5"), std::string::npos);
+  dcmSetImageSize(r, 16, 16);
+  EXPECT_EQ(dcmExecute(r), DCM_ERROR_INVALID_OPERATION);
+  EXPECT_NE(TakeError(r).find("dcmSetSampleFunction"), std::string::npos);
+  EXPECT_EQ(dcmGetImage(r, nullptr, nullptr), nullptr);
+  EXPECT_NE(TakeError(r).find("no result"), std::string::npos);
+  EXPECT_EQ(dcmGetStat(r, "exact_fraction"), 0.0);
+  EXPECT_NE(TakeError(r).find("no result"), std::string::npos);
+  dcmReleaseReconstructor(r);
+}
+
+TEST(CApi, ReconstructsTwoSurfacesWithFewExactPixels) {
+  Scene scene;
+  DCMReconstructor r = Make(scene);
+  dcmSetInt(r, "threads", 2);
+  dcmSetInt(r, "batch_size", 64);
+  ASSERT_EQ(dcmExecute(r), DCM_ERROR_NONE) << TakeError(r);
+  int w = 0, h = 0, mw = 0, mh = 0;
+  const float* img = dcmGetImage(r, &w, &h);
+  const uint8_t* map = dcmGetSampleMap(r, &mw, &mh);
+  ASSERT_NE(img, nullptr);
+  ASSERT_NE(map, nullptr);
+  ASSERT_EQ(w, scene.width);
+  ASSERT_EQ(h, scene.height);
+  ASSERT_EQ(mw, scene.width);
+  ASSERT_EQ(mh, scene.height);
+  long exact = 0;
+  double maxErr = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      float L[3];
+      scene.Truth(x, y, L);
+      for (int c = 0; c < 3; ++c) maxErr = std::max(maxErr, double(std::fabs(img[3 * (y * w + x) + c] - L[c])));
+      ASSERT_LT(map[y * w + x], DCM_REASON_COUNT);
+      if (map[y * w + x] != DCM_REASON_INTERPOLATED) ++exact;
+    }
+  EXPECT_LT(maxErr, 1e-4) << "a linear ramp per surface is reconstructed exactly";
+  EXPECT_EQ(exact, scene.evaluated.load()) << "every exact pixel once, through the callback";
+  EXPECT_EQ(double(exact), dcmGetStat(r, "exact_pixels"));
+  EXPECT_EQ(double(w * h), dcmGetStat(r, "total_pixels"));
+  EXPECT_GT(dcmGetStat(r, "exact_fraction"), 0.0);
+  EXPECT_LT(dcmGetStat(r, "exact_fraction"), 0.5);
+  EXPECT_GT(dcmGetStat(r, "provider_calls"), 1.0);
+  EXPECT_FALSE(scene.sawSplitBuffers.load()) << "no texture guide: no split buffers";
+  EXPECT_FALSE(scene.sawOutOfRange.load());
+  dcmGetStat(r, "no_such_stat");
+  EXPECT_NE(TakeError(r).find("no_such_stat"), std::string::npos);
+  dcmReleaseReconstructor(r);
+}
+
+TEST(CApi, FullEvaluationEvaluatesEveryPixel) {
+  Scene scene;
+  DCMReconstructor r = Make(scene);
+  dcmSetBool(r, "full_evaluation", 1);
+  ASSERT_EQ(dcmExecute(r), DCM_ERROR_NONE) << TakeError(r);
+  EXPECT_EQ(dcmGetStat(r, "exact_fraction"), 1.0);
+  EXPECT_EQ(scene.evaluated.load(), long(scene.width * scene.height));
+  dcmReleaseReconstructor(r);
+}
+
+TEST(CApi, CallbackFailureStopsWithCallbackError) {
+  Scene scene;
+  scene.failWith = 7;
+  DCMReconstructor r = Make(scene);
+  DCMError code;
+  EXPECT_EQ(dcmExecute(r), DCM_ERROR_CALLBACK);
+  const std::string m = TakeError(r, &code);
+  EXPECT_EQ(code, DCM_ERROR_CALLBACK);
+  EXPECT_NE(m.find("returned 7"), std::string::npos) << m;
+  EXPECT_EQ(dcmGetImage(r, nullptr, nullptr), nullptr) << "no result after a failure";
+  TakeError(r);
+  scene.failWith = 0;
+  EXPECT_EQ(dcmExecute(r), DCM_ERROR_NONE) << "the handle is usable again";
+  dcmReleaseReconstructor(r);
+}
+
+TEST(CApi, InvalidOptionValuesAreReportedByExecute) {
+  Scene scene;
+  DCMReconstructor r = Make(scene);
+  dcmSetInt(r, "elementary_block", 6);
+  DCMError code;
+  EXPECT_EQ(dcmExecute(r), DCM_ERROR_RECONSTRUCTION);
+  const std::string m = TakeError(r, &code);
+  EXPECT_NE(m.find("elementaryBlock"), std::string::npos) << m;
+  EXPECT_EQ(scene.evaluated.load(), 0);
+  dcmReleaseReconstructor(r);
+}
+
+TEST(CApi, NotThreadSafeCallbackIsCalledFromOneThreadAtATime) {
+  Scene scene;
+  scene.width = 256;
+  scene.height = 256;
+  DCMReconstructor r = Make(scene, 0);
+  dcmSetInt(r, "threads", 4);
+  dcmSetInt(r, "batch_size", 16);
+  ASSERT_EQ(dcmExecute(r), DCM_ERROR_NONE) << TakeError(r);
+  EXPECT_EQ(scene.maxInFlight.load(), 1);
+  EXPECT_GT(dcmGetStat(r, "provider_calls"), 4.0);
+  dcmReleaseReconstructor(r);
+}
+
+TEST(CApi, SplitBuffersWithTextureAndFlag) {
+  Scene scene;
+  DCMReconstructor r = Make(scene, DCM_SAMPLE_SPLIT);
+  std::vector<float> tau(size_t(3 * scene.width * scene.height), 1.f);
+  dcmSetTexture(r, tau.data());
+  ASSERT_EQ(dcmExecute(r), DCM_ERROR_NONE) << TakeError(r);
+  EXPECT_TRUE(scene.sawSplitBuffers.load());
+  dcmReleaseReconstructor(r);
+}
+
+TEST(CApi, DownsampleGivesTheOutputResolution) {
+  Scene scene;
+  DCMReconstructor r = Make(scene);
+  dcmSetInt(r, "downsample", 2);
+  ASSERT_EQ(dcmExecute(r), DCM_ERROR_NONE) << TakeError(r);
+  int w = 0, h = 0, mw = 0, mh = 0;
+  ASSERT_NE(dcmGetImage(r, &w, &h), nullptr);
+  ASSERT_NE(dcmGetSampleMap(r, &mw, &mh), nullptr);
+  EXPECT_EQ(w, scene.width / 2);
+  EXPECT_EQ(h, scene.height / 2);
+  EXPECT_EQ(mw, scene.width);
+  EXPECT_EQ(mh, scene.height);
+  dcmSetInt(r, "downsample", 5);
+  EXPECT_EQ(dcmExecute(r), DCM_ERROR_INVALID_ARGUMENT);
+  EXPECT_NE(TakeError(r).find("not a multiple of downsample 5"), std::string::npos);
+  dcmReleaseReconstructor(r);
+}
+
+TEST(CApi, ProgressIsReported) {
+  Scene scene;
+  DCMReconstructor r = Make(scene);
+  struct P {
+    int calls = 0;
+    float last = -1;
+    bool stageNamed = true;
+  } p;
+  dcmSetProgressFunction(
+      r,
+      [](void* u, float f, const char* stage) {
+        auto* pp = static_cast<P*>(u);
+        if (!stage || !*stage) pp->stageNamed = false;
+        pp->last = f;
+        ++pp->calls;
+      },
+      &p);
+  ASSERT_EQ(dcmExecute(r), DCM_ERROR_NONE) << TakeError(r);
+  EXPECT_GT(p.calls, 0);
+  EXPECT_LE(p.last, 1.f);
+  EXPECT_TRUE(p.stageNamed);
+  dcmReleaseReconstructor(r);
+}
+
+TEST(CApi, RetainKeepsTheHandleAlive) {
+  Scene scene;
+  DCMReconstructor r = Make(scene);
+  dcmRetainReconstructor(r);
+  dcmReleaseReconstructor(r);
+  EXPECT_EQ(dcmExecute(r), DCM_ERROR_NONE) << "still alive after one release";
+  dcmReleaseReconstructor(r);
+}
+
+}  // namespace

@@ -1,0 +1,383 @@
+// PipeProvider and `dcm pipe` against the Python example provider
+// (examples/provider-python) and faulty variants of it (faulty_provider.py).
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "common/image_io.h"
+#include "dcm/pipe/pipe_provider.h"
+#include "dcm/reconstructor.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string Analytic(const std::string& args = "") {
+  return std::string(DCM_PYTHON3) + " " + DCM_ANALYTIC_PROVIDER + (args.empty() ? "" : " " + args);
+}
+std::string Faulty(const std::string& mode) { return std::string(DCM_PYTHON3) + " " + DCM_FAULTY_PROVIDER + " " + mode; }
+
+dcm::Status Start(const std::string& command, std::unique_ptr<dcm::pipe::PipeProvider>* p, double timeout = 60) {
+  dcm::pipe::PipeOptions o;
+  o.command = command;
+  o.timeoutSeconds = timeout;
+  o.startupTimeoutSeconds = 120;  // python3 + numpy on a loaded machine
+  return dcm::pipe::PipeProvider::Start(o, p);
+}
+
+bool Contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+/// A fresh, empty directory for one test.
+class TempDir {
+ public:
+  TempDir() {
+    char tmpl[] = "/tmp/dcm-pipe-test.XXXXXX";
+    path_ = mkdtemp(tmpl);
+  }
+  ~TempDir() { fs::remove_all(path_); }
+  std::string operator/(const std::string& name) const { return (fs::path(path_) / name).string(); }
+  bool empty() const { return fs::is_empty(path_); }
+
+ private:
+  std::string path_;
+};
+
+/// Runs a shell command; returns its exit status and its stdout+stderr.
+int RunShell(const std::string& command, std::string* output) {
+  FILE* p = popen((command + " 2>&1").c_str(), "r");
+  if (!p) return -1;
+  output->clear();
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) output->append(buf, n);
+  const int status = pclose(p);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+std::string Quoted(const std::string& s) { return "'" + s + "'"; }
+
+// --- PipeProvider ------------------------------------------------------------
+
+TEST(PipeProvider, HandshakeAnnouncesTheScene) {
+  std::unique_ptr<dcm::pipe::PipeProvider> p;
+  ASSERT_TRUE(Start(Analytic("--width 40 --height 24"), &p).ok());
+  const dcm::ProviderCapabilities c = p->Capabilities();
+  EXPECT_EQ(c.width, 40);
+  EXPECT_EQ(c.height, 24);
+  EXPECT_TRUE(c.objectId);
+  EXPECT_TRUE(c.shaderId);
+  EXPECT_TRUE(c.texture);
+  EXPECT_TRUE(c.splitRadiance);
+  EXPECT_FALSE(c.variance);
+  EXPECT_FALSE(c.threadSafe);
+  EXPECT_EQ(c.name, "analytic-python");
+  EXPECT_EQ(p->childProtocolVersion(), 1);
+  EXPECT_TRUE(p->Finish().ok());
+}
+
+TEST(PipeProvider, GuidesAndSamplesAgree) {
+  std::unique_ptr<dcm::pipe::PipeProvider> p;
+  ASSERT_TRUE(Start(Analytic("--width 64 --height 48"), &p).ok());
+  const dcm::Bounds2i region{{10, 5}, {60, 40}};
+  dcm::GuideImage g;
+  ASSERT_TRUE(p->Guides(region, {true, true, true}, &g).ok());
+  ASSERT_EQ(g.region, region);
+  ASSERT_EQ(g.objectId.size(), size_t(region.area()));
+  ASSERT_EQ(g.shaderId.size(), size_t(region.area()));
+  ASSERT_EQ(g.texture.size(), size_t(region.area()));
+  int objects[4] = {0, 0, 0, 0};
+  for (uint32_t id : g.objectId) {
+    ASSERT_GE(id, 1u);
+    ASSERT_LE(id, 3u);
+    ++objects[id];
+  }
+  EXPECT_GT(objects[1], 0);
+  EXPECT_GT(objects[2], 0);
+  EXPECT_GT(objects[3], 0) << "the thin bar crosses the region";
+  // Only what is asked for.
+  dcm::GuideImage ids;
+  ASSERT_TRUE(p->Guides(region, {true, false, false}, &ids).ok());
+  EXPECT_EQ(ids.objectId, g.objectId);
+  EXPECT_TRUE(ids.shaderId.empty());
+  EXPECT_TRUE(ids.texture.empty());
+
+  std::vector<dcm::Point2i> px;
+  for (int y = region.min.y; y < region.max.y; y += 3)
+    for (int x = region.min.x; x < region.max.x; x += 2) px.push_back({x, y});
+  std::vector<dcm::ExactSample> s(px.size());
+  ASSERT_TRUE(p->Evaluate(px, {true, false}, s).ok());
+  for (size_t i = 0; i < px.size(); ++i) {
+    const dcm::RGB tau = g.texture[size_t(region.offset(px[i]))];
+    const dcm::RGB L = s[i].Li * tau + s[i].Lc;
+    ASSERT_NEAR(L.r, s[i].L.r, 1e-5f);
+    ASSERT_NEAR(L.g, s[i].L.g, 1e-5f);
+    ASSERT_NEAR(L.b, s[i].L.b, 1e-5f);
+  }
+  // The same pixel gives the same bits in another batch.
+  std::vector<dcm::ExactSample> one(1);
+  ASSERT_TRUE(p->Evaluate(std::span(px).subspan(7, 1), {false, false}, one).ok());
+  EXPECT_EQ(one[0].L, s[7].L);
+  EXPECT_TRUE(p->Finish().ok());
+  EXPECT_FALSE(p->Evaluate(px, {false, false}, s).ok()) << "no requests after Finish()";
+}
+
+TEST(PipeProvider, ReconstructsWithFewExactPixels) {
+  std::unique_ptr<dcm::pipe::PipeProvider> p;
+  ASSERT_TRUE(Start(Analytic("--width 96 --height 64"), &p).ok());
+  dcm::Reconstruction r;
+  ASSERT_TRUE(dcm::Reconstruct(*p, dcm::ReconstructionOptions{}, &r).ok());
+  EXPECT_GT(r.stats.exactFraction(), 0.0);
+  EXPECT_LT(r.stats.exactFraction(), 0.5);
+  EXPECT_TRUE(r.stats.usedSplit);
+  EXPECT_TRUE(r.stats.usedShaderId);
+  EXPECT_TRUE(p->Finish().ok());
+}
+
+TEST(PipeProvider, UnknownHandshakeKeysAndCapabilitiesAreIgnored) {
+  std::unique_ptr<dcm::pipe::PipeProvider> p;
+  ASSERT_TRUE(
+      Start("printf 'dcm-pipe 1 width=4 height=3 caps=object_id,hyperspectral colour=blue\\n'; cat >/dev/null", &p)
+          .ok());
+  EXPECT_EQ(p->Capabilities().width, 4);
+  EXPECT_EQ(p->Capabilities().height, 3);
+  EXPECT_TRUE(p->Capabilities().objectId);
+  EXPECT_FALSE(p->Capabilities().texture);
+  EXPECT_EQ(p->Capabilities().name, "pipe");
+  EXPECT_TRUE(p->Finish().ok());
+}
+
+/// Starts `command` and drives it through guides and one batch; returns the
+/// first error.
+dcm::Status Drive(const std::string& command, double timeout = 60) {
+  std::unique_ptr<dcm::pipe::PipeProvider> p;
+  DCM_RETURN_IF_ERROR(Start(command, &p, timeout));
+  const dcm::ProviderCapabilities c = p->Capabilities();
+  dcm::GuideImage g;
+  DCM_RETURN_IF_ERROR(p->Guides({{0, 0}, {c.width, c.height}}, {true, true, true}, &g));
+  std::vector<dcm::Point2i> px{{0, 0}, {1, 2}, {3, 1}, {c.width - 1, c.height - 1}};
+  std::vector<dcm::ExactSample> s(px.size());
+  DCM_RETURN_IF_ERROR(p->Evaluate(px, {true, false}, s));
+  return p->Finish();
+}
+
+struct FaultCase {
+  const char* mode;
+  const char* message;
+};
+/// For gtest's messages.
+void PrintTo(const FaultCase& f, std::ostream* os) { *os << f.mode; }
+
+class PipeFault : public ::testing::TestWithParam<FaultCase> {};
+
+TEST_P(PipeFault, BecomesAClearError) {
+  const FaultCase& f = GetParam();
+  const std::string command = Faulty(f.mode);
+  const dcm::Status st = Drive(command, 5);
+  ASSERT_FALSE(st.ok());
+  EXPECT_TRUE(Contains(st.message(), "provider '" + command + "': ")) << st.message();
+  EXPECT_TRUE(Contains(st.message(), f.message)) << st.message();
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Modes, PipeFault,
+    ::testing::Values(
+        FaultCase{"crash-on-eval", "(signal 11, Segmentation fault)"},
+        FaultCase{"exit-on-eval", "closed its output instead of answering 'eval 4 L,split' (it exited with status 3)"},
+        FaultCase{"garbage-on-eval", "sent '\\x00\\xff\\x13garbage \\x80\\x81' in answer to 'eval 4 L,split'"},
+        FaultCase{"garbage-handshake", "sent 'HELLO I am a renderer' in answer to 'dcm-pipe 1'"},
+        FaultCase{"wrong-count", "answered 'samples 3' to 'eval 4 L,split', which asks for 4 pixels"},
+        FaultCase{"short-payload", "closed its output in the middle of its answer to 'eval 4 L,split'"},
+        FaultCase{"error-on-guides", "reported an error: scene file 'missing.scn' not found"},
+        FaultCase{"bad-version", "speaks dcm-pipe protocol version 99, dcm speaks version 1"},
+        FaultCase{"long-line", "sent a line longer than 4096 bytes"},
+        FaultCase{"exit-after-quit", "exited with status 5 after 'quit'"}),
+    [](const ::testing::TestParamInfo<FaultCase>& param) {
+      std::string n = param.param.mode;
+      for (char& c : n)
+        if (c == '-') c = '_';
+      return n;
+    });
+
+TEST(PipeProvider, TimeoutKillsTheChild) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const dcm::Status st = Drive(Faulty("hang-on-eval"), 0.5);
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_FALSE(st.ok());
+  EXPECT_TRUE(Contains(st.message(), "did not answer 'eval 4 L,split' within 0.5 s (killed)")) << st.message();
+  EXPECT_LT(s, 30.0) << "the hanging child (sleep 120) was killed";
+}
+
+TEST(PipeProvider, MissingCommandAndBadHandshakes) {
+  dcm::Status st = Drive("/nonexistent/renderer --fast");
+  EXPECT_TRUE(Contains(st.message(), "closed its output instead of answering 'dcm-pipe 1' (it exited with status 127)"))
+      << st.message();
+  st = Drive("printf 'dcm-pipe 1 height=4\\n'; cat >/dev/null");
+  EXPECT_TRUE(Contains(st.message(), "handshake without width= and height=")) << st.message();
+  st = Drive("printf 'dcm-pipe 1 width=0 height=4\\n'; cat >/dev/null");
+  EXPECT_TRUE(Contains(st.message(), "width must be from 1 to 131072, got '0'")) << st.message();
+  st = Drive("printf 'dcm-pipe one width=4 height=4\\n'; cat >/dev/null");
+  EXPECT_TRUE(Contains(st.message(), "handshake without a protocol version")) << st.message();
+  dcm::pipe::PipeOptions o;
+  std::unique_ptr<dcm::pipe::PipeProvider> p;
+  EXPECT_FALSE(dcm::pipe::PipeProvider::Start(o, &p).ok()) << "empty command";
+  EXPECT_EQ(p, nullptr);
+}
+
+TEST(PipeProvider, AfterAFailureEveryCallReturnsTheSameError) {
+  std::unique_ptr<dcm::pipe::PipeProvider> p;
+  ASSERT_TRUE(Start(Faulty("wrong-count"), &p).ok());
+  std::vector<dcm::Point2i> px{{0, 0}, {1, 1}};
+  std::vector<dcm::ExactSample> s(px.size());
+  const dcm::Status first = p->Evaluate(px, {false, false}, s);
+  ASSERT_FALSE(first.ok());
+  EXPECT_EQ(p->Evaluate(px, {false, false}, s).message(), first.message());
+  dcm::GuideImage g;
+  EXPECT_EQ(p->Guides({{0, 0}, {2, 2}}, {true, false, false}, &g).message(), first.message());
+  EXPECT_EQ(p->Finish().message(), first.message());
+}
+
+TEST(PipeProvider, DestructionWithoutFinishEndsAStubbornChild) {
+  TempDir dir;
+  const std::string pidFile = dir / "sleep.pid";
+  std::unique_ptr<dcm::pipe::PipeProvider> p;
+  // The shell ignores 'quit' and waits for a grandchild (sleep).
+  ASSERT_TRUE(Start("printf 'dcm-pipe 1 width=4 height=4\\n'; sleep 30 & echo $! > " + pidFile + "; wait", &p).ok());
+  // The pid file is written right after the handshake; wait for it.
+  for (int i = 0; i < 500 && (!fs::exists(pidFile) || fs::is_empty(pidFile)); ++i) ::usleep(10000);
+  std::ifstream pf(pidFile);
+  pid_t sleeper = 0;
+  pf >> sleeper;
+  ASSERT_GT(sleeper, 0);
+  ASSERT_EQ(::kill(sleeper, 0), 0) << "the grandchild runs";
+  const auto t0 = std::chrono::steady_clock::now();
+  p.reset();
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_LT(s, 10.0);
+  EXPECT_GE(s, 1.5) << "it was given time to quit";
+  bool gone = false;
+  for (int i = 0; i < 300 && !gone; ++i) {  // init reaps the orphan
+    gone = ::kill(sleeper, 0) != 0;
+    if (!gone) ::usleep(10000);
+  }
+  EXPECT_TRUE(gone) << "the whole process group was killed";
+}
+
+// --- dcm pipe ----------------------------------------------------------------
+
+TEST(DcmPipe, ReconstructsTheAnalyticScene) {
+  TempDir dir;
+  const std::string out = dir / "out.exr", stats = dir / "stats.json", count = dir / "count.txt",
+                    truth = dir / "truth.raw", map = dir / "map.png";
+  std::string log;
+  ASSERT_EQ(RunShell(Analytic("--width 192 --height 144 --truth " + truth), &log), 0) << log;
+  const int rc = RunShell(std::string(DCM_BINARY) + " pipe --quiet --provider-cmd " +
+                         Quoted(Analytic("--width 192 --height 144 --count-file " + count)) + " -o " + out +
+                         " --stats " + stats + " --sample-map " + map,
+                     &log);
+  ASSERT_EQ(rc, 0) << log;
+  EXPECT_TRUE(Contains(log, "exact pixels")) << log;
+  ASSERT_TRUE(fs::exists(out));
+  ASSERT_TRUE(fs::exists(map));
+
+  std::ifstream js(stats);
+  const nlohmann::json j = nlohmann::json::parse(js);
+  const double fraction = j.at("exact_fraction").get<double>();
+  const int64_t exact = j.at("exact_pixels").get<int64_t>(), total = j.at("total_pixels").get<int64_t>();
+  EXPECT_EQ(total, 192 * 144);
+  EXPECT_GT(fraction, 0.0);
+  EXPECT_LT(fraction, 0.15);
+  EXPECT_DOUBLE_EQ(fraction, double(exact) / double(total));
+  EXPECT_EQ(j.at("provider").get<std::string>(), "pipe");
+  // The provider evaluated exactly the exact pixels, each once.
+  std::ifstream cf(count);
+  int64_t evaluated = -1;
+  cf >> evaluated;
+  EXPECT_EQ(evaluated, exact);
+
+  int w = 0, h = 0;
+  std::vector<dcm::RGB> img;
+  ASSERT_TRUE(dcm::toolkit::ReadRgb(out, &w, &h, &img).ok());
+  ASSERT_EQ(w, 192);
+  ASSERT_EQ(h, 144);
+  std::vector<float> ref(size_t(w * h * 3));
+  std::ifstream tf(truth, std::ios::binary);
+  tf.read(reinterpret_cast<char*>(ref.data()), std::streamsize(ref.size() * 4));
+  ASSERT_TRUE(tf.good());
+  double sum = 0;
+  for (size_t i = 0; i < img.size(); ++i)
+    for (int c = 0; c < 3; ++c) sum += std::fabs(double(img[i][c]) - double(ref[3 * i + size_t(c)]));
+  EXPECT_LT(sum / double(3 * img.size()), 0.005) << "mean absolute error against the analytic image";
+}
+
+TEST(DcmPipe, FullEvaluationAsksForEveryPixel) {
+  TempDir dir;
+  std::string log;
+  const int rc = RunShell(std::string(DCM_BINARY) + " pipe --quiet --full --provider-cmd " +
+                         Quoted(Analytic("--width 32 --height 32 --count-file " + (dir / "count.txt"))) + " -o " +
+                         (dir / "out.exr"),
+                     &log);
+  ASSERT_EQ(rc, 0) << log;
+  std::ifstream cf(dir / "count.txt");
+  int64_t evaluated = -1;
+  cf >> evaluated;
+  EXPECT_EQ(evaluated, 32 * 32);
+  EXPECT_TRUE(Contains(log, "100.00 %")) << log;
+}
+
+class DcmPipeFault : public ::testing::TestWithParam<FaultCase> {};
+
+TEST_P(DcmPipeFault, ExitsWithAMessageAndNoOutput) {
+  const FaultCase& f = GetParam();
+  TempDir dir;
+  std::string log;
+  const int rc = RunShell(std::string(DCM_BINARY) + " pipe --quiet --provider-timeout 2 --provider-startup-timeout 120 --provider-cmd " +
+                         Quoted(Faulty(f.mode)) + " -o " + (dir / "out.exr") + " --stats " + (dir / "s.json") +
+                         " --sample-map " + (dir / "m.png"),
+                     &log);
+  EXPECT_EQ(rc, 1) << log;
+  EXPECT_TRUE(Contains(log, "dcm pipe: error: provider '")) << log;
+  EXPECT_TRUE(Contains(log, f.message)) << log;
+  EXPECT_TRUE(dir.empty()) << "no output, not even a temporary file";
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Modes, DcmPipeFault,
+    ::testing::Values(FaultCase{"crash-on-eval", "Segmentation fault"},
+                      FaultCase{"exit-on-eval", "(it exited with status 3)"},
+                      FaultCase{"garbage-on-eval", "garbage"},
+                      FaultCase{"wrong-count", "which asks for"},
+                      FaultCase{"short-payload", "in the middle of its answer"},
+                      FaultCase{"hang-on-eval", "within 2 s (killed)"},
+                      FaultCase{"exit-after-quit", "exited with status 5 after 'quit'"}),
+    [](const ::testing::TestParamInfo<FaultCase>& param) {
+      std::string n = param.param.mode;
+      for (char& c : n)
+        if (c == '-') c = '_';
+      return n;
+    });
+
+TEST(DcmPipe, UsageErrors) {
+  std::string log;
+  EXPECT_EQ(RunShell(std::string(DCM_BINARY) + " pipe -o /tmp/never.exr", &log), 2) << log;
+  EXPECT_TRUE(Contains(log, "--provider-cmd")) << log;
+  TempDir dir;
+  EXPECT_EQ(RunShell(std::string(DCM_BINARY) + " pipe --quiet --downsample 5 --provider-cmd " +
+                    Quoted(Analytic("--width 32 --height 32")) + " -o " + (dir / "o.exr"),
+                &log),
+            2)
+      << log;
+  EXPECT_TRUE(Contains(log, "not a multiple of --downsample 5")) << log;
+  EXPECT_TRUE(dir.empty());
+}
+
+}  // namespace

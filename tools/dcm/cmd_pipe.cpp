@@ -1,0 +1,137 @@
+// dcm pipe: an out-of-process renderer as the provider. dcm starts
+// --provider-cmd as a child process and speaks the dcm-pipe protocol
+// (plugins/pipe/PROTOCOL.md) on its stdin/stdout: guides once, then batches of
+// pixels to evaluate exactly. Any failure of the child ends the command with a
+// message, exit status 1 and no output file.
+//
+// Compiles to nothing unless the dcm_pipe library is linked (DCM_HAVE_PIPE).
+#ifdef DCM_HAVE_PIPE
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "commands.h"
+#include "common/image_io.h"
+#include "common/progress.h"
+#include "common/sample_map.h"
+#include "common/stats_json.h"
+#include "dcm/pipe/pipe_provider.h"
+#include "dcm/reconstructor.h"
+#include "engine_flags.h"
+
+namespace dcm::cli {
+namespace {
+
+struct PipeFlags {
+  std::string command;
+  std::string output;
+  std::string stats;
+  std::string sampleMap;
+  double timeout = 600.0;
+  double startupTimeout = 600.0;
+  EngineFlags engine;
+};
+
+int Fail(const std::string& message, int code = kExitFailure) {
+  std::cerr << "dcm pipe: error: " << message << "\n";
+  return code;
+}
+
+int RunPipe(const PipeFlags& f) {
+  ReconstructionOptions options;
+  if (Status st = ToOptions(f.engine, &options); !st.ok()) return Fail(st.message(), kExitUsage);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  std::unique_ptr<pipe::PipeProvider> provider;
+  pipe::PipeOptions po;
+  po.command = f.command;
+  po.timeoutSeconds = f.timeout;
+  po.startupTimeoutSeconds = f.startupTimeout;
+  if (Status st = pipe::PipeProvider::Start(po, &provider); !st.ok()) return Fail(st.message());
+  const ProviderCapabilities caps = provider->Capabilities();
+  if (f.engine.verbose) {
+    std::cerr << "provider '" << caps.name << "' (dcm-pipe " << provider->childProtocolVersion() << "): "
+              << caps.width << "x" << caps.height << (caps.objectId ? ", object IDs" : "")
+              << (caps.shaderId ? ", shader IDs" : "") << (caps.texture ? ", texture" : "")
+              << (caps.splitRadiance ? ", split radiance" : "") << "\n";
+  }
+  if (caps.width % options.downsample != 0 || caps.height % options.downsample != 0) {
+    return Fail("the provider's image " + std::to_string(caps.width) + "x" + std::to_string(caps.height) +
+                    " is not a multiple of --downsample " + std::to_string(options.downsample),
+                kExitUsage);
+  }
+
+  toolkit::Progress progress(!f.engine.quiet);
+  options.progress = [&](float v, std::string_view stage) { progress.Update(v, stage); };
+  Reconstruction rec;
+  Status st = Reconstruct(*provider, options, &rec);
+  progress.Done();
+  if (!st.ok()) return Fail(st.message());
+  // The child must end cleanly before anything is written.
+  if (Status fin = provider->Finish(); !fin.ok()) return Fail(fin.message());
+  const double wallS = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const ReconstructionStats& stats = rec.stats;
+  const std::string method = options.fullEvaluation ? "full" : f.engine.method;
+
+  toolkit::Metadata meta;
+  meta.strings.push_back({"dcm:provider", "pipe"});
+  meta.strings.push_back({"dcm:provider_name", caps.name});
+  meta.strings.push_back({"dcm:method", method});
+  meta.strings.push_back({"dcm:options", toolkit::OptionsToJson(options).dump()});
+  meta.floats.push_back({"dcm:exact_fraction", float(stats.exactFraction())});
+  meta.floats.push_back({"dcm:time_illum_s", float(stats.timeProviderS)});
+  meta.floats.push_back({"dcm:time_dcm_s", float(stats.timeEngineS)});
+  if (Status w = toolkit::WriteRgbExr(f.output, rec.width, rec.height, rec.image, meta); !w.ok())
+    return Fail(w.message());
+  if (!f.sampleMap.empty()) {
+    if (Status w = toolkit::WriteSampleMap(f.sampleMap, rec); !w.ok()) return Fail(w.message());
+  }
+  if (!f.stats.empty()) {
+    nlohmann::json j = toolkit::StatsToJson(stats);
+    j["provider"] = "pipe";
+    j["provider_name"] = caps.name;
+    j["provider_cmd"] = f.command;
+    j["method"] = method;
+    j["options"] = toolkit::OptionsToJson(options);
+    j["resolution"] = {rec.width, rec.height};
+    j["working_resolution"] = {rec.workWidth, rec.workHeight};
+    j["time_wall_s"] = wallS;
+    if (Status w = toolkit::WriteJson(f.stats, j); !w.ok()) return Fail(w.message());
+  }
+
+  std::printf("%s: %dx%d (working %dx%d), %s, provider '%s'\n", f.output.c_str(), rec.width, rec.height,
+              rec.workWidth, rec.workHeight, method.c_str(), caps.name.c_str());
+  std::printf("  exact pixels   %.2f %% (%lld of %lld)\n", 100.0 * stats.exactFraction(),
+              static_cast<long long>(stats.exactPixels), static_cast<long long>(stats.totalPixels));
+  std::printf("  time           provider %.2f s, DCM %.2f s, guides %.2f s, total %.2f s\n", stats.timeProviderS,
+              stats.timeEngineS, stats.timeGuidesS, wallS);
+  std::printf("  provider calls %lld\n", static_cast<long long>(stats.providerCalls));
+  return kExitOk;
+}
+
+Registration reg("pipe", "Reconstruct with an external renderer as a child process (dcm-pipe protocol)",
+                 [](CLI::App* app) -> std::function<int()> {
+                   auto f = std::make_shared<PipeFlags>();
+                   app->add_option("--provider-cmd", f->command,
+                                   "shell command of the provider (run with /bin/sh -c; see plugins/pipe/PROTOCOL.md)")
+                       ->required();
+                   app->add_option("-o,--output", f->output, "output image (EXR)")->required();
+                   app->add_option("--stats", f->stats, "write statistics (JSON)");
+                   app->add_option("--sample-map", f->sampleMap, "write the sample map (PNG): which pixels were exact, why");
+                   app->add_option("--provider-timeout", f->timeout,
+                                   "seconds to wait for any later answer of the provider and for its exit (default 600)")
+                       ->check(CLI::PositiveNumber);
+                   app->add_option("--provider-startup-timeout", f->startupTimeout,
+                                   "seconds to wait for the provider's handshake (default 600)")
+                       ->check(CLI::PositiveNumber);
+                   AddEngineFlags(app, &f->engine);
+                   return [f] { return RunPipe(*f); };
+                 });
+
+}  // namespace
+}  // namespace dcm::cli
+
+#endif  // DCM_HAVE_PIPE
