@@ -240,7 +240,7 @@ Status ApplyMappings(const std::vector<Mapping>& maps, const ChannelSet& set, bo
 }
 
 /// True when the three roles of an RGB group are present; error when only some are.
-Status RgbPresent(const RoleExprs& roles, Role first, bool* present) {
+Status RgbPresent(const RoleExprs& roles, Role first, const ChannelSet& set, bool* present) {
   int n = 0;
   for (int c = 0; c < 3; ++c) n += roles[size_t(Comp(first, c))].has_value();
   if (n != 0 && n != 3) {
@@ -249,7 +249,7 @@ Status RgbPresent(const RoleExprs& roles, Role first, bool* present) {
       std::string& list = roles[size_t(Comp(first, c))] ? have : miss;
       list += (list.empty() ? "" : ", ") + std::string(RoleName(Comp(first, c)));
     }
-    return Status::Error("incomplete colour role: " + have + " found but not " + miss);
+    return Status::Error("incomplete colour role in " + set.Paths() + ": " + have + " found but not " + miss);
   }
   *present = n == 3;
   return Status::Ok();
@@ -535,10 +535,10 @@ Status LookupTextures(const ChannelSet& set, const RoleExprs& roles,
 Status ComputeSamples(const ChannelSet& set, Evaluator& ev, const RoleExprs& roles, bool split,
                       bool variance, const std::vector<uint8_t>* mask, Data* d) {
   bool hasL = false, hasLi = false, hasLc = false, hasVar = false;
-  DCM_RETURN_IF_ERROR(RgbPresent(roles, kL, &hasL));
-  DCM_RETURN_IF_ERROR(RgbPresent(roles, kLi, &hasLi));
-  DCM_RETURN_IF_ERROR(RgbPresent(roles, kLc, &hasLc));
-  DCM_RETURN_IF_ERROR(RgbPresent(roles, kVar, &hasVar));
+  DCM_RETURN_IF_ERROR(RgbPresent(roles, kL, set, &hasL));
+  DCM_RETURN_IF_ERROR(RgbPresent(roles, kLi, set, &hasLi));
+  DCM_RETURN_IF_ERROR(RgbPresent(roles, kLc, set, &hasLc));
+  DCM_RETURN_IF_ERROR(RgbPresent(roles, kVar, set, &hasVar));
   std::vector<RGB> L, Li, Lc, var;
   if (hasL) DCM_RETURN_IF_ERROR(ev.EvalRgb(roles, kL, &L));
   if (hasLi) DCM_RETURN_IF_ERROR(ev.EvalRgb(roles, kLi, &Li));
@@ -569,9 +569,9 @@ Status ComputeSamples(const ChannelSet& set, Evaluator& ev, const RoleExprs& rol
 Status CheckSampleRoles(const RoleExprs& roles, bool split, bool tau, const ChannelSet& set,
                         const std::string& what) {
   bool hasL = false, hasLi = false, hasLc = false;
-  DCM_RETURN_IF_ERROR(RgbPresent(roles, kL, &hasL));
-  DCM_RETURN_IF_ERROR(RgbPresent(roles, kLi, &hasLi));
-  DCM_RETURN_IF_ERROR(RgbPresent(roles, kLc, &hasLc));
+  DCM_RETURN_IF_ERROR(RgbPresent(roles, kL, set, &hasL));
+  DCM_RETURN_IF_ERROR(RgbPresent(roles, kLi, set, &hasLi));
+  DCM_RETURN_IF_ERROR(RgbPresent(roles, kLc, set, &hasLc));
   if (split ? (hasLi && (hasL || hasLc)) : (hasL || (hasLi && hasLc && tau))) return Status::Ok();
   return Status::Error(what + ": no exact samples: need the beauty (L.R/G/B) " +
                        std::string(split ? "with Li.R/G/B, or Li and Lc" : "or Li, Lc and tau") +
@@ -622,7 +622,7 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
 
   Evaluator guideEval(guides);
   bool hasTau = false;
-  DCM_RETURN_IF_ERROR(RgbPresent(roles, kTau, &hasTau));
+  DCM_RETURN_IF_ERROR(RgbPresent(roles, kTau, guides, &hasTau));
   if (hasTau) {
     DCM_RETURN_IF_ERROR(guideEval.EvalRgb(roles, kTau, &d->tau));
     d->notes.push_back("tau: " + RgbText(roles, kTau));
@@ -642,10 +642,10 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
     sroles[size_t(Role::kMask)].reset();
     DCM_RETURN_IF_ERROR(ApplyMappings(options.mappings, guides, /*samples=*/true, &sroles));
     bool hasLi = false, hasL = false, hasLc = false, hasVar = false;
-    DCM_RETURN_IF_ERROR(RgbPresent(sroles, kLi, &hasLi));
-    DCM_RETURN_IF_ERROR(RgbPresent(sroles, kL, &hasL));
-    DCM_RETURN_IF_ERROR(RgbPresent(sroles, kLc, &hasLc));
-    DCM_RETURN_IF_ERROR(RgbPresent(sroles, kVar, &hasVar));
+    DCM_RETURN_IF_ERROR(RgbPresent(sroles, kLi, guides, &hasLi));
+    DCM_RETURN_IF_ERROR(RgbPresent(sroles, kL, guides, &hasL));
+    DCM_RETURN_IF_ERROR(RgbPresent(sroles, kLc, guides, &hasLc));
+    DCM_RETURN_IF_ERROR(RgbPresent(sroles, kVar, guides, &hasVar));
     split = options.split && hasTau && hasLi && (hasL || hasLc);
     DCM_RETURN_IF_ERROR(CheckSampleRoles(sroles, split, hasTau, guides, guides.Paths()));
     d->L.assign(n, RGB{});
@@ -696,7 +696,7 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
       DCM_RETURN_IF_ERROR(CheckSampleRoles(sroles, split, hasTau, s, "samples file " + Quote(path)));
       if (split) {
         bool hasLi = false;
-        DCM_RETURN_IF_ERROR(RgbPresent(sroles, kLi, &hasLi));
+        DCM_RETURN_IF_ERROR(RgbPresent(sroles, kLi, s, &hasLi));
         if (!hasLi)
           return Status::Error("samples file " + Quote(path) +
                                ": the guides carry tau, so the samples need L_i (Li.R/G/B, or "
@@ -704,7 +704,7 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
       }
       if (variance) {
         bool hasVar = false;
-        DCM_RETURN_IF_ERROR(RgbPresent(sroles, kVar, &hasVar));
+        DCM_RETURN_IF_ERROR(RgbPresent(sroles, kVar, s, &hasVar));
         if (!hasVar) return Status::Error("samples file " + Quote(path) + ": no variance channels");
       }
       Evaluator ev(s);
