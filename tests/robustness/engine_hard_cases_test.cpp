@@ -7,13 +7,11 @@
 #include <gtest/gtest.h>
 
 #include <array>
-#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <functional>
 #include <limits>
-#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -38,69 +36,27 @@ struct RendererPixel {
   RGB L, Li, Lc;
 };
 
-/// A provider over a per-pixel function of RendererPixel; counts evaluations.
-class RendererProvider final : public SampleProvider {
+/// The analytic provider over a per-pixel function of RendererPixel, whose L
+/// is the renderer's own, not recomputed from its parts.
+class RendererProvider final : public AnalyticProvider {
  public:
   RendererProvider(int w, int h, std::function<RendererPixel(int, int)> f, bool texture = true)
-      : w_(w), h_(h), f_(std::move(f)), texture_(texture), count_(new std::atomic<int>[size_t(w) * size_t(h)]) {
-    for (size_t i = 0; i < size_t(w) * size_t(h); ++i) count_[i] = 0;
-  }
-  ProviderCapabilities Capabilities() const override {
-    ProviderCapabilities c;
-    c.width = w_;
-    c.height = h_;
-    c.objectId = c.shaderId = true;
-    c.texture = c.splitRadiance = texture_;
-    c.name = "renderer-like";
-    return c;
-  }
-  Status Guides(const Bounds2i& region, const GuideRequest& what, GuideImage* out) override {
-    out->region = region;
-    const size_t n = size_t(region.area());
-    out->objectId.assign(what.objectId ? n : 0, 0);
-    out->shaderId.assign(what.shaderId ? n : 0, 0);
-    out->texture.assign(what.texture ? n : 0, RGB{});
-    for (int y = region.min.y; y < region.max.y; ++y)
-      for (int x = region.min.x; x < region.max.x; ++x) {
-        const RendererPixel p = f_(x, y);
-        const size_t i = size_t(region.offset({x, y}));
-        if (what.objectId) out->objectId[i] = p.objectId;
-        if (what.shaderId) out->shaderId[i] = p.shaderId;
-        if (what.texture) out->texture[i] = p.tau;
-      }
-    return Status::Ok();
-  }
-  Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what, std::span<ExactSample> out) override {
-    for (size_t k = 0; k < pixels.size(); ++k) {
-      const Point2i q = pixels[k];
-      if (q.x < 0 || q.y < 0 || q.x >= w_ || q.y >= h_) return Status::Error("pixel outside the image");
-      ++count_[size_t(q.y) * size_t(w_) + size_t(q.x)];
-      const RendererPixel p = f_(q.x, q.y);
-      out[k].L = p.L;
-      if (what.split) {
-        out[k].Li = p.Li;
-        out[k].Lc = p.Lc;
-      }
-    }
-    return Status::Ok();
-  }
-  std::vector<RGB> FullRender() const {
-    std::vector<RGB> img(size_t(w_) * size_t(h_));
-    for (int y = 0; y < h_; ++y)
-      for (int x = 0; x < w_; ++x) img[size_t(y) * size_t(w_) + size_t(x)] = f_(x, y).L;
-    return img;
-  }
-  int MaxEvaluationsOfOnePixel() const {
-    int m = 0;
-    for (size_t i = 0; i < size_t(w_) * size_t(h_); ++i) m = std::max(m, count_[i].load());
-    return m;
-  }
+      : AnalyticProvider(w, h, ToTruth(std::move(f)), AnalyticChannels{true, true, texture}) {}
 
  private:
-  int w_, h_;
-  std::function<RendererPixel(int, int)> f_;
-  bool texture_;
-  std::unique_ptr<std::atomic<int>[]> count_;
+  static SceneFunction ToTruth(std::function<RendererPixel(int, int)> f) {
+    return [f = std::move(f)](int x, int y) {
+      const RendererPixel r = f(x, y);
+      PixelTruth t;
+      t.objectId = r.objectId;
+      t.shaderId = r.shaderId;
+      t.tau = r.tau;
+      t.Li = r.Li;
+      t.Lc = r.Lc;
+      t.renderedL = r.L;
+      return t;
+    };
+  }
 };
 
 Reconstruction ReconstructOk(SampleProvider& p, const ReconstructionOptions& o) {

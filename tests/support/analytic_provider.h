@@ -5,6 +5,7 @@
 #include <atomic>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "dcm/sample_provider.h"
@@ -18,7 +19,10 @@ struct PixelTruth {
   RGB tau = RGB::Gray(1.f);  ///< texture value; L = Li * tau + Lc
   RGB Li;
   RGB Lc;
-  RGB L() const { return Li * tau + Lc; }
+  /// L as a renderer measured it, when it is not exactly Li * tau + Lc (a
+  /// renderer that divides L_t by a tiny tau, or leaves garbage in L_i).
+  std::optional<RGB> renderedL;
+  RGB L() const { return renderedL.value_or(Li * tau + Lc); }
 };
 
 using SceneFunction = std::function<PixelTruth(int x, int y)>;
@@ -31,7 +35,7 @@ struct AnalyticChannels {
 };
 
 /// Serves a SceneFunction; counts how often each pixel is evaluated.
-class AnalyticProvider final : public SampleProvider {
+class AnalyticProvider : public SampleProvider {
  public:
   AnalyticProvider(int width, int height, SceneFunction scene, AnalyticChannels channels = {});
 
