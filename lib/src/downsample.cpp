@@ -1,15 +1,17 @@
-#include "downsample.h"
+#include "dcm/downsample.h"
 
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 
-namespace dcm::detail {
+namespace dcm {
 
-std::vector<RGB> BoxDownsample(const std::vector<RGB>& in, int w, int h, int s, int* outW, int* outH) {
+std::vector<RGB> BoxDownsample(std::span<const RGB> in, int w, int h, int s, int* outW, int* outH) {
+  s = std::max(s, 1);
   *outW = (w + s - 1) / s;
   *outH = (h + s - 1) / s;
-  if (s == 1) return in;
+  if (in.size() < size_t(w) * size_t(h)) return std::vector<RGB>(size_t(*outW) * size_t(*outH));
+  if (s == 1) return std::vector<RGB>(in.begin(), in.begin() + ptrdiff_t(size_t(w) * size_t(h)));
   std::vector<RGB> out(size_t(*outW) * size_t(*outH));
   const int ow = *outW;
   tbb::parallel_for(0, *outH, [&](int oy) {
@@ -27,4 +29,4 @@ std::vector<RGB> BoxDownsample(const std::vector<RGB>& in, int w, int h, int s, 
   return out;
 }
 
-}  // namespace dcm::detail
+}  // namespace dcm

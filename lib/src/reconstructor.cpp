@@ -17,7 +17,7 @@
 
 #include "block.h"
 #include "contrast_test.h"
-#include "downsample.h"
+#include "dcm/downsample.h"
 #include "edge_classification.h"
 #include "least_discrepancy_direction.h"
 #include "oriented_interpolation.h"

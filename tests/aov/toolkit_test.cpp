@@ -11,6 +11,7 @@
 #include <limits>
 #include <set>
 
+#include "dcm/downsample.h"
 #include "common/image_io.h"
 #include "common/metrics.h"
 #include "common/preview.h"
@@ -82,7 +83,7 @@ TEST(Metrics, SsimFallsWithStructure) {
 TEST(Metrics, BoxDownsample) {
   std::vector<RGB> in = {RGB::Gray(1), RGB::Gray(3), RGB::Gray(5), RGB::Gray(5), RGB::Gray(7), RGB::Gray(9)};
   int ow = 0, oh = 0;
-  auto out = toolkit::BoxDownsample(in, 3, 2, 2, &ow, &oh);
+  auto out = dcm::BoxDownsample(in, 3, 2, 2, &ow, &oh);
   ASSERT_EQ(ow, 2);
   ASSERT_EQ(oh, 1);
   EXPECT_EQ(out[0], RGB::Gray(4));  // (1+3+5+7)/4

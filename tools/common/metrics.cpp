@@ -102,25 +102,4 @@ ImageError Compare(std::span<const RGB> image, std::span<const RGB> reference, i
   return e;
 }
 
-std::vector<RGB> BoxDownsample(std::span<const RGB> in, int w, int h, int s, int* outW, int* outH) {
-  s = std::max(s, 1);
-  const int ow = (w + s - 1) / s, oh = (h + s - 1) / s;
-  *outW = ow;
-  *outH = oh;
-  std::vector<RGB> out(size_t(ow) * size_t(oh));
-  if (in.size() < size_t(w) * size_t(h)) return out;
-  for (int oy = 0; oy < oh; ++oy) {
-    for (int ox = 0; ox < ow; ++ox) {
-      double sum[3] = {0, 0, 0};
-      int count = 0;
-      for (int y = oy * s; y < std::min(h, oy * s + s); ++y)
-        for (int x = ox * s; x < std::min(w, ox * s + s); ++x, ++count)
-          for (int c = 0; c < 3; ++c) sum[c] += double(in[size_t(y) * size_t(w) + size_t(x)][c]);
-      out[size_t(oy) * size_t(ow) + size_t(ox)] =
-          RGB{float(sum[0] / count), float(sum[1] / count), float(sum[2] / count)};
-    }
-  }
-  return out;
-}
-
 }  // namespace dcm::toolkit

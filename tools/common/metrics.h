@@ -23,11 +23,6 @@ struct ImageError {
 /// NaN when nothing can be compared (empty or too short spans).
 ImageError Compare(std::span<const RGB> image, std::span<const RGB> reference, int width, int height);
 
-/// Averages s x s boxes of `in` (w x h, row-major); partial boxes at the right
-/// and bottom border average the pixels they have (as the engine does with
-/// --downsample). Output size ceil(w/s) x ceil(h/s).
-std::vector<RGB> BoxDownsample(std::span<const RGB> in, int w, int h, int s, int* outW, int* outH);
-
 /// sRGB encoding (IEC 61966-2-1) of a linear value clipped to [0,1]; NaN gives 0.
 float SrgbEncode(float linear);
 

@@ -28,6 +28,7 @@
 #include <thread>
 #include <vector>
 
+#include "dcm/downsample.h"
 #include "bench_rivals.h"
 #include "commands.h"
 #include "common/image_io.h"
@@ -318,7 +319,7 @@ std::vector<RGB> ToOutput(const std::vector<RGB>& work, int w, int h, int ds, in
     *oh = h;
     return work;
   }
-  return toolkit::BoxDownsample(work, w, h, ds, ow, oh);
+  return dcm::BoxDownsample(work, w, h, ds, ow, oh);
 }
 
 nlohmann::json PointToJson(const Point& p) {

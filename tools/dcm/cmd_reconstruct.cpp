@@ -15,6 +15,7 @@
 #include <memory>
 #include <sstream>
 
+#include "dcm/downsample.h"
 #include "aov_common.h"
 #include "common/image_io.h"
 #include "common/metrics.h"
@@ -99,7 +100,7 @@ int RunReconstruct(const ReconstructFlags& f) {
     haveRef = true;
   } else if (provider->dense()) {
     int w = 0, h = 0;
-    reference = toolkit::BoxDownsample(provider->Beauty(), provider->width(), provider->height(),
+    reference = dcm::BoxDownsample(provider->Beauty(), provider->width(), provider->height(),
                                        options.downsample, &w, &h);
     haveRef = (w == r.width && h == r.height);
   }

@@ -4,7 +4,7 @@
 #include <filesystem>
 
 #include "common/image_io.h"
-#include "common/metrics.h"
+#include "dcm/downsample.h"
 
 namespace dcm::cli {
 
@@ -68,7 +68,7 @@ Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {
     const bool quiet = f.quiet;
     o->onLevel = [dir, s, quiet](int level, int w, int h, const std::vector<RGB>& work) {
       int ow = w, oh = h;
-      const std::vector<RGB> image = toolkit::BoxDownsample(work, w, h, s, &ow, &oh);
+      const std::vector<RGB> image = dcm::BoxDownsample(work, w, h, s, &ow, &oh);
       const std::string path = dir + "/level_" + std::to_string(level) + ".exr";
       toolkit::Metadata meta;
       meta.floats.push_back({"dcm:level", float(level)});

@@ -1,0 +1,16 @@
+// Supersampling: the working image is box-filtered down by s per axis.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "dcm/color.h"
+
+namespace dcm {
+
+/// Averages s x s boxes of `in` (w x h, row-major); partial boxes at the right
+/// and bottom border average the pixels they have (s < 1 counts as 1). Output
+/// size ceil(w/s) x ceil(h/s); all zero when `in` holds fewer than w*h pixels.
+std::vector<RGB> BoxDownsample(std::span<const RGB> in, int w, int h, int s, int* outW, int* outH);
+
+}  // namespace dcm
