@@ -15,11 +15,6 @@ float Mitchell(float lo, float hi) {
   return (hi - lo) / std::fabs(sum);
 }
 
-float DisplayEncode(float v) {
-  v = std::clamp(v, 0.f, 1.f);
-  return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.f / 2.4f) - 0.055f;
-}
-
 }  // namespace
 
 float ContrastTest::Contrast(std::span<const Value> values) const {
@@ -35,8 +30,8 @@ float ContrastTest::Contrast(std::span<const Value> values) const {
   }
   if (values.empty()) return 0.f;
   if (metric_ == ContrastMetric::kDisplay) {
-    float c = DisplayEncode(hiA) - DisplayEncode(loA);
-    if (split_) c = std::max(c, DisplayEncode(hiB) - DisplayEncode(loB));
+    float c = SrgbEncode(hiA) - SrgbEncode(loA);
+    if (split_) c = std::max(c, SrgbEncode(hiB) - SrgbEncode(loB));
     return c;
   }
   float c = Mitchell(loA, hiA);

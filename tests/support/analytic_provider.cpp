@@ -181,14 +181,10 @@ SceneFunction ManyPrimitivesOneShader(int s) {
 }
 
 double DisplayPsnr(const std::vector<RGB>& image, const std::vector<RGB>& reference) {
-  auto enc = [](float v) {
-    v = std::clamp(v, 0.f, 1.f);
-    return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.f / 2.4f) - 0.055f;
-  };
   double se = 0;
   for (size_t i = 0; i < image.size(); ++i)
     for (int c = 0; c < 3; ++c) {
-      const double d = enc(image[i][c]) - enc(reference[i][c]);
+      const double d = double(SrgbEncode(image[i][c])) - double(SrgbEncode(reference[i][c]));
       se += d * d;
     }
   const double mse = se / (3.0 * double(image.size()));

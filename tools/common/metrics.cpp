@@ -8,12 +8,6 @@
 
 namespace dcm::toolkit {
 
-float SrgbEncode(float linear) {
-  if (!(linear > 0.f)) return 0.f;  // also maps NaN to 0
-  if (linear >= 1.f) return 1.f;
-  if (linear <= 0.0031308f) return 12.92f * linear;
-  return 1.055f * std::pow(linear, 1.f / 2.4f) - 0.055f;
-}
 
 namespace {
 

@@ -23,7 +23,7 @@ struct ImageError {
 /// NaN when nothing can be compared (empty or too short spans).
 ImageError Compare(std::span<const RGB> image, std::span<const RGB> reference, int width, int height);
 
-/// sRGB encoding (IEC 61966-2-1) of a linear value clipped to [0,1]; NaN gives 0.
-float SrgbEncode(float linear);
+/// sRGB encoding of a linear value clipped to [0,1]: the engine's.
+using dcm::SrgbEncode;
 
 }  // namespace dcm::toolkit

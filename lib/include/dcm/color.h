@@ -28,6 +28,15 @@ struct RGB {
 /// Rec. 709 luminance of linear RGB.
 inline float Luminance(RGB c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b; }
 
+/// sRGB encoding (IEC 61966-2-1) of a linear value clipped to [0,1]; NaN
+/// encodes as 0. The display units of tolerances and PSNR.
+inline float SrgbEncode(float linear) {
+  if (!(linear > 0.f)) return 0.f;
+  if (linear >= 1.f) return 1.f;
+  if (linear <= 0.0031308f) return 12.92f * linear;
+  return 1.055f * std::pow(linear, 1.f / 2.4f) - 0.055f;
+}
+
 /// True when all three channels are finite (no NaN, no infinity).
 inline bool IsFinite(RGB c) {
   return std::isfinite(c.r) && std::isfinite(c.g) && std::isfinite(c.b);
