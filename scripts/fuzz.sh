@@ -16,8 +16,10 @@ here=$(cd "$(dirname "$0")/.." && pwd)
 build=${DCM_FUZZ_BUILD_DIR:-$here/build-fuzz}
 cxx=${CXX_FUZZ:-clang++-14}
 
+# Installs clang-14 and libclang-rt-14-dev (and the build dependencies) if missing.
+"$here/scripts/install-deps.sh" --with-fuzz
 if ! command -v "$cxx" >/dev/null; then
-  echo "fuzz.sh: $cxx not found (apt-get install clang-14 libclang-rt-14-dev)" >&2
+  echo "fuzz.sh: $cxx not found (scripts/install-deps.sh --with-fuzz)" >&2
   exit 2
 fi
 cmake -S "$here/fuzz" -B "$build" -G Ninja -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null

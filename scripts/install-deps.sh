@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages dcm needs to build, test and run its examples.
 # Only what is missing is installed; nothing is downloaded outside apt.
-# Usage: scripts/install-deps.sh [--with-renderers]
+# Usage: scripts/install-deps.sh [--with-renderers] [--with-fuzz]
 set -euo pipefail
 
 packages=(
@@ -16,9 +16,13 @@ packages=(
   # helper scripts (plots, checks): Debian's python, not the one first on PATH
   python3-numpy python3-matplotlib python3-openimageio
 )
-if [[ "${1:-}" == "--with-renderers" ]]; then
-  packages+=(povray blender)
-fi
+for arg in "$@"; do
+  case "$arg" in
+    --with-renderers) packages+=(povray blender) ;;            # examples/blender, POV-Ray
+    --with-fuzz) packages+=(clang-14 libclang-rt-14-dev) ;;    # scripts/fuzz.sh (libFuzzer)
+    *) echo "install-deps: unknown option $arg" >&2; exit 2 ;;
+  esac
+done
 
 missing=()
 for p in "${packages[@]}"; do
