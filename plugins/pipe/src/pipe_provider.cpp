@@ -100,9 +100,7 @@ Status PipeProvider::Start(const PipeOptions& options, std::unique_ptr<PipeProvi
 }
 
 std::string PipeProvider::Prefix() const {
-  std::string c = options_.command;
-  if (c.size() > 80) c = c.substr(0, 77) + "...";
-  return "provider '" + c + "'";
+  return "provider '" + options_.command + "'";
 }
 
 Status PipeProvider::Fail(const std::string& what) {
