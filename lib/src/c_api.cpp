@@ -141,6 +141,10 @@ struct IntOption {
   const char* name;
   int Options::*member;
 };
+struct FloatOption {
+  const char* name;
+  float Options::*member;
+};
 struct BoolOption {
   const char* name;
   bool Options::*member;
@@ -156,6 +160,10 @@ constexpr IntOption kIntOptions[] = {
     {"tile_size", &Options::tileSize},
     {"batch_size", &Options::batchSize},
 };
+constexpr FloatOption kFloatOptions[] = {
+    {"contrast_threshold", &Options::contrastThreshold},
+    {"noise_significance", &Options::noiseSignificance},
+};
 constexpr BoolOption kBoolOptions[] = {
     {"surface_aware", &Options::surfaceAware},
     {"texture_split", &Options::textureSplit},
@@ -167,7 +175,14 @@ constexpr BoolOption kBoolOptions[] = {
     {"fallback", &Options::fallback},
     {"finest_centre_probe", &Options::finestCentreProbe},
     {"full_evaluation", &Options::fullEvaluation},
+    {"denoise_samples", &Options::denoiseSamples},
 };
+
+float* FindFloat(Options& o, std::string_view name) {
+  for (const auto& e : kFloatOptions)
+    if (name == e.name) return &(o.*e.member);
+  return nullptr;
+}
 
 int* FindInt(Options& o, std::string_view name) {
   for (const auto& e : kIntOptions)
@@ -375,8 +390,8 @@ DCM_API void dcmSetInt(DCMReconstructor r, const char* name, int value) {
 DCM_API void dcmSetFloat(DCMReconstructor r, const char* name, float value) {
   if (!CheckArgs(r, name, "dcmSetFloat")) return;
   Guard(r, [&] {
-    if (std::string_view(name) == "contrast_threshold") {
-      r->options.contrastThreshold = value;
+    if (float* f = FindFloat(r->options, name)) {
+      *f = value;
     } else if (int* p = FindInt(r->options, name)) {
       if (!(std::nearbyint(value) == value) || std::fabs(value) > 1e9f)
         return SetError(r, DCM_ERROR_INVALID_ARGUMENT,
@@ -411,7 +426,7 @@ DCM_API float dcmGetFloat(DCMReconstructor r, const char* name) {
   if (!CheckArgs(r, name, "dcmGetFloat")) return 0.f;
   float result = 0.f;
   Guard(r, [&] {
-    if (std::string_view(name) == "contrast_threshold") result = r->options.contrastThreshold;
+    if (float* f = FindFloat(r->options, name)) result = *f;
     else if (int* p = FindInt(r->options, name)) result = float(*p);
     else SetError(r, DCM_ERROR_INVALID_ARGUMENT, UnknownOption("float", name));
   });

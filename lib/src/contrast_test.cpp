@@ -17,29 +17,61 @@ float Mitchell(float lo, float hi) {
 
 }  // namespace
 
+namespace {
+
+/// The range of one luminance over a set, with the variances of its extremes.
+struct Range {
+  float lo = std::numeric_limits<float>::infinity(), hi = -std::numeric_limits<float>::infinity();
+  float varLo = 0.f, varHi = 0.f;
+  void Add(float v, float var) {
+    if (v < lo) lo = v, varLo = var;
+    if (v > hi) hi = v, varHi = var;
+  }
+  /// Shrinks the range by k standard deviations of hi - lo.
+  void Discount(float k) {
+    if (k <= 0.f || !(varLo + varHi > 0.f)) return;
+    const float d = 0.5f * k * std::sqrt(varLo + varHi);
+    if (hi - lo <= 2.f * d) {
+      lo = hi = 0.5f * (lo + hi);
+    } else {
+      lo += d, hi -= d;
+    }
+  }
+};
+
+}  // namespace
+
 float ContrastTest::Contrast(std::span<const Value> values) const {
   constexpr float kInf = std::numeric_limits<float>::infinity();
-  float loA = kInf, hiA = -kInf, loB = kInf, hiB = -kInf, loT = kInf, hiT = -kInf;
+  Range A, B, T;
   for (const Value& v : values) {
     if (!IsFinite(v.a) || !IsFinite(v.b)) return kInf;
     const float la = Luminance(v.a);
     const float lb = split_ ? Luminance(v.b) : 0.f;
-    loA = std::min(loA, la), hiA = std::max(hiA, la);
-    loB = std::min(loB, lb), hiB = std::max(hiB, lb);
-    loT = std::min(loT, la + lb), hiT = std::max(hiT, la + lb);
+    A.Add(la, v.varA);
+    B.Add(lb, split_ ? v.varB : 0.f);
+    T.Add(la + lb, v.varA + (split_ ? v.varB : 0.f));
   }
   if (values.empty()) return 0.f;
+  A.Discount(k_), B.Discount(k_), T.Discount(k_);
   if (metric_ == ContrastMetric::kDisplay) {
-    float c = SrgbEncode(hiA) - SrgbEncode(loA);
-    if (split_) c = std::max(c, SrgbEncode(hiB) - SrgbEncode(loB));
+    float c = SrgbEncode(A.hi) - SrgbEncode(A.lo);
+    if (split_) c = std::max(c, SrgbEncode(B.hi) - SrgbEncode(B.lo));
     return c;
   }
-  float c = Mitchell(loA, hiA);
+  float c = Mitchell(A.lo, A.hi);
   if (split_) {
-    const float total = std::fabs(hiT) + std::fabs(loT);
-    if (total > 1e-12f) c = std::max(c, (hiB - loB) / total);
+    const float total = std::fabs(T.hi) + std::fabs(T.lo);
+    if (total > 1e-12f) c = std::max(c, (B.hi - B.lo) / total);
   }
   return c;
+}
+
+bool ContrastTest::WithinNoise(const Value& p, const Value& q) const {
+  const float varA = p.varA + q.varA, varB = split_ ? p.varB + q.varB : 0.f;
+  if (k_ <= 0.f || !(varA > 0.f || varB > 0.f)) return false;
+  if (std::fabs(Luminance(p.a) - Luminance(q.a)) > k_ * std::sqrt(varA)) return false;
+  return !split_ || std::fabs(Luminance(p.b) - Luminance(q.b)) <= k_ * std::sqrt(varB);
 }
 
 }  // namespace dcm::detail

@@ -12,8 +12,11 @@ namespace dcm::detail {
 
 class ContrastTest {
  public:
-  ContrastTest(ContrastMetric metric, float threshold, bool split)
-      : metric_(metric), threshold_(threshold), split_(split) {}
+  /// `significance` k: with noisy values, the range of a set is first reduced
+  /// by k standard deviations of the difference of its extremes, so that only
+  /// differences significant given the noise count. 0: the paper's test.
+  ContrastTest(ContrastMetric metric, float threshold, bool split, float significance = 0.f)
+      : metric_(metric), threshold_(threshold), split_(split), k_(significance) {}
 
   /// Contrast of a set of values; +infinity when any is not finite.
   /// Mitchell: (max-min)/(max+min) of luminance (0 for a black set). With the
@@ -21,6 +24,8 @@ class ContrastTest {
   /// change of L_c against the total L_i + L_c of the set, since L_c is near
   /// zero on diffuse surfaces and its own contrast would be noise.
   /// Display: the range of sRGB-encoded luminance clipped to [0,1].
+  /// With noise, each range [lo, hi] shrinks to [lo + d/2, hi - d/2] with
+  /// d = k sqrt(var(lo) + var(hi)) (no contrast when it closes).
   float Contrast(std::span<const Value> values) const;
 
   /// True when the contrast of the set exceeds the threshold.
@@ -32,12 +37,18 @@ class ContrastTest {
     return IsEdge(pair);
   }
 
+  /// True when noise alone may explain the difference of p and q: it is
+  /// within k standard deviations in the luminance of a and (with the split)
+  /// of b. Always false for noiseless values or k = 0.
+  bool WithinNoise(const Value& p, const Value& q) const;
+
   float threshold() const { return threshold_; }
 
  private:
   ContrastMetric metric_;
   float threshold_;
   bool split_;
+  float k_;
 };
 
 }  // namespace dcm::detail

@@ -35,7 +35,12 @@ DirectionChoice LeastDiscrepancyDirection(const SampleStore& store, const Block&
       in.index = {i0, i1, 0, 0};
       in.weight = {1 - e.w1, e.w1, 0, 0};
       in.count = 2;
-      sum += SquaredDifference(store.ValueAt(ip), Evaluate(store, in));
+      const Value v = store.ValueAt(ip), predicted = Evaluate(store, in);
+      // With noisy samples, each difference counts in units of its own
+      // standard deviation (a chi-square): noisy pairs do not outvote clean
+      // ones, and a direction along which only noise differs scores ~1.
+      const double var = double(v.varA) + v.varB + predicted.varA + predicted.varB;
+      sum += var > 0 ? SquaredDifference(v, predicted) / var : SquaredDifference(v, predicted);
       ++pairs;
     }
     if (pairs == 0) continue;

@@ -20,6 +20,8 @@ ReconstructionOptions ReconstructionOptions::Guo() {
   o.finestCentreProbe = false;
   o.gradientBlocksSimple = false;
   o.fallback = false;
+  o.noiseSignificance = 0.f;
+  o.denoiseSamples = false;
   return o;
 }
 
@@ -89,6 +91,8 @@ Status ReconstructionOptions::Validate() const {
   if (!(contrastThreshold >= 0) || !std::isfinite(contrastThreshold))
     return bad("contrastThreshold", "must be a finite number >= 0");
   if (directions < 1 || directions > 64) return bad("directions", "must be from 1 to 64, got " + std::to_string(directions));
+  if (!(noiseSignificance >= 0) || !std::isfinite(noiseSignificance))
+    return bad("noiseSignificance", "must be a finite number >= 0");
   if (fallbackMaxChanges < 0) return bad("fallbackMaxChanges", "must be >= 0");
   if (downsample < 1 || downsample > 64) return bad("downsample", "must be from 1 to 64, got " + std::to_string(downsample));
   if (threads < 0) return bad("threads", "must be >= 0");

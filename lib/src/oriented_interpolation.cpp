@@ -17,39 +17,47 @@ Direction Direction::Of(int k, int count) {
 
 bool ExitPoint(const Block& b, double px, double py, Direction d, BorderPoint* out) {
   constexpr double kEps = 1e-9;
+  // In block-local coordinates (pixel positions are integers, so the shift is
+  // exact): the rounding then does not depend on where the block lies in the
+  // image, and a block reconstructed in a window of the image gives the same
+  // bits as in the whole image (tiles, dcm/window_provider.h).
+  const double lx = px - b.x0, ly = py - b.y0;
+  const int w = b.x1 - b.x0, h = b.y1 - b.y0;
   double t = INFINITY;
   int side = -1;  // 0: x = x0, 1: x = x1, 2: y = y0, 3: y = y1
   auto consider = [&](double tc, int s) {
     if (tc > kEps && tc < t) t = tc, side = s;
   };
   if (d.dx != 0) {
-    consider((b.x0 - px) / d.dx, 0);
-    consider((b.x1 - px) / d.dx, 1);
+    consider((0 - lx) / d.dx, 0);
+    consider((w - lx) / d.dx, 1);
   }
   if (d.dy != 0) {
-    consider((b.y0 - py) / d.dy, 2);
-    consider((b.y1 - py) / d.dy, 3);
+    consider((0 - ly) / d.dy, 2);
+    consider((h - ly) / d.dy, 3);
   }
   if (side < 0) return false;
   // The ray must cross the open interior, not run along the border.
-  const double mx = px + 0.5 * t * d.dx, my = py + 0.5 * t * d.dy;
-  if (!(mx > b.x0 + kEps && mx < b.x1 - kEps && my > b.y0 + kEps && my < b.y1 - kEps)) return false;
+  const double mx = lx + 0.5 * t * d.dx, my = ly + 0.5 * t * d.dy;
+  if (!(mx > kEps && mx < w - kEps && my > kEps && my < h - kEps)) return false;
 
   out->t = t;
   if (side <= 1) {
     const int x = side == 0 ? b.x0 : b.x1;
-    double y = std::clamp(py + t * d.dy, double(b.y0), double(b.y1));
-    const int y0 = std::min(int(std::floor(y)), b.y1);
-    out->p0 = {x, y0};
-    out->p1 = {x, std::min(y0 + 1, b.y1)};
-    out->w1 = out->p1.y == y0 ? 0.0 : y - y0;
+    double y = std::clamp(ly + t * d.dy, 0.0, double(h));
+    const int y0 = std::min(int(std::floor(y)), h);
+    const int y1 = std::min(y0 + 1, h);
+    out->p0 = {x, b.y0 + y0};
+    out->p1 = {x, b.y0 + y1};
+    out->w1 = y1 == y0 ? 0.0 : y - y0;
   } else {
     const int y = side == 2 ? b.y0 : b.y1;
-    double x = std::clamp(px + t * d.dx, double(b.x0), double(b.x1));
-    const int x0 = std::min(int(std::floor(x)), b.x1);
-    out->p0 = {x0, y};
-    out->p1 = {std::min(x0 + 1, b.x1), y};
-    out->w1 = out->p1.x == x0 ? 0.0 : x - x0;
+    double x = std::clamp(lx + t * d.dx, 0.0, double(w));
+    const int x0 = std::min(int(std::floor(x)), w);
+    const int x1 = std::min(x0 + 1, w);
+    out->p0 = {b.x0 + x0, y};
+    out->p1 = {b.x0 + x1, y};
+    out->w1 = x1 == x0 ? 0.0 : x - x0;
   }
   return true;
 }
@@ -79,15 +87,20 @@ bool OrientedInterpolant(const SampleStore& store, const Block& b, Point2i q, Di
 
 Value Evaluate(const SampleStore& store, const Interpolant& in) {
   // Weights in double: a linear ramp is reproduced to float rounding.
-  double a[3] = {0, 0, 0}, bb[3] = {0, 0, 0};
+  double a[3] = {0, 0, 0}, bb[3] = {0, 0, 0}, varA = 0, varB = 0;
   for (int k = 0; k < in.count; ++k) {
     const Value v = store.ValueAt(in.index[k]);
+    const double w = in.weight[k];
     for (int c = 0; c < 3; ++c) {
-      a[c] += in.weight[k] * v.a[c];
-      bb[c] += in.weight[k] * v.b[c];
+      a[c] += w * v.a[c];
+      bb[c] += w * v.b[c];
     }
+    // Independent samples: the variance of the weighted sum.
+    varA += w * w * v.varA;
+    varB += w * w * v.varB;
   }
-  return {RGB(float(a[0]), float(a[1]), float(a[2])), RGB(float(bb[0]), float(bb[1]), float(bb[2]))};
+  return {RGB(float(a[0]), float(a[1]), float(a[2])), RGB(float(bb[0]), float(bb[1]), float(bb[2])),
+          float(varA), float(varB)};
 }
 
 Value Bilinear(const SampleStore& store, const Block& b, Point2i q) {

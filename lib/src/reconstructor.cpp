@@ -21,6 +21,7 @@
 #include "edge_classification.h"
 #include "least_discrepancy_direction.h"
 #include "oriented_interpolation.h"
+#include "sample_denoising.h"
 #include "sample_store.h"
 
 namespace dcm {
@@ -93,11 +94,13 @@ class Engine {
         opt_(opt),
         caps_(caps),
         split_(split),
-        store_(caps.width, caps.height, split),
-        contrast_(opt.contrastMetric, opt.contrastThreshold, split) {
+        noisy_(caps.variance && opt.noiseSignificance > 0.f),
+        store_(caps.width, caps.height, split, noisy_),
+        contrast_(opt.contrastMetric, opt.contrastThreshold, split, noisy_ ? opt.noiseSignificance : 0.f) {
     const int blocksPerTile = std::max(1, opt.tileSize / std::max(1, opt.elementaryBlock));
     grain_ = size_t(blocksPerTile) * size_t(blocksPerTile);
     request_.split = split;
+    request_.variance = noisy_;
   }
 
   Status Run(Reconstruction* out, std::vector<Point2i>* pending);
@@ -144,6 +147,7 @@ class Engine {
   const ReconstructionOptions& opt_;
   ProviderCapabilities caps_;
   bool split_;
+  bool noisy_;  ///< samples carry their variance and the tests weigh it
   SampleStore store_;
   ContrastTest contrast_;
   SampleRequest request_;
@@ -386,7 +390,7 @@ Status Engine::EvaluateBordersAdaptively(const std::vector<Block>& edges) {
         const int64_t ij = index(s, j);
         const bool same0 = surf.Same(ij, i0), same1 = surf.Same(ij, i1);
         const float t = (same0 == same1) ? float(j - last) / float(k - last) : (same0 ? 0.f : 1.f);
-        store_.SetFilled(ij, {v0.a * (1 - t) + v1.a * t, v0.b * (1 - t) + v1.b * t});
+        store_.SetFilled(ij, Lerp(v0, v1, t));
       }
       last = k;
     }
@@ -515,7 +519,9 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
           Leaf& leaf = lazy[i];
           leaf = MakeLeaf(b, BlockType::kLazy, e.direction.index);
           leaf.centre = c;
-          leaf.delta = {exact.a - predicted.a, exact.b - predicted.b};
+          // A correction the noise may explain is noise: spread over the
+          // block by the tent, it would move both sides of the edge.
+          if (!contrast_.WithinNoise(exact, predicted)) leaf.delta = {exact.a - predicted.a, exact.b - predicted.b};
           leaf.lo = leaf.hi = exact;
           for (Point2i p : e.border) {
             const int64_t ip = store_.Index(p.x, p.y);
@@ -607,6 +613,10 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
     });
     DCM_RETURN_IF_ERROR(Flush());
 
+    if (noisy_ && opt_.denoiseSamples) {
+      Progress(0.93f, "denoising samples");
+      stats_.denoisedSamples = DenoiseExactSamples(store_, opt_.elementaryBlock, contrast_);
+    }
     Progress(0.95f, "interpolation");
     ForEach(smoothLeaves_, [&](Leaf& l, size_t) { WriteSmooth(l); });
     ForEach(orientedLeaves_, [&](Leaf& l, size_t) { WriteOriented(l); });

@@ -10,7 +10,7 @@
 
 namespace dcm::detail {
 
-SampleStore::SampleStore(int width, int height, bool split)
+SampleStore::SampleStore(int width, int height, bool split, bool variance)
     : width_(width), height_(height), split_(split) {
   const size_t n = size_t(width) * size_t(height);
   if (split_) {
@@ -21,6 +21,7 @@ SampleStore::SampleStore(int width, int height, bool split)
   reason_.assign(n, SampleReason::kInterpolated);
   finite_.assign(n, 1);
   filled_.assign(n, 0);
+  if (variance) var_.assign(n, {0.f, 0.f});
 }
 
 void SampleStore::SetGuides(GuideImage guides, ObjectTest test) {
@@ -38,8 +39,29 @@ bool SampleStore::TauRecoverable(RGB tau) {
   return true;
 }
 
+std::array<float, 2> SampleStore::LuminanceVariances(RGB varL, RGB tau) {
+  // The noise of the three channels is taken as fully correlated (one path
+  // carries all three), so their standard deviations add with the luminance
+  // weights: sd(lum) = Luminance(sd). L_i = (L - L_c)/tau carries the noise
+  // of L divided by tau; L_c may carry all of it.
+  RGB sd, sdA;
+  for (int c = 0; c < 3; ++c) {
+    // An unknown (non-finite or negative) variance counts as none: the
+    // sample's differences are then judged as the paper judges them.
+    sd[c] = (std::isfinite(varL[c]) && varL[c] > 0.f) ? std::sqrt(varL[c]) : 0.f;
+    sdA[c] = sd[c] / std::max(std::fabs(tau[c]), 1e-6f);
+  }
+  const float a = Luminance(sdA), b = Luminance(sd);
+  return {a * a, b * b};
+}
+
 void SampleStore::SetInterpolated(int64_t i, const Value& v) {
-  if (IsExact(i)) return;
+  if (!IsExact(i)) Write(i, v);
+}
+
+void SampleStore::ReplaceExact(int64_t i, const Value& v) { Write(i, v); }
+
+void SampleStore::Write(int64_t i, const Value& v) {
   if (split_) {
     a_[i] = v.a;
     b_[i] = v.b;
@@ -47,6 +69,7 @@ void SampleStore::SetInterpolated(int64_t i, const Value& v) {
   } else {
     out_[i] = v.a;
   }
+  if (!var_.empty()) var_[i] = {v.varA, v.varB};
 }
 
 Status SampleStore::Flush(SampleProvider& provider, const SampleRequest& what, int batchSize,
@@ -117,6 +140,7 @@ Status SampleStore::Flush(SampleProvider& provider, const SampleRequest& what, i
     // Where tau is zero or denormal, L_i = L_t / tau is not recoverable: the
     // sample keeps its own exact L but never serves to interpolate others.
     finite_[i] = (finite && (!split_ || TauRecoverable(tau_[i]))) ? 1 : 0;
+    if (!var_.empty()) var_[i] = LuminanceVariances(s.variance, split_ ? tau_[i] : RGB::Gray(1.f));
   }
   return Status::Ok();
 }

@@ -5,6 +5,7 @@
 
 #include <tbb/enumerable_thread_specific.h>
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -15,11 +16,22 @@
 namespace dcm::detail {
 
 /// A value in the interpolation domain: (L_i, L_c) with the texture split, or
-/// (L, 0) without. The displayed radiance is a*tau + b.
+/// (L, 0) without. The displayed radiance is a*tau + b. With noisy samples,
+/// `varA` and `varB` are the variances of the luminance of a and b (0 for
+/// noiseless samples); an interpolated value carries sum(w^2 var) of its
+/// interpolants.
 struct Value {
   RGB a;
   RGB b;
+  float varA = 0.f;
+  float varB = 0.f;
 };
+
+/// (1-t) p + t q, with the variance of independent p and q.
+inline Value Lerp(const Value& p, const Value& q, float t) {
+  return {p.a * (1 - t) + q.a * t, p.b * (1 - t) + q.b * t,
+          (1 - t) * (1 - t) * p.varA + t * t * q.varA, (1 - t) * (1 - t) * p.varB + t * t * q.varB};
+}
 
 /// Which pairs of pixels lie on the same surface (paper 2.2 and 3.2).
 class SurfaceTest {
@@ -43,7 +55,8 @@ class SurfaceTest {
 
 class SampleStore {
  public:
-  SampleStore(int width, int height, bool split);
+  /// `variance`: exact samples carry the variance of their estimate.
+  SampleStore(int width, int height, bool split, bool variance = false);
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -56,8 +69,15 @@ class SampleStore {
   /// non-finite (L_i = L_t / tau is meaningless there).
   bool IsFinite(int64_t i) const { return finite_[i] != 0; }
   static bool TauRecoverable(RGB tau);
+  /// (varA, varB) of a sample whose L has per-channel variance `varL`.
+  static std::array<float, 2> LuminanceVariances(RGB varL, RGB tau);
   /// Without the split the interpolated quantity is L itself, stored once.
-  Value ValueAt(int64_t i) const { return split_ ? Value{a_[i], b_[i]} : Value{out_[i], RGB{}}; }
+  Value ValueAt(int64_t i) const {
+    Value v = split_ ? Value{a_[i], b_[i]} : Value{out_[i], RGB{}};
+    if (!var_.empty()) v.varA = var_[i][0], v.varB = var_[i][1];
+    return v;
+  }
+  bool hasVariance() const { return !var_.empty(); }
   RGB Tau(int64_t i) const { return tau_.empty() ? RGB::Gray(1.f) : tau_[i]; }
 
   /// Writes an interpolated value (never over an exact pixel).
@@ -69,6 +89,8 @@ class SampleStore {
     if (!IsExact(i)) filled_[i] = 1;
   }
   bool IsFilled(int64_t i) const { return filled_[i] != 0; }
+  /// Replaces the value of exact pixel i (a denoised estimate); it stays exact.
+  void ReplaceExact(int64_t i, const Value& v);
 
   /// Asks for pixel (x, y) to be evaluated exactly in the next Flush(). Safe
   /// to call concurrently. When several reasons ask for one pixel, the one
@@ -93,10 +115,12 @@ class SampleStore {
   std::vector<SampleReason> TakeReasons() { return std::move(reason_); }
 
  private:
+  void Write(int64_t i, const Value& v);
   int width_, height_;
   bool split_;
   std::vector<RGB> a_, b_;  // (L_i, L_c) with the split only
   std::vector<RGB> out_, tau_;
+  std::vector<std::array<float, 2>> var_;  // (varA, varB) with variance only
   std::vector<SampleReason> reason_;
   std::vector<uint8_t> finite_, filled_;
   GuideImage guides_;

@@ -86,6 +86,7 @@ Status EmbreeProvider::Create(const Scene& scene, std::unique_ptr<EmbreeProvider
   cfg.mirrorDepth = fx.mirror ? rs.mirrorDepth : 0;
   cfg.indirectBounces = fx.indirect ? rs.indirectBounces : 0;
   cfg.indirectRays = fx.indirect ? rs.indirectRays : 0;
+  cfg.samplesPerPixel = rs.samplesPerPixel;
   cfg.seed = rs.seed;
   cfg.background = rs.background;
   p->integrator_ = std::make_unique<Integrator>(*p->bvh_, *p->camera_, cfg, std::move(materials), std::move(lights),
@@ -102,7 +103,7 @@ ProviderCapabilities EmbreeProvider::Capabilities() const {
   c.shaderId = true;
   c.texture = effects_.textures;
   c.splitRadiance = effects_.textures;
-  c.variance = false;
+  c.variance = scene_.render.samplesPerPixel > 1;
   c.threadSafe = true;
   c.name = "embree";
   return c;
@@ -153,6 +154,7 @@ Status EmbreeProvider::Evaluate(std::span<const Point2i> pixels, const SampleReq
       s.Li = r.Li;
       s.Lc = r.Lc;
     }
+    if (what.variance) s.variance = r.variance;
   }
   AddCounts(counts);
   return Status::Ok();

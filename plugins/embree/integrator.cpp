@@ -1,5 +1,6 @@
 #include "embree/integrator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -280,12 +281,32 @@ PixelRadiance Integrator::Evaluate(int x, int y, RayCounts* counts) const {
   q.mirrorLeft = cfg_.mirrorDepth;
   const Differentials diff{cr.origin, cr.dirDx, cr.origin, cr.dirDy};
   const Material& m = materials_[size_t(objectMaterial_[size_t(h.object)])];
-  Shading s = Shade(h, -cr.dir, m, q, &diff, rng, counts);
-  if (m.diffuse()) {
-    r.tau = TauAt(h, m, &diff);
-    r.Li = m.color * s.diffuse;
+  if (m.diffuse()) r.tau = TauAt(h, m, &diff);
+  // samplesPerPixel independent estimates from one random stream; their mean
+  // is the sample, the spread of the estimates gives its variance.
+  const int n = std::max(1, cfg_.samplesPerPixel);
+  double sumLi[3] = {}, sumLc[3] = {}, sumL[3] = {}, sumL2[3] = {};
+  for (int k = 0; k < n; ++k) {
+    const Shading s = Shade(h, -cr.dir, m, q, &diff, rng, counts);
+    const RGB li = m.diffuse() ? m.color * s.diffuse : RGB{};
+    const RGB l = li * r.tau + s.constant;
+    for (int c = 0; c < 3; ++c) {
+      sumLi[c] += li[c], sumLc[c] += s.constant[c];
+      sumL[c] += l[c], sumL2[c] += double(l[c]) * l[c];
+    }
   }
-  r.Lc = s.constant;
+  if (n == 1) {
+    r.Li = RGB(float(sumLi[0]), float(sumLi[1]), float(sumLi[2]));
+    r.Lc = RGB(float(sumLc[0]), float(sumLc[1]), float(sumLc[2]));
+  } else {
+    for (int c = 0; c < 3; ++c) {
+      r.Li[c] = float(sumLi[c] / n);
+      r.Lc[c] = float(sumLc[c] / n);
+      const double mean = sumL[c] / n;
+      // Unbiased sample variance of one estimate, divided by n: the variance of the mean.
+      r.variance[c] = float(std::max(0.0, sumL2[c] - n * mean * mean) / (double(n - 1) * n));
+    }
+  }
   r.L = r.Li * r.tau + r.Lc;
   return r;
 }

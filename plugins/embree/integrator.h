@@ -37,6 +37,9 @@ struct RayCounts {
 struct PixelRadiance {
   RGB L, Li, Lc;
   RGB tau{1.f, 1.f, 1.f};
+  /// Variance of the estimate of L (of the mean of samplesPerPixel
+  /// estimates); 0 with one estimate.
+  RGB variance;
 };
 
 /// The guides of one pixel.
@@ -55,6 +58,7 @@ struct IntegratorConfig {
   int mirrorDepth = 0;      ///< 0 when no material is a mirror
   int indirectBounces = 0;  ///< 0: off
   int indirectRays = 0;
+  int samplesPerPixel = 1;  ///< independent estimates averaged per pixel
   uint32_t seed = 0;
   RGB background;
 };

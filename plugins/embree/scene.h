@@ -125,6 +125,9 @@ struct RenderSettings {
   int indirectBounces = 0;       ///< 0: no indirect diffuse light
   int indirectRays = 16;         ///< cosine-distributed rays at the first diffuse hit
   int supersampling = 1;         ///< working resolution = resolution * supersampling per axis
+  /// Independent estimates averaged per exact pixel; from 2 on, each pixel
+  /// also reports the variance of its mean (a Monte Carlo renderer's "spp").
+  int samplesPerPixel = 1;
   uint32_t seed = 0;             ///< changes the per-pixel random streams
   RGB background{0.f, 0.f, 0.f}; ///< radiance of rays that leave the scene
 };

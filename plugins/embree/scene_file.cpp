@@ -71,6 +71,7 @@ Status ReadRender(const Json& j, const std::string& file, RenderSettings* s) {
   r.Int("glossy_rays", &s->glossyRays, false, 0, 65536);
   r.Int("mirror_depth", &s->mirrorDepth, false, 0, 64);
   r.Int("supersampling", &s->supersampling, false, 1, 16);
+  r.Int("samples_per_pixel", &s->samplesPerPixel, false, 1, 1 << 20);
   r.Uint32("seed", &s->seed, 0, UINT32_MAX);
   r.Color("background", &s->background);
   if (const Json* ind = r.Get("indirect"); ind && r.ok()) {
@@ -243,12 +244,41 @@ Status ReadLight(const Json& j, const std::string& path, const std::string& file
   return r.Finish();
 }
 
+/// Applies one "KEY.PATH=JSON" override to the root of a scene.
+Status ApplyOverride(const std::string& setting, const std::string& file, Json* root) {
+  const size_t eq = setting.find('=');
+  const std::string key = setting.substr(0, eq);
+  if (eq == std::string::npos || key.empty() || key.front() == '.' || key.back() == '.' ||
+      key.find("..") != std::string::npos)
+    return Status::Error(file + ": override '" + setting + "': expected KEY.PATH=VALUE (e.g. render.shadow_rays=4)");
+  Json value;
+  const std::string text = setting.substr(eq + 1);
+  if (!ParseJsonText(text, "override", &value).ok()) value = text;  // a bare word is a string
+  Json* node = root;
+  size_t begin = 0;
+  for (;;) {
+    const size_t dot = key.find('.', begin);
+    const std::string part = key.substr(begin, dot == std::string::npos ? std::string::npos : dot - begin);
+    if (!node->is_object())
+      return Status::Error(file + ": override '" + setting + "': '" + key.substr(0, begin ? begin - 1 : 0) +
+                           "' is not an object");
+    if (dot == std::string::npos) {
+      (*node)[part] = std::move(value);
+      return Status::Ok();
+    }
+    if (!node->contains(part)) (*node)[part] = Json::object();
+    node = &(*node)[part];
+    begin = dot + 1;
+  }
+}
+
 }  // namespace
 
 Status ParseScene(std::string_view text, const std::string& file, const std::string& baseDir,
-                  Scene* scene) {
+                  Scene* scene, std::span<const std::string> overrides) {
   Json root;
   DCM_RETURN_IF_ERROR(ParseJsonText(text, file, &root));
+  for (const std::string& o : overrides) DCM_RETURN_IF_ERROR(ApplyOverride(o, file, &root));
   Scene s;
   s.file = file;
   FieldReader r(root, "", file);
@@ -300,14 +330,14 @@ Status ParseScene(std::string_view text, const std::string& file, const std::str
   return Status::Ok();
 }
 
-Status LoadSceneFile(const std::string& path, Scene* scene) {
+Status LoadSceneFile(const std::string& path, Scene* scene, std::span<const std::string> overrides) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return Status::Error(path + ": cannot open the scene file");
   std::stringstream buffer;
   buffer << in.rdbuf();
   if (in.bad()) return Status::Error(path + ": read error");
   std::string baseDir = fs::path(path).parent_path().string();
-  return ParseScene(buffer.str(), path, baseDir, scene);
+  return ParseScene(buffer.str(), path, baseDir, scene, overrides);
 }
 
 }  // namespace dcm::embree

@@ -44,6 +44,8 @@ nlohmann::json OptionsToJson(const ReconstructionOptions& o) {
   j["fallback"] = o.fallback;
   j["fallback_max_changes"] = o.fallbackMaxChanges;
   j["finest_centre_probe"] = o.finestCentreProbe;
+  j["noise_significance"] = o.noiseSignificance;
+  j["denoise_samples"] = o.denoiseSamples;
   j["downsample"] = o.downsample;
   j["full_evaluation"] = o.fullEvaluation;
   j["threads"] = o.threads;
@@ -71,6 +73,7 @@ nlohmann::json StatsToJson(const ReconstructionStats& s) {
                  {"lazy_rejected", s.lazyRejected},
                  {"fallback", s.fallbackBlocks}};
   j["non_finite_samples"] = s.nonFiniteSamples;
+  j["denoised_samples"] = s.denoisedSamples;
   j["provider_calls"] = s.providerCalls;
   j["used"] = {{"split", s.usedSplit}, {"object_id", s.usedObjectId}, {"shader_id", s.usedShaderId}};
   return j;

@@ -35,6 +35,9 @@ struct RenderFlags {
   std::string size;
   float scale = 0.f;
   int supersampling = 0;
+  int spp = 0;
+  std::vector<std::string> overrides;
+  int64_t seed = -1;
   bool withReference = false;
   std::string referenceOut;
   EngineFlags engine;
@@ -91,7 +94,7 @@ int Fail(const Status& st) {
 int RunRender(const RenderFlags& f, CLI::App* app) {
   // Scene and its overrides.
   embree::Scene scene;
-  if (Status st = embree::LoadSceneFile(f.scene, &scene); !st.ok()) return Fail(st);
+  if (Status st = embree::LoadSceneFile(f.scene, &scene, f.overrides); !st.ok()) return Fail(st);
   if (!f.size.empty()) {
     if (Status st = ParseSize(f.size, &scene.camera.width, &scene.camera.height); !st.ok()) {
       std::cerr << "dcm render: " << st.message() << "\n";
@@ -102,6 +105,8 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
     scene.camera.height = std::max(1, int(std::lround(float(scene.camera.height) * f.scale)));
   }
   if (f.supersampling > 0) scene.render.supersampling = f.supersampling;
+  if (f.spp > 0) scene.render.samplesPerPixel = f.spp;
+  if (f.seed >= 0) scene.render.seed = uint32_t(f.seed);
 
   ReconstructionOptions options;
   if (Status st = ToOptions(f.engine, &options); !st.ok()) {
@@ -258,6 +263,16 @@ Registration reg("render", "Ray trace a scene file (Embree) with DCM: a few perc
                    app->add_option("--supersampling", f->supersampling,
                                    "override render.supersampling (samples per output pixel per axis)")
                        ->check(CLI::Range(1, 16));
+                   app->add_option("--spp", f->spp,
+                                   "override render.samples_per_pixel (independent estimates per exact pixel; "
+                                   "from 2 on, samples carry their variance)")
+                       ->check(CLI::Range(1, 1 << 20));
+                   app->add_option("--set", f->overrides,
+                                   "override a scene setting before it is read, KEY.PATH=JSON (repeatable), "
+                                   "e.g. --set render.shadow_rays=1 --set 'render.indirect={\"bounces\":2,\"rays\":1}'")
+                       ->allow_extra_args(false);
+                   app->add_option("--seed", f->seed, "override render.seed (an independent render of the same scene)")
+                       ->check(CLI::Range(int64_t(0), int64_t(UINT32_MAX)));
                    app->add_flag("--with-reference", f->withReference,
                                  "also render the full image in this run: prints the speed-up and the error");
                    app->add_option("--reference-out", f->referenceOut,

@@ -29,7 +29,11 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
   app->add_flag("--full", f->full, "evaluate every pixel exactly (the baseline)");
   app->add_option("--downsample", f->downsample, "the input is supersampled N times per axis; box-filter the result down");
   app->add_option("--threads", f->threads, "worker threads (0: all cores)");
-  app->add_option("--tile", f->tile, "tile size in pixels for parallel work");
+  app->add_option("--tile-size", f->tile, "pixels per side of a unit of parallel work (default 64)");
+  app->add_flag("--no-denoise-samples", f->noDenoise, "noisy samples: interpolate the raw exact samples");
+  app->add_option("--noise-significance", f->noiseSignificance,
+                  "with noisy samples (a variance channel or samples_per_pixel > 1): a difference counts when it "
+                  "exceeds this many standard deviations (default 3; 0: ignore the noise, as the paper)");
   app->add_option("--progressive", f->progressive,
                   "write DIR/level_N.exr after each refinement level (an early, usable picture)");
   app->add_flag("-v,--verbose", f->verbose, "say more");
@@ -59,6 +63,8 @@ Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {
   o->downsample = f.downsample;
   o->threads = f.threads;
   if (f.tile) o->tileSize = f.tile;
+  if (f.noDenoise) o->denoiseSamples = false;
+  if (f.noiseSignificance >= 0) o->noiseSignificance = f.noiseSignificance;
   if (!f.progressive.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(f.progressive, ec);

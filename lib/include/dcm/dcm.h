@@ -136,13 +136,15 @@ DCM_API void dcmSetString(DCMReconstructor r, const char* name, const char* valu
  *  0/1 here too. Ranges are checked by dcmExecute(). */
 DCM_API void dcmSetInt(DCMReconstructor r, const char* name, int value);
 
-/** Sets a float option: "contrast_threshold". Integer options accept whole
+/** Sets a float option: "contrast_threshold", "noise_significance" (with a
+ *  provider that reports variance). Integer options accept whole
  *  numbers here too. */
 DCM_API void dcmSetFloat(DCMReconstructor r, const char* name, float value);
 
 /** Sets a bool option: "surface_aware", "texture_split", "adaptive_borders",
  *  "zero_order_test", "gradient_blocks_simple", "first_order_test",
- *  "lazy_evaluation", "fallback", "finest_centre_probe", "full_evaluation". */
+ *  "lazy_evaluation", "fallback", "finest_centre_probe", "full_evaluation",
+ *  "denoise_samples". */
 DCM_API void dcmSetBool(DCMReconstructor r, const char* name, int value);
 
 /** The value of an integer (or bool) option; 0 and an error for an unknown name. */

@@ -84,6 +84,19 @@ struct ReconstructionOptions {
   /// that refines below the finest block size).
   bool finestCentreProbe = true;
 
+  /// Noisy samples (a provider that reports variance): a difference between
+  /// samples counts only when it exceeds `noiseSignificance` standard
+  /// deviations of the difference, in the contrast test, the border
+  /// bisection, the simple/complex tests and every probe. Monte Carlo noise
+  /// then no longer reads as detail (the paper's open problem, section 5).
+  /// 0: differences are taken at face value, as in the paper.
+  float noiseSignificance = 3.f;
+  /// Noisy samples: before interpolation, each exact sample becomes a local
+  /// linear fit through the exact samples within one elementary block of it
+  /// on its surface and not significantly different (its own pixel too:
+  /// the output is closer to the converged image than the raw sample).
+  bool denoiseSamples = true;
+
   int downsample = 1;   ///< the working image is `downsample`x the output per axis
   bool fullEvaluation = false;  ///< baseline: evaluate every pixel exactly
 
