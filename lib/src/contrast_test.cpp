@@ -67,11 +67,11 @@ float ContrastTest::Contrast(std::span<const Value> values) const {
   return c;
 }
 
-bool ContrastTest::WithinNoise(const Value& p, const Value& q) const {
+bool ContrastTest::WithinNoise(const Value& p, const Value& q, float k) const {
   const float varA = p.varA + q.varA, varB = split_ ? p.varB + q.varB : 0.f;
   if (k_ <= 0.f || !(varA > 0.f || varB > 0.f)) return false;
-  if (std::fabs(Luminance(p.a) - Luminance(q.a)) > k_ * std::sqrt(varA)) return false;
-  return !split_ || std::fabs(Luminance(p.b) - Luminance(q.b)) <= k_ * std::sqrt(varB);
+  if (std::fabs(Luminance(p.a) - Luminance(q.a)) > k * std::sqrt(varA)) return false;
+  return !split_ || std::fabs(Luminance(p.b) - Luminance(q.b)) <= k * std::sqrt(varB);
 }
 
 }  // namespace dcm::detail

@@ -40,7 +40,10 @@ class ContrastTest {
   /// True when noise alone may explain the difference of p and q: it is
   /// within k standard deviations in the luminance of a and (with the split)
   /// of b. Always false for noiseless values or k = 0.
-  bool WithinNoise(const Value& p, const Value& q) const;
+  bool WithinNoise(const Value& p, const Value& q) const { return WithinNoise(p, q, k_); }
+  /// The same with k standard deviations instead of the test's own (still
+  /// false for noiseless values, and when the test ignores noise).
+  bool WithinNoise(const Value& p, const Value& q, float k) const;
 
   float threshold() const { return threshold_; }
 

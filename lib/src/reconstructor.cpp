@@ -520,8 +520,11 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
           leaf = MakeLeaf(b, BlockType::kLazy, e.direction.index);
           leaf.centre = c;
           // A correction the noise may explain is noise: spread over the
-          // block by the tent, it would move both sides of the edge.
-          if (!contrast_.WithinNoise(exact, predicted)) leaf.delta = {exact.a - predicted.a, exact.b - predicted.b};
+          // block by the tent, it would move both sides of the edge. One
+          // sample moving a whole block needs stronger evidence than a
+          // refinement (which costs samples, not error): 3 sd at least.
+          if (!contrast_.WithinNoise(exact, predicted, std::max(opt_.noiseSignificance, 3.f)))
+            leaf.delta = {exact.a - predicted.a, exact.b - predicted.b};
           leaf.lo = leaf.hi = exact;
           for (Point2i p : e.border) {
             const int64_t ip = store_.Index(p.x, p.y);

@@ -28,6 +28,8 @@ struct AovFlags {
   std::vector<std::string> textures;
   std::string layer;
   std::vector<std::string> samples;
+  std::vector<std::string> secondRender;
+  bool estimateVariance = false;
 };
 
 /// Adds INPUT... and --preset, --map, --texture, --layer, --samples.
@@ -51,6 +53,12 @@ inline void AddAovFlags(CLI::App* app, AovFlags* f, bool samplesHelpForPlan) {
                       : "sparse round trip: samples EXRs rendered for `dcm plan` (repeatable); the "
                         "inputs then carry the guides only")
       ->allow_extra_args(false);
+  app->add_option("--second-render", f->secondRender,
+                  "noisy renders: an independent render of the same frame (another seed, same channels); the "
+                  "samples are the mean of both and their difference gives the variance (repeatable, as the inputs)")
+      ->allow_extra_args(false);
+  app->add_flag("--estimate-variance", f->estimateVariance,
+                "noisy renders without a variance channel: estimate the noise from the data (docs/NOISE.md)");
 }
 
 /// The provider options the flags select; the message names the flag at fault.
@@ -66,6 +74,8 @@ inline Status ToAovOptions(const AovFlags& f, bool sparse, bool split, aov::AovO
   o->sparse = sparse;
   o->samples = f.samples;
   o->split = split;
+  o->secondRender = f.secondRender;
+  o->estimateVariance = f.estimateVariance;
   return Status::Ok();
 }
 

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -565,6 +566,68 @@ Status ComputeSamples(const ChannelSet& set, Evaluator& ev, const RoleExprs& rol
   return Status::Ok();
 }
 
+/// Per pixel, the mean of `v` over the (2r+1)^2 window of pixels on the same
+/// surface (equal object and shader IDs where the inputs carry them).
+std::vector<RGB> SurfaceWindowMean(const std::vector<RGB>& v, const Data& d, int r) {
+  const int W = d.width, H = d.height;
+  auto same = [&](size_t i, size_t j) {
+    return (d.objectId.empty() || d.objectId[i] == d.objectId[j]) &&
+           (d.shaderId.empty() || d.shaderId[i] == d.shaderId[j]);
+  };
+  std::vector<RGB> out(v.size());
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const size_t i = size_t(y) * size_t(W) + size_t(x);
+      double sum[3] = {};
+      int count = 0;
+      for (int ny = std::max(0, y - r); ny <= std::min(H - 1, y + r); ++ny)
+        for (int nx = std::max(0, x - r); nx <= std::min(W - 1, x + r); ++nx) {
+          const size_t j = size_t(ny) * size_t(W) + size_t(nx);
+          if (!same(i, j) || !IsFinite(v[j])) continue;
+          for (int c = 0; c < 3; ++c) sum[c] += v[j][c];
+          ++count;
+        }
+      if (count) out[i] = RGB(float(sum[0] / count), float(sum[1] / count), float(sum[2] / count));
+    }
+  return out;
+}
+
+/// The variance estimate of AovOptions::estimateVariance, in L units.
+std::vector<RGB> EstimateVarianceFromData(const Data& d) {
+  const int W = d.width, H = d.height;
+  const bool split = !d.Li.empty() && !d.tau.empty();
+  const std::vector<RGB>& v = split ? d.Li : d.L;
+  auto same = [&](size_t i, size_t j) {
+    return (d.objectId.empty() || d.objectId[i] == d.objectId[j]) &&
+           (d.shaderId.empty() || d.shaderId[i] == d.shaderId[j]);
+  };
+  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+  std::vector<RGB> r2(v.size(), RGB::Gray(kNaN));
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const size_t i = size_t(y) * size_t(W) + size_t(x);
+      if (!IsFinite(v[i])) continue;
+      RGB mean;
+      int count = 0;
+      for (auto [dx, dy] : {std::pair{-1, 0}, {1, 0}, {0, -1}, {0, 1}}) {
+        const int nx = x + dx, ny = y + dy;
+        if (nx < 0 || ny < 0 || nx >= W || ny >= H) continue;
+        const size_t j = size_t(ny) * size_t(W) + size_t(nx);
+        if (!same(i, j) || !IsFinite(v[j])) continue;
+        mean += v[j];
+        ++count;
+      }
+      if (count < 2) continue;
+      // r = v - mean of k neighbours has variance sigma^2 (1 + 1/k).
+      const RGB res = v[i] - mean * (1.f / float(count));
+      r2[i] = res * res * (1.f / (1.f + 1.f / float(count)));
+    }
+  std::vector<RGB> var = SurfaceWindowMean(r2, d, 2);
+  if (split)
+    for (size_t i = 0; i < var.size(); ++i) var[i] = var[i] * d.tau[i] * d.tau[i];
+  return var;
+}
+
 /// Which sample roles `split`/non-split needs; message when they are absent.
 Status CheckSampleRoles(const RoleExprs& roles, bool split, bool tau, const ChannelSet& set,
                         const std::string& what) {
@@ -663,8 +726,53 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
       d->notes.push_back(hasLc ? "L_c: " + RgbText(sroles, kLc) : "L_c: L - L_i*tau");
     }
     if (hasVar) d->notes.push_back("variance: " + RgbText(sroles, kVar));
+    if (hasVar && (!options.secondRender.empty() || options.estimateVariance))
+      return Status::Error("the inputs carry variance (" + RgbText(sroles, kVar) +
+                           "): a second render or an estimate from the data would replace it; use one");
+    if (!options.secondRender.empty()) {
+      // An independent render: the mean of the two, and the variance of that
+      // mean from their difference.
+      ChannelSet second;
+      for (const auto& path : options.secondRender) DCM_RETURN_IF_ERROR(second.Add(path));
+      if (second.width() != d->width || second.height() != d->height)
+        return Status::Error("second render " + Quote(options.secondRender[0]) + " is " +
+                             std::to_string(second.width()) + "x" + std::to_string(second.height()) + ", " +
+                             Quote(inputs[0]) + " is " + std::to_string(d->width) + "x" + std::to_string(d->height));
+      RoleExprs roles2;
+      DCM_RETURN_IF_ERROR(PresetExprs(options.preset, options.viewLayer, second, /*samples=*/true, &roles2, nullptr));
+      roles2[size_t(Role::kMask)].reset();
+      DCM_RETURN_IF_ERROR(ApplyMappings(options.mappings, second, /*samples=*/true, &roles2));
+      DCM_RETURN_IF_ERROR(CheckSampleRoles(roles2, split, hasTau, second, "second render " + Quote(options.secondRender[0])));
+      Data b;
+      b.tau = d->tau;
+      b.L.assign(n, RGB{});
+      if (split) b.Li.assign(n, RGB{}), b.Lc.assign(n, RGB{});
+      Evaluator ev2(second);
+      DCM_RETURN_IF_ERROR(ComputeSamples(second, ev2, roles2, split, false, nullptr, &b));
+      DCM_RETURN_IF_ERROR(ev2.Report(roles2, {kL, kLi, kLc}, nullptr, &d->warnings));
+      std::vector<RGB> diff2(n);
+      for (size_t i = 0; i < n; ++i) {
+        const RGB diff = d->L[i] - b.L[i];
+        diff2[i] = diff * diff * 0.25f;
+        d->L[i] = (d->L[i] + b.L[i]) * 0.5f;
+        if (split) {
+          d->Li[i] = (d->Li[i] + b.Li[i]) * 0.5f;
+          d->Lc[i] = (d->Lc[i] + b.Lc[i]) * 0.5f;
+        }
+      }
+      d->var = SurfaceWindowMean(diff2, *d, 2);
+      d->notes.push_back("samples: the mean of the inputs and the second render " + Quote(options.secondRender[0]) +
+                         "; variance from their difference (5x5 window on each surface)");
+    } else if (options.estimateVariance) {
+      d->var = EstimateVarianceFromData(*d);
+      d->notes.push_back("variance: estimated from the data (residual against the 4-neighbours, 5x5 window on "
+                         "each surface)");
+    }
     d->dense = true;
   } else {
+    if (!options.secondRender.empty() || options.estimateVariance)
+      return Status::Error("a second render and a variance estimate from the data need dense inputs; in the "
+                           "sparse round trip the samples carry their variance (var.R/G/B with --map var=...)");
     // Capabilities come from the guides and the options alone, so that they
     // are the same in every round; the samples must then match them.
     split = options.split && hasTau;

@@ -95,6 +95,21 @@ struct AovOptions {
   /// Offer the split (L_i, L_c) when tau is available. In sparse mode this
   /// decides which channels the samples must carry.
   bool split = true;
+  /// Dense mode, noisy renders without a variance channel. An independent
+  /// render of the same frame (another seed; same channels): the samples are
+  /// the mean of the two renders, and the variance of that mean is
+  /// (A - B)^2 / 4, averaged over a 5x5 window of pixels on the same surface
+  /// (one pixel's difference alone is one degree of freedom).
+  std::vector<std::string> secondRender;
+  /// Dense mode, one noisy render and no variance channel: the variance is
+  /// estimated from the data, as the mean over a 5x5 window on the same
+  /// surface of r^2 / 1.25, r = the pixel minus the mean of its same-surface
+  /// 4-neighbours (1.25 sigma^2 for independent noise), in L_i when the split
+  /// is available (the texture divided out), else in L. It fails where the
+  /// image has real detail at the pixel scale that the guides do not explain
+  /// (an untextured pattern, hair, aliased geometry inside one object): that
+  /// detail is taken for noise and smoothed over.
+  bool estimateVariance = false;
 };
 
 /// The provider. Create with Open(); all data is loaded (and checked) there,
