@@ -82,9 +82,10 @@ class AnalyticScene:
 class Provider:
     """Serves a scene over the dcm-pipe protocol."""
 
-    def __init__(self, scene, name="analytic-python"):
+    def __init__(self, scene, name="analytic-python", noise=0.0):
         self.scene = scene
         self.name = name
+        self.noise = noise
         self.evaluated = 0
         self.batches = 0
 
@@ -104,8 +105,9 @@ class Provider:
 
     # --- the protocol ----------------------------------------------------
     def handshake_line(self):
-        return "dcm-pipe %d width=%d height=%d caps=object_id,shader_id,texture,split name=%s\n" % (
-            PROTOCOL_VERSION, self.scene.width, self.scene.height, self.name)
+        caps = "object_id,shader_id,texture,split" + (",variance" if self.noise > 0 else "")
+        return "dcm-pipe %d width=%d height=%d caps=%s name=%s\n" % (
+            PROTOCOL_VERSION, self.scene.width, self.scene.height, caps, self.name)
 
     def answer_guides(self, tokens, out):
         x0, y0, x1, y1 = (int(t) for t in tokens[1:5])
@@ -129,8 +131,21 @@ class Provider:
         x, y = xy[:, 0], xy[:, 1]
         if n and (x.min() < 0 or y.min() < 0 or x.max() >= self.scene.width or y.max() >= self.scene.height):
             raise ProtocolError("pixel outside the image")
+        want_variance = len(tokens) > 2 and "variance" in tokens[2].split(",")
         L, li, lc = self.scene.radiance(x, y)
-        record = np.hstack([L, li, lc]) if split else L
+        if self.noise > 0:
+            # A Monte Carlo estimate in miniature: Gaussian noise of sd `noise`
+            # on L_i, the same deviate for a pixel in every batch.
+            dev = np.array([np.random.default_rng(int(py) * 65536 + int(px)).standard_normal()
+                            for px, py in zip(x, y)], np.float32)[:, None]
+            tau = self.scene.guides(x, y)[2]
+            li = li + self.noise * dev
+            L = li * tau + lc
+        parts = [L] + ([li, lc] if split else [])
+        if want_variance:
+            tau = self.scene.guides(x, y)[2]
+            parts.append(np.full((n, 3), self.noise ** 2, np.float32) * tau * tau)
+        record = np.hstack(parts)
         out.write(b"samples %d\n" % n)
         out.write(record.astype("<f4").tobytes())
         self.evaluated += n
@@ -168,6 +183,9 @@ def main(argv=None):
     ap.add_argument("--width", type=int, default=192)
     ap.add_argument("--height", type=int, default=144)
     ap.add_argument("--truth", help="write the full image (float32 RGB, row-major, raw) to this file and exit")
+    ap.add_argument("--noise", type=float, default=0.0,
+                    help="Gaussian noise of this sd on L_i, announced with its variance (a Monte Carlo renderer); "
+                         "--truth stays noise-free")
     ap.add_argument("--count-file", help="at the end, write the number of evaluated pixels to this file")
     args = ap.parse_args(argv)
     scene = AnalyticScene(args.width, args.height)
@@ -176,7 +194,7 @@ def main(argv=None):
         L, _, _ = scene.radiance(xs.ravel(), ys.ravel())
         L.astype("<f4").tofile(args.truth)
         return 0
-    provider = Provider(scene)
+    provider = Provider(scene, noise=args.noise)
     status = provider.serve(sys.stdin.buffer, sys.stdout.buffer)
     sys.stderr.write("analytic_provider: evaluated %d pixels in %d batches\n" % (provider.evaluated, provider.batches))
     if args.count_file:

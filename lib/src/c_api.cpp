@@ -39,6 +39,7 @@ struct DCMReconstructorImpl {
   std::vector<uint32_t> objectIds, shaderIds;
   std::vector<dcm::RGB> texture;
   DCMSampleFunction sample = nullptr;
+  DCMNoisySampleFunction noisySample = nullptr;  ///< set instead of `sample`
   void* sampleUser = nullptr;
   int sampleFlags = 0;
   DCMProgressFunction progress = nullptr;
@@ -213,6 +214,7 @@ class CallbackProvider final : public dcm::SampleProvider {
     c.shaderId = !r_.shaderIds.empty();
     c.texture = !r_.texture.empty();
     c.splitRadiance = (r_.sampleFlags & DCM_SAMPLE_SPLIT) != 0;
+    c.variance = r_.noisySample != nullptr;
     c.threadSafe = (r_.sampleFlags & DCM_SAMPLE_THREAD_SAFE) != 0;
     c.name = "C API sample function";
     return c;
@@ -246,13 +248,18 @@ class CallbackProvider final : public dcm::SampleProvider {
       xy[2 * i] = pixels[i].x;
       xy[2 * i + 1] = pixels[i].y;
     }
-    std::vector<float> rgb(3 * n, 0.f), li, lc;
+    std::vector<float> rgb(3 * n, 0.f), li, lc, var;
     if (what.split) {
       li.assign(3 * n, 0.f);
       lc.assign(3 * n, 0.f);
     }
-    const int code = r_.sample(r_.sampleUser, xy.data(), int(n), rgb.data(), what.split ? li.data() : nullptr,
-                               what.split ? lc.data() : nullptr);
+    const bool variance = what.variance && r_.noisySample;
+    if (variance) var.assign(3 * n, 0.f);
+    float* const liOut = what.split ? li.data() : nullptr;
+    float* const lcOut = what.split ? lc.data() : nullptr;
+    const int code = r_.noisySample ? r_.noisySample(r_.sampleUser, xy.data(), int(n), rgb.data(), liOut, lcOut,
+                                                     variance ? var.data() : nullptr)
+                                    : r_.sample(r_.sampleUser, xy.data(), int(n), rgb.data(), liOut, lcOut);
     if (code != 0) {
       failed_ = true;
       return dcm::Status::Error("the sample function returned " + std::to_string(code) + " for a batch of " +
@@ -264,6 +271,7 @@ class CallbackProvider final : public dcm::SampleProvider {
         out[i].Li = {li[3 * i], li[3 * i + 1], li[3 * i + 2]};
         out[i].Lc = {lc[3 * i], lc[3 * i + 1], lc[3 * i + 2]};
       }
+      if (variance) out[i].variance = {var[3 * i], var[3 * i + 1], var[3 * i + 2]};
     }
     return dcm::Status::Ok();
   }
@@ -489,6 +497,17 @@ DCM_API void dcmSetSampleFunction(DCMReconstructor r, DCMSampleFunction fn, void
   if (flags & ~(DCM_SAMPLE_THREAD_SAFE | DCM_SAMPLE_SPLIT))
     return SetError(r, DCM_ERROR_INVALID_ARGUMENT, "dcmSetSampleFunction: unknown flags");
   r->sample = fn;
+  r->noisySample = nullptr;
+  r->sampleUser = user;
+  r->sampleFlags = flags;
+}
+
+DCM_API void dcmSetNoisySampleFunction(DCMReconstructor r, DCMNoisySampleFunction fn, void* user, int flags) {
+  if (!r) return SetError(nullptr, DCM_ERROR_INVALID_ARGUMENT, "dcmSetNoisySampleFunction: NULL reconstructor");
+  if (flags & ~(DCM_SAMPLE_THREAD_SAFE | DCM_SAMPLE_SPLIT))
+    return SetError(r, DCM_ERROR_INVALID_ARGUMENT, "dcmSetNoisySampleFunction: unknown flags");
+  r->noisySample = fn;
+  r->sample = nullptr;
   r->sampleUser = user;
   r->sampleFlags = flags;
 }
@@ -517,8 +536,9 @@ DCM_API DCMError dcmExecute(DCMReconstructor r) {
       fail(DCM_ERROR_INVALID_OPERATION, "dcmExecute: no image size (call dcmSetImageSize())");
       return code;
     }
-    if (!r->sample) {
-      fail(DCM_ERROR_INVALID_OPERATION, "dcmExecute: no sample function (call dcmSetSampleFunction())");
+    if (!r->sample && !r->noisySample) {
+      fail(DCM_ERROR_INVALID_OPERATION,
+           "dcmExecute: no sample function (call dcmSetSampleFunction() or dcmSetNoisySampleFunction())");
       return code;
     }
     if (r->options.downsample > 0 &&

@@ -342,3 +342,57 @@ TEST(CApi, RetainKeepsTheHandleAlive) {
 }
 
 }  // namespace
+
+namespace {
+
+/// The two-surface scene with Gaussian noise of sd 0.03 per pixel (fixed by
+/// the pixel), reporting its variance when asked.
+struct NoisyScene : Scene {
+  std::atomic<bool> sawVarianceBuffer{false};
+};
+
+int EvaluateNoisy(void* user, const int* xy, int count, float* rgb, float* li, float* lc, float* variance) {
+  auto* s = static_cast<NoisyScene*>(user);
+  if (variance) s->sawVarianceBuffer = true;
+  for (int i = 0; i < count; ++i) {
+    const int x = xy[2 * i], y = xy[2 * i + 1];
+    s->Truth(x, y, rgb + 3 * i);
+    // A deviate fixed by the pixel (Box-Muller from a hash).
+    uint32_t h = uint32_t(x) * 0x9e3779b1u ^ uint32_t(y) * 0x85ebca6bu;
+    h ^= h >> 15, h *= 0x2c1b3c6du, h ^= h >> 12, h *= 0x297a2d39u, h ^= h >> 15;
+    const double u1 = (double(h >> 8) + 0.5) * 0x1p-24, u2 = double((h * 2654435761u) >> 8) * 0x1p-24;
+    const float n = float(std::sqrt(-2.0 * std::log(u1)) * std::cos(6.283185307179586 * u2));
+    for (int c = 0; c < 3; ++c) {
+      rgb[3 * i + c] += 0.03f * n;
+      if (variance) variance[3 * i + c] = 0.03f * 0.03f;
+      if (li && lc) li[3 * i + c] = rgb[3 * i + c], lc[3 * i + c] = 0.f;
+    }
+  }
+  s->evaluated += count;
+  return 0;
+}
+
+}  // namespace
+
+TEST(CApi, NoisySampleFunctionReportsVariance) {
+  // With the variance reported, the engine does not chase the noise: fewer
+  // exact pixels than with the noise taken at face value (noise_significance
+  // 0), on the same samples.
+  auto exactPixels = [](float significance, bool* sawVariance) {
+    NoisyScene scene;
+    DCMReconstructor r = Make(scene);
+    dcmSetNoisySampleFunction(r, EvaluateNoisy, &scene, DCM_SAMPLE_THREAD_SAFE);
+    dcmSetFloat(r, "noise_significance", significance);
+    EXPECT_FLOAT_EQ(dcmGetFloat(r, "noise_significance"), significance);
+    EXPECT_EQ(dcmExecute(r), DCM_ERROR_NONE) << TakeError(r);
+    *sawVariance = scene.sawVarianceBuffer;
+    const long n = scene.evaluated;
+    dcmReleaseReconstructor(r);
+    return n;
+  };
+  bool withVariance = false, without = true;
+  const long aware = exactPixels(1.5f, &withVariance), literal = exactPixels(0.f, &without);
+  EXPECT_TRUE(withVariance) << "the engine asks for the variance when it weighs noise";
+  EXPECT_FALSE(without) << "and not when it ignores it";
+  EXPECT_LT(aware, literal);
+}

@@ -170,6 +170,42 @@ dcm::Status Drive(const std::string& command, double timeout = 60) {
   return p->Finish();
 }
 
+TEST(PipeProvider, VarianceOfANoisyProvider) {
+  // The provider announces `variance` with --noise: samples then carry it
+  // (noise sd 0.05 on L_i, so sigma^2 tau^2 in L), and the engine weighs it:
+  // with the noise taken into account, fewer pixels are evaluated than with
+  // the noise taken at face value.
+  std::unique_ptr<dcm::pipe::PipeProvider> p;
+  ASSERT_TRUE(Start(Analytic("--width 96 --height 64 --noise 0.05"), &p).ok());
+  ASSERT_TRUE(p->Capabilities().variance);
+  dcm::GuideImage g;
+  ASSERT_TRUE(p->Guides({{0, 0}, {96, 64}}, {false, false, true}, &g).ok());
+  std::vector<dcm::Point2i> px{{0, 0}, {50, 30}, {95, 63}};
+  std::vector<dcm::ExactSample> s(px.size());
+  ASSERT_TRUE(p->Evaluate(px, {true, true}, s).ok());
+  for (size_t i = 0; i < px.size(); ++i) {
+    const dcm::RGB tau = g.texture[size_t(px[i].y) * 96 + size_t(px[i].x)];
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(s[i].variance[c], 0.0025f * tau[c] * tau[c], 1e-6f) << "pixel " << i << " channel " << c;
+    // L = L_i tau + L_c holds for the noisy sample (float rounding).
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(s[i].L[c], s[i].Li[c] * tau[c] + s[i].Lc[c], 1e-5f);
+  }
+  ASSERT_TRUE(p->Finish().ok());
+
+  auto exactFraction = [](float significance) {
+    std::unique_ptr<dcm::pipe::PipeProvider> q;
+    EXPECT_TRUE(Start(Analytic("--width 96 --height 64 --noise 0.05"), &q).ok());
+    dcm::ReconstructionOptions o;
+    o.noiseSignificance = significance;
+    dcm::Reconstruction r;
+    const dcm::Status st = dcm::Reconstruct(*q, o, &r);
+    EXPECT_TRUE(st.ok()) << st.message();
+    EXPECT_TRUE(q->Finish().ok());
+    return r.stats.exactFraction();
+  };
+  EXPECT_LT(exactFraction(1.5f), exactFraction(0.f));
+}
+
 struct FaultCase {
   const char* mode;
   const char* message;

@@ -41,7 +41,7 @@ extern "C" {
 #endif
 
 /** Version of this C interface; raised on incompatible changes. */
-#define DCM_C_API_VERSION 1
+#define DCM_C_API_VERSION 2
 
 /** A reconstructor: options, guides, the sample callback and the last result. */
 typedef struct DCMReconstructorImpl* DCMReconstructor;
@@ -89,6 +89,15 @@ enum {
  *  stops the reconstruction with DCM_ERROR_CALLBACK (the value is in the
  *  message). Exact samples must be deterministic per pixel. */
 typedef int (*DCMSampleFunction)(void* user, const int* xy, int count, float* rgb, float* li, float* lc);
+
+/** A sample function of a noisy (Monte Carlo) renderer: as DCMSampleFunction,
+ *  and `variance`, when not NULL, receives 3*count floats: the variance of the
+ *  estimate of L per channel (the variance of the pixel's mean). The engine
+ *  then asks whether differences are significant given that noise (option
+ *  "noise_significance") and denoises the samples ("denoise_samples"). Since
+ *  API version 2. */
+typedef int (*DCMNoisySampleFunction)(void* user, const int* xy, int count, float* rgb, float* li, float* lc,
+                                      float* variance);
 
 /** Reports progress in [0,1] with the name of the current stage; called from
  *  the thread that runs dcmExecute(). */
@@ -177,6 +186,11 @@ DCM_API void dcmSetTexture(DCMReconstructor r, const float* rgb);
  *  DCM_SAMPLE_* flags. Without DCM_SAMPLE_THREAD_SAFE it is called from one
  *  thread at a time. */
 DCM_API void dcmSetSampleFunction(DCMReconstructor r, DCMSampleFunction fn, void* user, int flags);
+
+/** Sets a sample function that also reports the variance of its samples
+ *  (replaces one set by dcmSetSampleFunction(), and the other way round).
+ *  Flags as for dcmSetSampleFunction(). Since API version 2. */
+DCM_API void dcmSetNoisySampleFunction(DCMReconstructor r, DCMNoisySampleFunction fn, void* user, int flags);
 
 /** Sets (or with NULL removes) a progress function. */
 DCM_API void dcmSetProgressFunction(DCMReconstructor r, DCMProgressFunction fn, void* user);

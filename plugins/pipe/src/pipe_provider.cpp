@@ -203,6 +203,7 @@ Status PipeProvider::Handshake() {
         else if (c == "shader_id") caps_.shaderId = true;
         else if (c == "texture") caps_.texture = true;
         else if (c == "split") caps_.splitRadiance = true;
+        else if (c == "variance") caps_.variance = true;
         // Unknown capabilities are ignored (newer providers).
       }
     } else if (key == "name") {
@@ -289,8 +290,10 @@ Status PipeProvider::Evaluate(std::span<const Point2i> pixels, const SampleReque
   if (pixels.size() > size_t(std::numeric_limits<int32_t>::max() / 2))
     return Status::Error(Prefix() + ": batch too large");
   const bool split = what.split && caps_.splitRadiance;
+  const bool variance = what.variance && caps_.variance;
   const size_t n = pixels.size();
-  const std::string request = "eval " + std::to_string(n) + (split ? " L,split" : " L");
+  const std::string request =
+      "eval " + std::to_string(n) + " L" + (split ? ",split" : "") + (variance ? ",variance" : "");
   std::vector<char> message(request.size() + 1 + n * 8);
   std::memcpy(message.data(), request.data(), request.size());
   message[request.size()] = '\n';
@@ -314,7 +317,7 @@ Status PipeProvider::Evaluate(std::span<const Point2i> pixels, const SampleReque
     return Fail("answered 'samples " + std::to_string(count) + "' to '" + request + "', which asks for " +
                 std::to_string(n) + " pixels");
   }
-  const size_t perPixel = split ? 9 : 3;
+  const size_t perPixel = 3 + (split ? 6 : 0) + (variance ? 3 : 0);
   std::vector<float> f(n * perPixel);
   if (!ReadPayload(*child_, f.data(), f.size() * 4, request, options_.timeoutSeconds, &failure).ok())
     return Fail(failure);
@@ -324,6 +327,10 @@ Status PipeProvider::Evaluate(std::span<const Point2i> pixels, const SampleReque
     if (split) {
       out[i].Li = {p[3], p[4], p[5]};
       out[i].Lc = {p[6], p[7], p[8]};
+    }
+    if (variance) {
+      const float* v = p + (split ? 9 : 3);
+      out[i].variance = {v[0], v[1], v[2]};
     }
   }
   return Status::Ok();
