@@ -180,3 +180,57 @@ TEST(BenchQuick, RoomOutputsAreSane) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(BenchNoise, SppSweepAgainstAConvergedReference) {
+  // dcm bench --spp on a path-traced room at 64x64: the noise points exist
+  // for every spp and method, the reference is the high-spp render, and
+  // (the property of issue #8 that holds at any size) dcm, weighing the
+  // noise, evaluates fewer pixels than the paper's method, which chases it.
+  const fs::path dir = fs::temp_directory_path() / ("dcm_bench_noise_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const std::string scene = std::string(DCM_SOURCE_DIR) + "/examples/scenes/room.json";
+  const std::string cmd = ShellQuote(DCM_BINARY) + " bench " + ShellQuote(scene) +
+                          " --scale 0.125 --spp 4,16 --reference-spp 256 --set render.shadow_rays=1"
+                          " --set render.glossy_rays=1 --set render.supersampling=1 --quiet --out " +
+                          ShellQuote(dir.string());
+  const int status = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << cmd;
+  std::ifstream in(dir / "bench.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_EQ(j["inputs"].size(), 1u);
+  EXPECT_EQ(j["inputs"][0]["reference_spp"], 256);
+  std::map<std::string, nlohmann::json> byLabel;
+  for (const auto& p : j["points"]) byLabel[p["label"].get<std::string>()] = p;
+  EXPECT_EQ(byLabel["full"]["spp"], 256);
+  for (int spp : {4, 16}) {
+    const std::string sfx = " spp=" + std::to_string(spp);
+    for (const char* m : {"full", "dcm", "dcm noise ignored", "paper"})
+      ASSERT_TRUE(byLabel.count(m + sfx)) << m << sfx;
+    EXPECT_EQ(byLabel["full" + sfx]["exact_fraction"], 1.0);
+    EXPECT_LT(Num(byLabel["dcm" + sfx]["exact_fraction"]), Num(byLabel["paper" + sfx]["exact_fraction"]));
+    EXPECT_TRUE(std::isfinite(Num(byLabel["dcm" + sfx]["psnr_db"])));
+  }
+  if (DCM_HAVE_MATPLOTLIB) EXPECT_TRUE(fs::is_regular_file(dir / "room_noise.png"));
+  fs::remove_all(dir);
+}
+
+TEST(BenchNoise, UsageErrors) {
+  const std::string scene = std::string(DCM_SOURCE_DIR) + "/examples/scenes/room.json";
+  const fs::path dir = fs::temp_directory_path() / ("dcm_bench_noise_err_" + std::to_string(::getpid()));
+  const std::string cmd = ShellQuote(DCM_BINARY) + " bench " + ShellQuote(scene) +
+                          " --scale 0.125 --spp 4,16 --reference-spp 16 --quiet --no-plots --out " +
+                          ShellQuote(dir.string()) + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  ASSERT_NE(p, nullptr);
+  std::string out;
+  char buf[512];
+  while (size_t n = fread(buf, 1, sizeof buf, p)) out.append(buf, n);
+  const int status = pclose(p);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) != 0) << out;
+  EXPECT_NE(out.find("--reference-spp 16 is also in --spp"), std::string::npos) << out;
+  fs::remove_all(dir);
+}
+
+}  // namespace

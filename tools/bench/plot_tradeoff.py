@@ -54,6 +54,33 @@ def save(fig, path):
     plt.close(fig)
 
 
+def plot_noise(scene, rows, path):
+    """dcm bench --spp: PSNR against the converged reference and exact pixels
+    against the samples per pixel, one curve per method."""
+    labels = []
+    for r in rows:
+        label = r["label"].rsplit(" spp=", 1)[0]
+        if label not in labels:
+            labels.append(label)
+    fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4.2))
+    for label in labels:
+        c = sorted((r for r in rows if r["label"].rsplit(" spp=", 1)[0] == label), key=lambda r: num(r["spp"]))
+        x = [num(r["spp"]) for r in c]
+        a.plot(x, [num(r["psnr_db"]) for r in c], "o-", label=label)
+        b.plot(x, [100 * num(r["exact_fraction"]) for r in c], "o-", label=label)
+    for ax in (a, b):
+        ax.set_xscale("log", base=2)
+        ax.set_xlabel("samples per pixel of the exact evaluation")
+        ax.grid(True, which="both", alpha=0.3)
+    a.set_ylabel("PSNR against the converged render, dB")
+    b.set_ylabel("exact pixels, %")
+    a.set_title("%s: error from noisy samples" % scene)
+    b.set_title("%s: pixels evaluated" % scene)
+    a.legend(fontsize=8)
+    fig.tight_layout()
+    save(fig, path)
+
+
 def main(argv):
     if len(argv) < 3:
         print(__doc__, file=sys.stderr)
@@ -68,6 +95,13 @@ def main(argv):
             scenes.append(r["scene"])
     for scene in scenes:
         pts = [r for r in rows if r["scene"] == scene]
+        noise = [r for r in pts if "noise" in r["sweeps"].split("|")]
+        if noise:
+            path = os.path.join(out_dir, "%s_noise.png" % scene)
+            plot_noise(scene, noise, path)
+            if not quiet:
+                print("wrote %s" % path, file=sys.stderr)
+            continue
         full = [r for r in pts if r["method"] == "full"]
         for xkey, xlabel, name, logx in [
             ("time_total_s", "total time, s (illumination + guides + reconstruction)", "psnr_vs_time", True),

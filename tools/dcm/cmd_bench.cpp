@@ -68,6 +68,10 @@ struct BenchFlags {
   std::vector<std::string> maps;
   int downsample = 1;
   bench::JbuParams jbu;
+  // Scenes: scene overrides and the noise sweep.
+  std::vector<std::string> overrides;
+  std::vector<int> spp;
+  int referenceSpp = 0;
 };
 
 /// The settings of one point of the sweep.
@@ -77,6 +81,7 @@ struct Config {
   std::string sweeps;   ///< sweeps this point belongs to, '|'-separated
   ReconstructionOptions options;
   int supersampling = 1;
+  int spp = 0;  ///< noise sweep: estimates per exact pixel (0: the scene's own)
   // Rivals: the budget (exact pixels) and the label of the point it matches.
   int64_t budget = 0;
   std::string budgetOf;
@@ -103,7 +108,8 @@ struct Subject {
 #if DCM_BENCH_HAVE_AOV
   aov::AovOptions aovOptions;
 #endif
-  std::map<int, std::unique_ptr<SampleProvider>> providers;  ///< by supersampling
+  /// By (supersampling, samples per pixel); spp 0 is the scene's own setting.
+  std::map<std::pair<int, int>, std::unique_ptr<SampleProvider>> providers;
 };
 
 std::string Fmt(const char* fmt, double v) {
@@ -128,15 +134,22 @@ bool EndsWith(const std::string& s, const std::string& suffix) {
                     [](char a, char b) { return std::tolower(a) == std::tolower(b); });
 }
 
-Status GetProvider(Subject& s, int ss, SampleProvider** out) {
-  auto it = s.providers.find(ss);
+/// The provider at supersampling `ss` and `spp` estimates per pixel (0: the
+/// scene's own). Noisy renders (spp > 0) use another seed than the scene's,
+/// so that they are independent of a reference rendered with its seed.
+Status GetProvider(Subject& s, int ss, SampleProvider** out, int spp = 0) {
+  auto it = s.providers.find({ss, spp});
   if (it == s.providers.end()) {
     if (s.kind != "scene") return Status::Error(s.input + ": supersampling applies to scenes only");
     embree::Scene scene = s.scene;
     scene.render.supersampling = ss;
+    if (spp > 0) {
+      scene.render.samplesPerPixel = spp;
+      scene.render.seed += uint32_t(spp);  // each spp its own random streams
+    }
     std::unique_ptr<embree::EmbreeProvider> p;
     DCM_RETURN_IF_ERROR(embree::EmbreeProvider::Create(scene, &p));
-    it = s.providers.emplace(ss, std::move(p)).first;
+    it = s.providers.emplace(std::pair{ss, spp}, std::move(p)).first;
   }
   *out = it->second.get();
   return Status::Ok();
@@ -161,7 +174,7 @@ Status OpenSubject(const BenchFlags& f, const std::string& input, Subject* s) {
     s->width = (caps.width + f.downsample - 1) / f.downsample;
     s->height = (caps.height + f.downsample - 1) / f.downsample;
     s->effects = {"aov"};
-    s->providers.emplace(f.downsample, std::move(p));
+    s->providers.emplace(std::pair{f.downsample, 0}, std::move(p));
     return Status::Ok();
 #else
     return Status::Error(input + ": AOV EXR inputs need plugins/aov (dcm_aov), which this build does not have; "
@@ -169,7 +182,7 @@ Status OpenSubject(const BenchFlags& f, const std::string& input, Subject* s) {
 #endif
   }
   s->kind = "scene";
-  DCM_RETURN_IF_ERROR(embree::LoadSceneFile(input, &s->scene));
+  DCM_RETURN_IF_ERROR(embree::LoadSceneFile(input, &s->scene, f.overrides));
   const float scale = f.scale > 0.f ? f.scale : (f.quick ? 0.125f : 1.f);
   s->scene.camera.width = std::max(8, int(std::lround(float(s->scene.camera.width) * scale)));
   s->scene.camera.height = std::max(8, int(std::lround(float(s->scene.camera.height) * scale)));
@@ -312,6 +325,35 @@ std::vector<Config> SweepConfigs(const BenchFlags& f, const Subject& s) {
   return out;
 }
 
+/// The noise sweep (--spp): at each number of estimates per pixel, the full
+/// noisy render, dcm (noise weighed), dcm with the noise taken at face value,
+/// and the paper's method as written.
+std::vector<Config> NoiseConfigs(const BenchFlags& f, const Subject& s) {
+  std::vector<Config> out;
+  for (int spp : f.spp) {
+    auto add = [&](const std::string& method, const std::string& label, ReconstructionOptions o) {
+      Config c;
+      c.method = method;
+      c.label = label + " spp=" + std::to_string(spp);
+      c.sweeps = "noise";
+      c.options = o;
+      c.options.threads = f.threads;
+      c.supersampling = s.defaultSs;
+      c.spp = spp;
+      out.push_back(std::move(c));
+    };
+    ReconstructionOptions full;
+    full.fullEvaluation = true;
+    add("full", "full", full);
+    add("dcm", "dcm", MethodOptions("dcm"));
+    ReconstructionOptions literal = MethodOptions("dcm");
+    literal.noiseSignificance = 0.f;
+    add("dcm", "dcm noise ignored", literal);
+    add("paper", "paper", MethodOptions("paper"));
+  }
+  return out;
+}
+
 /// Output-resolution image of a working image.
 std::vector<RGB> ToOutput(const std::vector<RGB>& work, int w, int h, int ds, int* ow, int* oh) {
   if (ds <= 1) {
@@ -330,6 +372,7 @@ nlohmann::json PointToJson(const Point& p) {
                       {"label", p.config.label},
                       {"sweeps", p.config.sweeps},
                       {"supersampling", p.config.supersampling},
+                      {"spp", p.config.spp},
                       {"exact_pixels", p.exactPixels},
                       {"total_pixels", p.totalPixels},
                       {"exact_fraction", p.exactFraction},
@@ -353,7 +396,7 @@ nlohmann::json PointToJson(const Point& p) {
 const char* kCsvHeader =
     "scene,input,method,label,sweeps,threshold,elementary_block,min_block,supersampling,thin_objects,object_test,"
     "texture_split,adaptive_borders,smooth_refinement,finest_centre_probe,lazy_evaluation,budget_of,exact_pixels,"
-    "total_pixels,exact_fraction,time_illum_s,time_guides_s,time_engine_s,time_total_s,psnr_db,rmse,relmse,ssim\n";
+    "total_pixels,exact_fraction,time_illum_s,time_guides_s,time_engine_s,time_total_s,psnr_db,rmse,relmse,ssim,spp\n";
 
 std::string CsvNum(double v) {
   if (std::isnan(v)) return "nan";
@@ -392,7 +435,7 @@ std::string PointToCsv(const Point& p) {
   s << CsvQuote(p.config.budgetOf) << ',' << p.exactPixels << ',' << p.totalPixels << ',' << CsvNum(p.exactFraction)
     << ',' << CsvNum(p.timeIllumS) << ',' << CsvNum(p.timeGuidesS) << ',' << CsvNum(p.timeEngineS) << ','
     << CsvNum(p.timeTotalS) << ',' << CsvNum(p.error.psnr) << ',' << CsvNum(p.error.rmse) << ','
-    << CsvNum(p.error.relmse) << ',' << CsvNum(p.error.ssim) << '\n';
+    << CsvNum(p.error.relmse) << ',' << CsvNum(p.error.ssim) << ',' << p.config.spp << '\n';
   return s.str();
 }
 
@@ -520,8 +563,17 @@ int RunBench(const BenchFlags& f) {
       std::cerr << "dcm bench: " << input << ": " << s.width << "x" << s.height << " (supersampling " << s.defaultSs
                 << "), effects " << Join(s.effects) << "\n";
     }
+    // --spp: the noise sweep against a reference of many estimates per pixel.
+    const bool noise = !f.spp.empty();
+    int referenceSpp = 0;
+    if (noise) {
+      if (s.kind != "scene") return Fail(Status::Error(input + ": --spp applies to scene files only"));
+      referenceSpp = f.referenceSpp > 0 ? f.referenceSpp : 16 * *std::max_element(f.spp.begin(), f.spp.end());
+      if (std::find(f.spp.begin(), f.spp.end(), referenceSpp) != f.spp.end())
+        return Fail(Status::Error("--reference-spp " + std::to_string(referenceSpp) + " is also in --spp"));
+    }
     SampleProvider* provider = nullptr;
-    if (Status st = GetProvider(s, s.defaultSs, &provider); !st.ok()) return Fail(st);
+    if (Status st = GetProvider(s, s.defaultSs, &provider, referenceSpp); !st.ok()) return Fail(st);
 
     // The full reference, once.
     Point full;
@@ -531,6 +583,7 @@ int RunBench(const BenchFlags& f) {
     full.config.label = "full";
     full.config.sweeps = "baseline";
     full.config.supersampling = s.defaultSs;
+    full.config.spp = referenceSpp;
     full.config.options.fullEvaluation = true;
     full.config.options.threads = f.threads;
     full.config.options.downsample = s.defaultSs;
@@ -564,7 +617,7 @@ int RunBench(const BenchFlags& f) {
       p->scene = s.name;
       p->config = c;
       SampleProvider* prov = nullptr;
-      DCM_RETURN_IF_ERROR(GetProvider(s, c.supersampling, &prov));
+      DCM_RETURN_IF_ERROR(GetProvider(s, c.supersampling, &prov, c.spp));
       int ow = 0, oh = 0;
       if (c.method == "bilinear" || c.method == "jbu") {
         p->rival = true;
@@ -603,12 +656,12 @@ int RunBench(const BenchFlags& f) {
       return Status::Ok();
     };
 
-    std::vector<Config> configs = SweepConfigs(f, s);
+    std::vector<Config> configs = noise ? NoiseConfigs(f, s) : SweepConfigs(f, s);
     // Rival budgets: those of the dcm threshold sweep, plus 25 % and 50 %.
     size_t nDcmThresholds = 0;
     for (const Config& c : configs)
       if (c.method == "dcm" && c.sweeps.find("threshold") != std::string::npos) ++nDcmThresholds;
-    const size_t nTotal = configs.size() + 2 * (nDcmThresholds + 2);
+    const size_t nTotal = configs.size() + (noise ? 0 : 2 * (nDcmThresholds + 2));
     size_t done = 0;
     auto report = [&](const Point& p) {
       ++done;
@@ -632,6 +685,35 @@ int RunBench(const BenchFlags& f) {
       if (c.label == defaultLabel) dcmDefaultImage = std::move(img);
       report(p);
       pts.push_back(std::move(p));
+    }
+    if (noise) {
+      summary << "## " << s.name << " (" << input << "): noise\n\n"
+              << s.width << "x" << s.height << ", supersampling " << s.defaultSs << ", effects "
+              << Join(s.effects, ", ") << "; shadow rays " << s.scene.render.shadowRays << ", glossy rays "
+              << s.scene.render.glossyRays << ", indirect " << s.scene.render.indirectBounces << " bounces x "
+              << s.scene.render.indirectRays << " rays per estimate. Reference: " << referenceSpp
+              << " estimates per pixel (" << Fmt("%.1f", full.timeTotalS) << " s), another seed.\n\n"
+              << "| spp | method | exact % | PSNR dB | relMSE | SSIM | total s | vs full noisy |\n"
+              << "|---|---|---|---|---|---|---|---|\n";
+      for (const Point& p : pts) {
+        if (p.config.sweeps != "noise") continue;
+        const Point* noisy = Find(pts, "full spp=" + std::to_string(p.config.spp));
+        summary << "| " << p.config.spp << " | " << p.config.label.substr(0, p.config.label.rfind(" spp=")) << " | "
+                << Fmt("%.1f", 100 * p.exactFraction) << " | " << Fmt("%.2f", p.error.psnr) << " | "
+                << Fmt("%.3g", p.error.relmse) << " | " << Fmt("%.4f", p.error.ssim) << " | "
+                << Fmt("%.3f", p.timeTotalS) << " | "
+                << (noisy ? Fmt("%+.2f dB", p.error.psnr - noisy->error.psnr) : std::string("")) << " |\n";
+      }
+      summary << "\n";
+      inputsJson.push_back({{"input", input},
+                            {"scene", s.name},
+                            {"kind", s.kind},
+                            {"resolution", {s.width, s.height}},
+                            {"supersampling", s.defaultSs},
+                            {"effects", s.effects},
+                            {"reference_spp", referenceSpp}});
+      for (auto& p : pts) all.push_back(std::move(p));
+      continue;
     }
     // Rivals at the same budgets.
     std::vector<std::pair<int64_t, std::string>> budgets;
@@ -804,7 +886,7 @@ int RunBench(const BenchFlags& f) {
     }
     if (!plotNote.empty() && !f.quiet) std::cerr << "dcm bench: warning: " << plotNote << "\n";
     for (const auto& ij : inputsJson) {
-      for (const char* kind : {"psnr_vs_time", "psnr_vs_exact"}) {
+      for (const char* kind : {"psnr_vs_time", "psnr_vs_exact", "noise"}) {
         const std::string name = ij["scene"].get<std::string>() + "_" + kind + ".png";
         if (fs::is_regular_file(fs::path(f.out) / name, ec)) plots.push_back(name);
       }
@@ -860,6 +942,17 @@ Registration reg(
       app->add_option("--downsample", f->downsample, "AOV inputs: supersampled N times per axis")
           ->check(CLI::Range(1, 16));
 #endif
+      app->add_option("--set", f->overrides,
+                      "scenes: override a setting before the scene is read, KEY.PATH=JSON (repeatable; as dcm render)")
+          ->allow_extra_args(false);
+      app->add_option("--spp", f->spp,
+                      "scenes: the noise sweep instead of the accuracy sweeps: at each number of estimates per "
+                      "pixel (render.samples_per_pixel), full noisy render, dcm, dcm with the noise ignored, paper")
+          ->delimiter(',')
+          ->check(CLI::Range(2, 1 << 20));
+      app->add_option("--reference-spp", f->referenceSpp,
+                      "--spp: estimates per pixel of the reference (default 16x the largest --spp)")
+          ->check(CLI::Range(2, 1 << 20));
       app->add_flag("-v,--verbose", f->verbose, "per point: the time split, pixel counts and SSIM");
       app->add_flag("--quiet", f->quiet, "no progress on stderr, no summary on stdout");
       return [f] { return RunBench(*f); };
