@@ -618,7 +618,10 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
 
     if (noisy_ && opt_.denoiseSamples) {
       Progress(0.93f, "denoising samples");
-      stats_.denoisedSamples = DenoiseExactSamples(store_, opt_.elementaryBlock, contrast_);
+      // Averaging what the noise explains: the gate is wider than the
+      // detection's significance (which errs towards refining), 2 sd at least.
+      stats_.denoisedSamples =
+          DenoiseExactSamples(store_, opt_.elementaryBlock, contrast_, std::max(opt_.noiseSignificance, 2.f));
     }
     Progress(0.95f, "interpolation");
     ForEach(smoothLeaves_, [&](Leaf& l, size_t) { WriteSmooth(l); });

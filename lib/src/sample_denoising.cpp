@@ -29,7 +29,7 @@ bool SolveFirstColumn(const double M[3][3], double g[3]) {
 
 }  // namespace
 
-int64_t DenoiseExactSamples(SampleStore& store, int radius, const ContrastTest& noise) {
+int64_t DenoiseExactSamples(SampleStore& store, int radius, const ContrastTest& noise, float gate) {
   if (!store.hasVariance() || radius < 1) return 0;
   const int W = store.width(), H = store.height();
   const SurfaceTest& surfaces = store.surfaces();
@@ -50,7 +50,7 @@ int64_t DenoiseExactSamples(SampleStore& store, int radius, const ContrastTest& 
         for (int nx = std::max(0, x - radius); nx <= std::min(W - 1, x + radius); ++nx) {
           const int64_t j = store.Index(nx, ny);
           if (!store.IsExact(j) || !store.IsFinite(j) || !surfaces.Same(i, j)) continue;
-          if (j != i && !noise.WithinNoise(vi, store.ValueAt(j))) continue;
+          if (j != i && !noise.WithinNoise(vi, store.ValueAt(j), gate)) continue;
           const double dx = double(nx - x), dy = double(ny - y);
           const Neighbour n{j, dx / radius, dy / radius, std::exp(-(dx * dx + dy * dy) / (2 * sd * sd))};
           const double v[3] = {1, n.x, n.y};

@@ -16,11 +16,11 @@ namespace dcm::detail {
 /// Replaces every exact, finite sample with a variance by the value at its
 /// pixel of a weighted least-squares plane fitted to the exact samples within
 /// `radius` pixels (Chebyshev distance; Gaussian weights of sd radius/2) that
-/// are finite, on the same surface, and within the noise of it
-/// (`noise.WithinNoise`) (a sigma filter, Lee 1983, with a local linear model
+/// are finite, on the same surface, and within `gate` standard deviations of
+/// it (`noise.WithinNoise`) (a sigma filter, Lee 1983, with a local linear model
 /// rather than a mean, so that gradients and one-sided neighbourhoods at
 /// edges are not biased). Deterministic: all fits read the samples as they
 /// were before the pass. Returns the number of samples replaced.
-int64_t DenoiseExactSamples(SampleStore& store, int radius, const ContrastTest& noise);
+int64_t DenoiseExactSamples(SampleStore& store, int radius, const ContrastTest& noise, float gate);
 
 }  // namespace dcm::detail

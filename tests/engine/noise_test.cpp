@@ -60,22 +60,33 @@ TEST(Noise, TheLiteralTestsChaseTheNoise) {
 }
 
 TEST(Noise, SignificanceSamplesAtTheNoiselessRate) {
-  // With the variance weighed, noise of 5-20 % costs no extra samples: the
-  // exact fraction stays at or below the noise-free run's (features whose
-  // contrast drowns in the noise are not chased either), and it does not grow
-  // with the noise.
+  // With the variance weighed at 3 sd, noise of 5-20 % costs no extra
+  // samples: the exact fraction stays at or below the noise-free run's
+  // (features whose contrast drowns in the noise are not chased either).
   const double clean = ReconstructNoisy({0.f, 0.f}).r.stats.exactFraction();
   for (float rel : {0.05f, 0.1f, 0.2f}) {
-    const double f = ReconstructNoisy({rel, 0.01f}).r.stats.exactFraction();
+    const double f = ReconstructNoisy({rel, 0.01f}, Significance(3.f)).r.stats.exactFraction();
     EXPECT_LE(f, 1.05 * clean) << "relative noise " << rel;
+  }
+}
+
+TEST(Noise, DefaultSignificanceSamplesFarLessThanTheLiteralTests) {
+  // The default (0.5 sd) errs towards refining, to keep faint features, yet
+  // spends at most 60 % of the samples the literal tests spend (measured:
+  // 30-50 %) at every noise level.
+  for (float rel : {0.05f, 0.1f, 0.2f}) {
+    const NoiseModel m{rel, 0.01f};
+    const double aware = ReconstructNoisy(m).r.stats.exactFraction();
+    const double literal = ReconstructNoisy(m, Significance(0.f)).r.stats.exactFraction();
+    EXPECT_LE(aware, 0.6 * literal) << "relative noise " << rel;
   }
 }
 
 TEST(Noise, CloserToTheTruthThanTheNoisyFullRender) {
   // The target: from noisy samples, the reconstruction is closer to
-  // the converged image than the full noisy render. Measured margins are
-  // 3.7-4.2 dB; 1 dB leaves room for changes of the engine, not for a
-  // reconstruction that merely matches the noisy image.
+  // the converged image than the full noisy render. The margin asked, 1 dB,
+  // is a fraction of the measured ones (several dB at every noise level)
+  // and still rejects a reconstruction that merely matches the noisy image.
   for (float rel : {0.05f, 0.1f, 0.2f}) {
     const NoiseModel m{rel, 0.01f};
     const Outcome dcm = ReconstructNoisy(m);

@@ -33,7 +33,7 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
   app->add_flag("--no-denoise-samples", f->noDenoise, "noisy samples: interpolate the raw exact samples");
   app->add_option("--noise-significance", f->noiseSignificance,
                   "with noisy samples (a variance channel or samples_per_pixel > 1): a difference counts when it "
-                  "exceeds this many standard deviations (default 1.5; 0: ignore the noise, as the paper)");
+                  "exceeds this many standard deviations (default 0.5; 0: ignore the noise, as the paper)");
   app->add_option("--progressive", f->progressive,
                   "write DIR/level_N.exr after each refinement level (an early, usable picture)");
   app->add_flag("-v,--verbose", f->verbose, "say more");

@@ -90,7 +90,7 @@ struct ReconstructionOptions {
   /// bisection, the simple/complex tests and every probe. Monte Carlo noise
   /// then no longer reads as detail (the paper's open problem, section 5).
   /// 0: differences are taken at face value, as in the paper.
-  float noiseSignificance = 1.5f;
+  float noiseSignificance = 0.5f;
   /// Noisy samples: before interpolation, each exact sample becomes a local
   /// linear fit through the exact samples within one elementary block of it
   /// on its surface and not significantly different (its own pixel too:

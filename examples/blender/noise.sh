@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# Noisy Cycles renders (issue #8, docs/NOISE.md): dcm reconstructs from a
+# 64-spp render with the noise estimated from the data, or from two 64-spp
+# renders of other seeds, and is compared against a converged render.
+#
+#   examples/blender/noise.sh [VIEW]            view a, b or c (default a)
+#
+# Environment: DCM, BLENDER, THREADS as for run.sh; SPP=64 (the noisy
+# renders), REF_SPP=2048 (the converged reference, about 10-20 min on 2 cores).
+# Renders only the EXRs that are missing (examples/blender/out/noise_*.exr).
+set -euo pipefail
+
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+root="$(cd "$here/../.." && pwd)"
+DCM="${DCM:-$root/build/tools/dcm/dcm}"
+BLENDER="${BLENDER:-blender}"
+THREADS="${THREADS:-2}"
+SPP="${SPP:-64}"
+REF_SPP="${REF_SPP:-2048}"
+view="${1:-a}"
+command -v "$BLENDER" >/dev/null || { echo "noise.sh: no '$BLENDER' (sudo apt-get install --no-install-recommends blender)" >&2; exit 1; }
+command -v oiiotool >/dev/null || { echo "noise.sh: no oiiotool (scripts/install-deps.sh)" >&2; exit 1; }
+[ -x "$DCM" ] || { echo "noise.sh: no dcm binary at $DCM (build it, or set DCM=...)" >&2; exit 1; }
+out="$here/out"
+mkdir -p "$out"
+
+render() {  # samples seed exr
+  [ -f "$3" ] && return 0
+  echo "rendering $(basename "$3") (256x256, $1 spp, seed $2)" >&2
+  local t0=$SECONDS
+  "$BLENDER" -b --factory-startup --python "$here/make_and_render.py" -- \
+    --out "$3" --view "$view" --res 256 --samples "$1" --seed "$2" --threads "$THREADS" > "$out/blender.log" 2>&1 ||
+    { tail -20 "$out/blender.log" >&2; exit 1; }
+  echo "$(basename "$3"): $((SECONDS - t0)) s" >&2
+}
+
+a="$out/noise_${view}_${SPP}_s1.exr"
+b="$out/noise_${view}_${SPP}_s2.exr"
+ref="$out/noise_${view}_${REF_SPP}_s3.exr"
+render "$SPP" 1 "$a"
+render "$SPP" 2 "$b"
+render "$REF_SPP" 3 "$ref"
+# The reference's beauty as plain R, G, B for --reference.
+layer=$(oiiotool --info -v "$ref" | sed -n 's/.*channel list: \([^ ,]*\)\.Combined\.R.*/\1/p' | head -1)
+layer=${layer:-ViewLayer}
+oiiotool "$ref" --ch "$layer.Combined.R,$layer.Combined.G,$layer.Combined.B" --chnames R,G,B -o "$out/noise_ref_rgb.exr"
+
+run() {  # label flags...
+  local label="$1"
+  shift
+  "$DCM" reconstruct --preset blender --quiet --reference "$out/noise_ref_rgb.exr" "$@" \
+    -o "$out/noise_out.exr" --stats "$out/noise_stats.json" > /dev/null
+  /usr/bin/python3 - "$out/noise_stats.json" "$label" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+r = s["reference"]
+print("| %s | %.1f | %.2f | %.3g | %.4f |" % (sys.argv[2], 100 * s["exact_fraction"], r["psnr"], r["relmse"], r["ssim"]))
+PY
+}
+
+echo "Cycles, view $view, 256x256; noisy renders $SPP spp (seeds 1, 2), reference $REF_SPP spp (seed 3)."
+echo
+echo "| input and method | exact % | PSNR dB | relMSE | SSIM |"
+echo "|---|---|---|---|---|"
+run "one render: the render itself" "$a" --full
+run "one render: paper (noise taken at face value)" "$a" --method paper
+run "one render: dcm, noise ignored (no variance)" "$a"
+run "one render: dcm --estimate-variance" "$a" --estimate-variance
+run "two renders: their mean" "$a" --second-render "$b" --full
+run "two renders: dcm --second-render" "$a" --second-render "$b"
