@@ -13,6 +13,9 @@ packages=(
   libcli11-dev nlohmann-json3-dev libassimp-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
+  # tests/tiles/slurm_test.sh: a single-node Slurm cluster on loopback
+  # (the test starts munged, slurmctld and slurmd itself; no systemd)
+  slurm-wlm munge
   # helper scripts (plots, checks): Debian's python, not the one first on PATH
   python3-numpy python3-matplotlib python3-openimageio
 )

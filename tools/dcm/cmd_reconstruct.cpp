@@ -22,6 +22,8 @@
 #include "common/preview.h"
 #include "common/sample_map.h"
 #include "common/stats_json.h"
+#include "common/tiles.h"
+#include "tile_flags.h"
 
 namespace dcm::cli {
 namespace {
@@ -31,6 +33,7 @@ struct ReconstructFlags {
   EngineFlags engine;
   std::string output, stats, sampleMap, preview, errorMap, reference;
   bool alpha = false;
+  TileFlags tiles;
 };
 
 nlohmann::json ErrorJson(const toolkit::ImageError& e) {
@@ -51,6 +54,132 @@ std::string PsnrText(double psnr) {
   return s.str();
 }
 
+/// --tile / --region: the region of the frame, written as a part for `dcm merge`.
+int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options, aov::AovProvider& provider) {
+  const std::string cmd = "reconstruct";
+  if (!f.engine.progressive.empty())
+    return aov_common::Fail(cmd, "--progressive needs the whole frame; not with --tile or --region", kExitUsage);
+  if (!f.reference.empty() || !f.errorMap.empty())
+    return aov_common::Fail(cmd, "--reference and --error-map need the whole frame; not with --tile or --region "
+                                 "(compare the merged frame)", kExitUsage);
+  const ProviderCapabilities caps = provider.Capabilities();
+  const Point2i frame = OutputSize(caps.width, caps.height, options.downsample);
+  Bounds2i region;
+  std::string tile;
+  Status st = ResolveRegion(f.tiles, frame.x, frame.y, TileAlignment(options), &region, &tile);
+  if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
+
+  // What decides the pixels besides the options: the input files by content
+  // and the flags that read them.
+  nlohmann::json identity;
+  for (const auto& [key, list] : {std::pair{"inputs", &f.aov.inputs}, std::pair{"samples", &f.aov.samples},
+                                   std::pair{"second_render", &f.aov.secondRender}}) {
+    nlohmann::json hashes = nlohmann::json::array();
+    for (const auto& path : *list) {
+      uint64_t h = 0;
+      if (st = toolkit::HashFile(path, &h); !st.ok()) return aov_common::Fail(cmd, st.message());
+      hashes.push_back(toolkit::HexHash(h));
+    }
+    identity[key] = hashes;
+  }
+  identity["estimate_variance"] = f.aov.estimateVariance;
+  identity["preset"] = f.aov.preset;
+  identity["map"] = f.aov.maps;
+  identity["texture"] = f.aov.textures;
+  identity["layer"] = f.aov.layer;
+  identity["alpha"] = f.alpha;
+  const nlohmann::json settings = toolkit::PartSettings(cmd, DCM_VERSION, options, identity);
+
+  toolkit::Progress progress(!f.engine.quiet);
+  options.progress = [&progress](float v, std::string_view stage) { progress.Update(v, stage); };
+  Reconstruction r;
+  RegionInfo info;
+  std::vector<Point2i> pending;
+  const auto t0 = std::chrono::steady_clock::now();
+  st = ReconstructRegion(provider, options, region, &r, &info, &pending);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  progress.Done();
+  if (st.pending()) {
+    int64_t missing = 0;
+    for (const auto& p : pending) missing += provider.HasSample(p) ? 0 : 1;
+    return aov_common::Fail(cmd, "the samples lack " + std::to_string(missing) +
+                                     " pixels the engine needs for this part; run `dcm plan` with the same "
+                                     "inputs, flags and samples, render what it asks for, and repeat");
+  }
+  if (!st.ok()) return aov_common::Fail(cmd, st.message());
+
+  // Dense input: the error against the same region of the full input.
+  bool haveRef = false;
+  toolkit::ImageError error;
+  if (provider.dense()) {
+    int w = 0, h = 0;
+    const std::vector<RGB> full =
+        dcm::BoxDownsample(provider.Beauty(), provider.width(), provider.height(), options.downsample, &w, &h);
+    if (w == frame.x && h == frame.y) {
+      std::vector<RGB> ref;
+      ref.reserve(size_t(region.area()));
+      for (int y = region.min.y; y < region.max.y; ++y)
+        for (int x = region.min.x; x < region.max.x; ++x) ref.push_back(full[size_t(y) * size_t(w) + size_t(x)]);
+      error = toolkit::Compare(r.image, ref, r.width, r.height);
+      haveRef = true;
+    }
+  }
+
+  nlohmann::json stats = toolkit::StatsToJson(r.stats);
+  stats["command"] = cmd;
+  stats["inputs"] = f.aov.inputs;
+  if (!f.aov.samples.empty()) stats["samples"] = f.aov.samples;
+  stats["mode"] = provider.dense() ? "dense" : "sparse";
+  stats["method"] = f.engine.method;
+  stats["width"] = r.width;
+  stats["height"] = r.height;
+  stats["work_width"] = r.workWidth;
+  stats["work_height"] = r.workHeight;
+  stats["time_reconstruct_s"] = wall;
+  stats["options"] = toolkit::OptionsToJson(options);
+  stats["warnings"] = provider.Warnings();
+  stats["part"] = PartJson(tile, info);
+  if (haveRef) stats["reference"] = ErrorJson(error);
+
+  toolkit::Metadata meta;
+  meta.strings.push_back({"Software", std::string("dcm ") + DCM_VERSION});
+  meta.strings.push_back({"dcm:method", f.engine.method});
+  meta.strings.push_back({"dcm:mode", provider.dense() ? "dense" : "sparse"});
+  meta.strings.push_back({"dcm:settings", toolkit::OptionsToJson(options).dump()});
+  std::string inputs;
+  for (const auto& in : f.aov.inputs) inputs += (inputs.empty() ? "" : " ") + in;
+  meta.strings.push_back({"dcm:inputs", inputs});
+  AddPartMetadata(tile, region, settings, r, info, &meta);
+
+  std::vector<std::string> written;
+  auto write = [&](const std::string& path, Status s) -> int {
+    if (!s.ok()) {
+      aov_common::RemoveAll(written);
+      return aov_common::Fail(cmd, s.message());
+    }
+    written.push_back(path);
+    return kExitOk;
+  };
+  int rc = write(f.output, toolkit::WritePartExr(f.output, frame.x, frame.y, region, r.image, meta, f.alpha));
+  if (rc) return rc;
+  if (!f.sampleMap.empty() && (rc = write(f.sampleMap, toolkit::WriteSampleMap(f.sampleMap, r)))) return rc;
+  if (!f.preview.empty() &&
+      (rc = write(f.preview, toolkit::WritePreview(f.preview, r.width, r.height, r.image))))
+    return rc;
+  if (!f.stats.empty() && (rc = write(f.stats, toolkit::WriteJson(f.stats, stats)))) return rc;
+  if (!f.engine.quiet) {
+    std::ostringstream s;
+    s << "dcm " << cmd << ": " << (tile.empty() ? "region " + toolkit::RegionText(region) : "tile " + tile)
+      << " of " << frame.x << "x" << frame.y << " (window " << info.window.width() << "x" << info.window.height()
+      << "), " << r.stats.exactPixels << " exact pixels (" << std::fixed << std::setprecision(2)
+      << 100.0 * r.stats.exactFraction() << " %)";
+    if (haveRef) s << ", PSNR " << PsnrText(error.psnr);
+    s << " -> " << f.output;
+    std::cerr << s.str() << "\n";
+  }
+  return kExitOk;
+}
+
 int RunReconstruct(const ReconstructFlags& f) {
   const std::string cmd = "reconstruct";
   ReconstructionOptions options;
@@ -66,6 +195,7 @@ int RunReconstruct(const ReconstructFlags& f) {
   std::unique_ptr<aov::AovProvider> provider;
   st = aov_common::OpenProvider(cmd, f.aov, aovOptions, f.engine, &provider);
   if (!st.ok()) return aov_common::Fail(cmd, st.message());
+  if (IsPartial(f.tiles)) return RunReconstructPart(f, options, *provider);
 
   // An explicit reference is read (and checked) before the work starts.
   std::vector<RGB> reference;
@@ -173,6 +303,35 @@ int RunReconstruct(const ReconstructFlags& f) {
   return kExitOk;
 }
 
+/// --frames: one reconstruction per frame, '#' in the file names replaced by
+/// the frame number.
+int RunReconstructFrames(const ReconstructFlags& f) {
+  std::vector<int> frames;
+  if (Status st = FrameList(f.tiles, &frames); !st.ok())
+    return aov_common::Fail("reconstruct", st.message(), kExitUsage);
+  if (frames.empty()) return RunReconstruct(f);
+  auto expand = [](ReconstructFlags* g, int frame, bool* any) {
+    for (auto* list : {&g->aov.inputs, &g->aov.samples, &g->aov.secondRender})
+      for (auto& name : *list) *any = *any || HasFramePattern(name), name = ExpandFrame(name, frame);
+    for (auto* name : {&g->output, &g->stats, &g->sampleMap, &g->preview, &g->errorMap, &g->reference})
+      *any = *any || HasFramePattern(*name), *name = ExpandFrame(*name, frame);
+  };
+  for (int frame : frames) {
+    ReconstructFlags g = f;
+    bool any = false;
+    expand(&g, frame, &any);
+    if (!any)
+      return aov_common::Fail("reconstruct", "--frames " + f.tiles.frames +
+                                                 ": no '#' frame pattern in the input or output names",
+                              kExitUsage);
+    if (int rc = RunReconstruct(g); rc != kExitOk) {
+      std::cerr << "dcm reconstruct: frame " << frame << " failed\n";
+      return rc;
+    }
+  }
+  return kExitOk;
+}
+
 Registration reg("reconstruct", "Reconstruct an image from a renderer's EXR AOVs with DCM",
                  [](CLI::App* app) -> std::function<int()> {
                    auto f = std::make_shared<ReconstructFlags>();
@@ -185,7 +344,8 @@ Registration reg("reconstruct", "Reconstruct an image from a renderer's EXR AOVs
                    app->add_option("--reference", f->reference, "compare with this EXR instead of the full input");
                    app->add_flag("--alpha", f->alpha, "write RGBA with A = 1");
                    AddEngineFlags(app, &f->engine);
-                   return [f] { return RunReconstruct(*f); };
+                   AddTileFlags(app, &f->tiles);
+                   return [f] { return RunReconstructFrames(*f); };
                  });
 
 }  // namespace

@@ -17,10 +17,12 @@
 #include "common/progress.h"
 #include "common/sample_map.h"
 #include "common/stats_json.h"
+#include "common/tiles.h"
 #include "dcm/reconstructor.h"
 #include "embree/embree_provider.h"
 #include "embree/scene_file.h"
 #include "engine_flags.h"
+#include "tile_flags.h"
 
 namespace dcm::cli {
 namespace {
@@ -41,6 +43,7 @@ struct RenderFlags {
   bool withReference = false;
   std::string referenceOut;
   EngineFlags engine;
+  TileFlags tiles;
 };
 
 Status ParseSize(const std::string& s, int* w, int* h) {
@@ -91,6 +94,83 @@ int Fail(const Status& st) {
   return kExitFailure;
 }
 
+/// --tile / --region: the region of the frame, written as a part for `dcm merge`.
+int RunRenderPart(const RenderFlags& f, const embree::Scene& scene, ReconstructionOptions options,
+                  embree::EmbreeProvider& provider, toolkit::Progress& progress) {
+  auto usage = [](const std::string& message) {
+    std::cerr << "dcm render: " << message << "\n";
+    return kExitUsage;
+  };
+  if (f.withReference || !f.referenceOut.empty() || !f.compare.empty())
+    return usage("--with-reference, --reference-out and --compare need the whole frame; not with --tile or "
+                 "--region (compare the merged frame)");
+  if (!f.engine.progressive.empty()) return usage("--progressive needs the whole frame; not with --tile or --region");
+  const ProviderCapabilities caps = provider.Capabilities();
+  const Point2i frame = OutputSize(caps.width, caps.height, options.downsample);
+  Bounds2i region;
+  std::string tile;
+  if (Status st = ResolveRegion(f.tiles, frame.x, frame.y, TileAlignment(options), &region, &tile); !st.ok())
+    return usage(st.message());
+  uint64_t sceneHash = 0;
+  if (Status st = toolkit::HashFile(f.scene, &sceneHash); !st.ok()) return Fail(st);
+  const nlohmann::json settings = toolkit::PartSettings(
+      "render", DCM_VERSION, options,
+      {{"scene_hash", toolkit::HexHash(sceneHash)}, {"width", scene.camera.width}, {"height", scene.camera.height},
+       {"supersampling", scene.render.supersampling}, {"samples_per_pixel", scene.render.samplesPerPixel},
+       {"seed", scene.render.seed}, {"overrides", f.overrides}});
+
+  options.progress = [&](float v, std::string_view stage) { progress.Update(v, stage); };
+  provider.ResetRayCounts();
+  const auto t0 = std::chrono::steady_clock::now();
+  Reconstruction rec;
+  RegionInfo info;
+  if (Status st = ReconstructRegion(provider, options, region, &rec, &info); !st.ok()) return Fail(st);
+  const double wallS = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const embree::RayCounts rays = provider.rayCounts();
+  progress.Done();
+
+  const std::string method = options.fullEvaluation ? "full" : f.engine.method;
+  const auto effects = provider.effects().Names();
+  toolkit::Metadata meta;
+  meta.strings.push_back({"dcm:scene", f.scene});
+  meta.strings.push_back({"dcm:method", method});
+  meta.strings.push_back({"dcm:options", toolkit::OptionsToJson(options).dump()});
+  meta.strings.push_back({"dcm:effects", Join(effects)});
+  meta.strings.push_back({"dcm:provider", "embree"});
+  AddPartMetadata(tile, region, settings, rec, info, &meta);
+  if (Status st = toolkit::WritePartExr(f.output, frame.x, frame.y, region, rec.image, meta); !st.ok())
+    return Fail(st);
+  if (!f.sampleMap.empty()) {
+    if (Status st = toolkit::WriteSampleMap(f.sampleMap, rec); !st.ok()) return Fail(st);
+  }
+  if (!f.preview.empty()) {
+    if (Status st = toolkit::WritePreview(f.preview, rec.width, rec.height, rec.image); !st.ok()) return Fail(st);
+  }
+  if (!f.stats.empty()) {
+    nlohmann::json j = toolkit::StatsToJson(rec.stats);
+    j["scene"] = f.scene;
+    j["method"] = method;
+    j["options"] = toolkit::OptionsToJson(options);
+    j["resolution"] = {rec.width, rec.height};
+    j["working_resolution"] = {rec.workWidth, rec.workHeight};
+    j["time_wall_s"] = wallS;
+    j["effects"] = effects;
+    j["rays"] = RaysToJson(rays);
+    j["part"] = PartJson(tile, info);
+    if (Status st = toolkit::WriteJson(f.stats, j); !st.ok()) return Fail(st);
+  }
+  std::printf("%s: %s %s of %dx%d (window %dx%d working pixels), %s\n", f.scene.c_str(),
+              tile.empty() ? "region" : "tile", tile.empty() ? toolkit::RegionText(region).c_str() : tile.c_str(),
+              frame.x, frame.y, info.window.width(), info.window.height(), method.c_str());
+  std::printf("  region         %s -> %s\n", toolkit::RegionText(region).c_str(), f.output.c_str());
+  std::printf("  exact pixels   %.2f %% of the region, %.2f %% of the window\n", 100.0 * rec.stats.exactFraction(),
+              100.0 * info.windowStats.exactFraction());
+  std::printf("  time           illumination %.2f s, DCM %.2f s, guides %.2f s, total %.2f s\n",
+              info.windowStats.timeProviderS, info.windowStats.timeEngineS, info.windowStats.timeGuidesS, wallS);
+  std::printf("  rays           %llu\n", static_cast<unsigned long long>(rays.total()));
+  return kExitOk;
+}
+
 int RunRender(const RenderFlags& f, CLI::App* app) {
   // Scene and its overrides.
   embree::Scene scene;
@@ -133,6 +213,7 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
               << provider->workWidth() << "x" << provider->workHeight() << "; effects "
               << Join(provider->effects().Names()) << "\n";
   }
+  if (IsPartial(f.tiles)) return RunRenderPart(f, scene, options, *provider, progress);
 
   // The reference compared against, from a file or rendered in this run.
   std::optional<std::vector<RGB>> reference;
@@ -246,6 +327,34 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
   return kExitOk;
 }
 
+/// --frames: one render per frame, '#' in the file names replaced by the frame.
+int RunRenderFrames(const RenderFlags& f, CLI::App* app) {
+  std::vector<int> frames;
+  if (Status st = FrameList(f.tiles, &frames); !st.ok()) {
+    std::cerr << "dcm render: " << st.message() << "\n";
+    return kExitUsage;
+  }
+  if (frames.empty()) return RunRender(f, app);
+  std::vector<std::string RenderFlags::*> names = {&RenderFlags::scene, &RenderFlags::output, &RenderFlags::compare,
+                                                   &RenderFlags::stats, &RenderFlags::sampleMap, &RenderFlags::preview,
+                                                   &RenderFlags::referenceOut};
+  bool any = false;
+  for (auto name : names) any = any || HasFramePattern(f.*name);
+  if (!any) {
+    std::cerr << "dcm render: --frames " << f.tiles.frames << ": no '#' frame pattern in the scene or output names\n";
+    return kExitUsage;
+  }
+  for (int frame : frames) {
+    RenderFlags g = f;
+    for (auto name : names) g.*name = ExpandFrame(f.*name, frame);
+    if (int rc = RunRender(g, app); rc != kExitOk) {
+      std::cerr << "dcm render: frame " << frame << " failed\n";
+      return rc;
+    }
+  }
+  return kExitOk;
+}
+
 Registration reg("render", "Ray trace a scene file (Embree) with DCM: a few percent of the pixels exact",
                  [](CLI::App* app) -> std::function<int()> {
                    auto f = std::make_shared<RenderFlags>();
@@ -278,7 +387,8 @@ Registration reg("render", "Ray trace a scene file (Embree) with DCM: a few perc
                    app->add_option("--reference-out", f->referenceOut,
                                    "write the full render (EXR); implies --with-reference");
                    AddEngineFlags(app, &f->engine);
-                   return [f, app] { return RunRender(*f, app); };
+                   AddTileFlags(app, &f->tiles);
+                   return [f, app] { return RunRenderFrames(*f, app); };
                  });
 
 }  // namespace

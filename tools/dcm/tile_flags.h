@@ -1,0 +1,64 @@
+// Tiles, regions and frame sequences, shared by `dcm render` and
+// `dcm reconstruct`: --tile I/N, --region x,y,w,h, --frames A-B with '#'
+// patterns in file names.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "common/image_io.h"
+#include "dcm/geometry.h"
+#include "dcm/reconstructor.h"
+#include "dcm/status.h"
+#include "dcm/window_provider.h"
+
+namespace dcm::cli {
+
+/// The flags as parsed.
+struct TileFlags {
+  std::string tile;    ///< "I/N", I 0-based
+  std::string region;  ///< "x,y,w,h" in output pixels
+  std::string frames;  ///< "N" or "A-B"
+};
+
+/// Adds --tile, --region (exclusive) and --frames.
+void AddTileFlags(CLI::App* app, TileFlags* flags);
+
+/// True when the flags ask for a part of the frame.
+inline bool IsPartial(const TileFlags& f) { return !f.tile.empty() || !f.region.empty(); }
+
+/// The output region the flags select in a width x height frame (tiles on
+/// multiples of `align` output pixels where possible, see dcm::TileRegion);
+/// `tile` receives "I/N" for --tile, "" for --region. The message names the flag.
+Status ResolveRegion(const TileFlags& f, int width, int height, int align, Bounds2i* region, std::string* tile);
+
+/// The frames of --frames ("7" or "1-10"); empty when the flag is absent.
+Status FrameList(const TileFlags& f, std::vector<int>* frames);
+
+/// True when `name` contains a '#' frame pattern.
+bool HasFramePattern(const std::string& name);
+
+/// Replaces each run of '#' in `pattern` by `frame`, zero-padded to the run's
+/// length (room.####.exr, 7 -> room.0007.exr; longer numbers are not cut).
+std::string ExpandFrame(const std::string& pattern, int frame);
+
+/// The elementary block in output pixels: the tile alignment.
+inline int TileAlignment(const ReconstructionOptions& o) {
+  return std::max(1, o.elementaryBlock / std::max(1, o.downsample));
+}
+
+/// The attributes of a part (tile, region, fingerprint, settings, the counts
+/// over its pixels) added to `meta`.
+void AddPartMetadata(const std::string& tile, const Bounds2i& region, const nlohmann::json& settings,
+                     const Reconstruction& part, const RegionInfo& info, toolkit::Metadata* meta);
+
+/// The part's entry of a --stats file: tile, region, window, frame size and
+/// the engine's statistics of the whole window.
+nlohmann::json PartJson(const std::string& tile, const RegionInfo& info);
+
+}  // namespace dcm::cli
