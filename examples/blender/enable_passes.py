@@ -68,6 +68,7 @@ def main():
     rendering = [vl for vl in sc.view_layers if vl.use]
     for vl in sc.view_layers:
         vl.use_pass_combined = True
+        vl.use_pass_normal = True  # creases inside one object (dcm --crease-angle)
         vl.use_pass_object_index = True
         vl.use_pass_material_index = True
         vl.use_pass_uv = True

@@ -82,10 +82,11 @@ class AnalyticScene:
 class Provider:
     """Serves a scene over the dcm-pipe protocol."""
 
-    def __init__(self, scene, name="analytic-python", noise=0.0):
+    def __init__(self, scene, name="analytic-python", noise=0.0, normals=False):
         self.scene = scene
         self.name = name
         self.noise = noise
+        self.normals = normals
         self.evaluated = 0
         self.batches = 0
 
@@ -105,7 +106,8 @@ class Provider:
 
     # --- the protocol ----------------------------------------------------
     def handshake_line(self):
-        caps = "object_id,shader_id,texture,split" + (",variance" if self.noise > 0 else "")
+        caps = ("object_id,shader_id,texture,split" + (",normal" if self.normals else "") +
+                (",variance" if self.noise > 0 else ""))
         return "dcm-pipe %d width=%d height=%d caps=%s name=%s\n" % (
             PROTOCOL_VERSION, self.scene.width, self.scene.height, caps, self.name)
 
@@ -123,6 +125,12 @@ class Provider:
             out.write(shader.astype("<u4").tobytes())
         if "texture" in kinds:
             out.write(tau.astype("<f4").tobytes())
+        if "normal" in kinds:
+            # The disc faces the camera (z), the background and the bar face up (y).
+            normal = np.zeros((obj.size, 3), np.float32)
+            normal[obj == 2, 2] = 1.0
+            normal[obj != 2, 1] = 1.0
+            out.write(normal.astype("<f4").tobytes())
 
     def answer_eval(self, tokens, inp, out):
         n = int(tokens[1])
@@ -186,6 +194,7 @@ def main(argv=None):
     ap.add_argument("--noise", type=float, default=0.0,
                     help="Gaussian noise of this sd on L_i, announced with its variance (a Monte Carlo renderer); "
                          "--truth stays noise-free")
+    ap.add_argument("--normals", action="store_true", help="announce and serve normal guides")
     ap.add_argument("--count-file", help="at the end, write the number of evaluated pixels to this file")
     args = ap.parse_args(argv)
     scene = AnalyticScene(args.width, args.height)
@@ -194,7 +203,7 @@ def main(argv=None):
         L, _, _ = scene.radiance(xs.ravel(), ys.ravel())
         L.astype("<f4").tofile(args.truth)
         return 0
-    provider = Provider(scene, noise=args.noise)
+    provider = Provider(scene, noise=args.noise, normals=args.normals)
     status = provider.serve(sys.stdin.buffer, sys.stdout.buffer)
     sys.stderr.write("analytic_provider: evaluated %d pixels in %d batches\n" % (provider.evaluated, provider.batches))
     if args.count_file:

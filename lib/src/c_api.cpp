@@ -38,6 +38,7 @@ struct DCMReconstructorImpl {
   int width = 0, height = 0;
   std::vector<uint32_t> objectIds, shaderIds;
   std::vector<dcm::RGB> texture;
+  std::vector<dcm::Vec3f> normals;
   DCMSampleFunction sample = nullptr;
   DCMNoisySampleFunction noisySample = nullptr;  ///< set instead of `sample`
   void* sampleUser = nullptr;
@@ -164,6 +165,7 @@ constexpr IntOption kIntOptions[] = {
 constexpr FloatOption kFloatOptions[] = {
     {"contrast_threshold", &Options::contrastThreshold},
     {"noise_significance", &Options::noiseSignificance},
+    {"crease_angle", &Options::creaseAngle},
 };
 constexpr BoolOption kBoolOptions[] = {
     {"surface_aware", &Options::surfaceAware},
@@ -213,6 +215,7 @@ class CallbackProvider final : public dcm::SampleProvider {
     c.objectId = !r_.objectIds.empty();
     c.shaderId = !r_.shaderIds.empty();
     c.texture = !r_.texture.empty();
+    c.normal = !r_.normals.empty();
     c.splitRadiance = (r_.sampleFlags & DCM_SAMPLE_SPLIT) != 0;
     c.variance = r_.noisySample != nullptr;
     c.threadSafe = (r_.sampleFlags & DCM_SAMPLE_THREAD_SAFE) != 0;
@@ -235,6 +238,7 @@ class CallbackProvider final : public dcm::SampleProvider {
     if (what.objectId && !r_.objectIds.empty()) copy(r_.objectIds, &out->objectId);
     if (what.shaderId && !r_.shaderIds.empty()) copy(r_.shaderIds, &out->shaderId);
     if (what.texture && !r_.texture.empty()) copy(r_.texture, &out->texture);
+    if (what.normal && !r_.normals.empty()) copy(r_.normals, &out->normal);
     return dcm::Status::Ok();
   }
 
@@ -463,6 +467,7 @@ DCM_API void dcmSetImageSize(DCMReconstructor r, int width, int height) {
     r->objectIds.clear();
     r->shaderIds.clear();
     r->texture.clear();
+    r->normals.clear();
   });
 }
 
@@ -489,6 +494,16 @@ DCM_API void dcmSetTexture(DCMReconstructor r, const float* rgb) {
     const size_t n = size_t(r->width) * size_t(r->height);
     r->texture.resize(n);
     for (size_t i = 0; i < n; ++i) r->texture[i] = {rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]};
+  });
+}
+
+DCM_API void dcmSetNormals(DCMReconstructor r, const float* xyz) {
+  if (!CanSetGuide(r, "dcmSetNormals")) return;
+  Guard(r, [&] {
+    if (!xyz) return r->normals.clear();
+    const size_t n = size_t(r->width) * size_t(r->height);
+    r->normals.resize(n);
+    for (size_t i = 0; i < n; ++i) r->normals[i] = {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
   });
 }
 

@@ -12,7 +12,7 @@ std::vector<int> SignificantChanges(const SampleStore& store, const ContrastTest
   for (int k = 0; k < n; ++k) {
     const Point2i p = loop[k], q = loop[(k + 1) % n];
     const int64_t ip = store.Index(p.x, p.y), iq = store.Index(q.x, q.y);
-    if (contrast.Differ(store.ValueAt(ip), store.ValueAt(iq)) || !store.surfaces().Same(ip, iq))
+    if (contrast.Differ(store.ValueAt(ip), store.ValueAt(iq)) || !store.surfaces().SameAdjacent(ip, iq))
       changes.push_back(k);
   }
   return changes;
@@ -24,7 +24,7 @@ int SurfaceChanges(const SampleStore& store, std::span<const Point2i> loop) {
   if (!store.surfaces().enabled() || n < 2) return 0;
   for (int k = 0; k < n; ++k) {
     const Point2i p = loop[k], q = loop[(k + 1) % n];
-    if (!store.surfaces().Same(store.Index(p.x, p.y), store.Index(q.x, q.y))) ++changes;
+    if (!store.surfaces().SameAdjacent(store.Index(p.x, p.y), store.Index(q.x, q.y))) ++changes;
   }
   return changes;
 }

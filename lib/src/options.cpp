@@ -21,6 +21,7 @@ ReconstructionOptions ReconstructionOptions::Guo() {
   o.gradientBlocksSimple = false;
   o.fallback = false;
   o.noiseSignificance = 0.f;
+  o.creaseAngle = 0.f;
   o.denoiseSamples = false;
   return o;
 }
@@ -91,6 +92,7 @@ Status ReconstructionOptions::Validate() const {
   if (!(contrastThreshold >= 0) || !std::isfinite(contrastThreshold))
     return bad("contrastThreshold", "must be a finite number >= 0");
   if (directions < 1 || directions > 64) return bad("directions", "must be from 1 to 64, got " + std::to_string(directions));
+  if (!(creaseAngle >= 0 && creaseAngle <= 180)) return bad("creaseAngle", "must be from 0 to 180 degrees");
   if (!(noiseSignificance >= 0) || !std::isfinite(noiseSignificance))
     return bad("noiseSignificance", "must be a finite number >= 0");
   if (fallbackMaxChanges < 0) return bad("fallbackMaxChanges", "must be >= 0");

@@ -162,10 +162,12 @@ Status Engine::LoadGuides() {
   want.objectId = caps_.objectId && opt_.objectTest != ObjectTest::kNone;
   want.shaderId = want.objectId && caps_.shaderId && opt_.objectTest == ObjectTest::kObjectAndShader;
   want.texture = split_;
+  want.normal = caps_.normal && opt_.creaseAngle > 0.f;
   stats_.usedObjectId = want.objectId;
   stats_.usedShaderId = want.shaderId;
   stats_.usedSplit = split_;
-  if (!want.objectId && !want.texture) {
+  stats_.usedNormals = want.normal;
+  if (!want.objectId && !want.texture && !want.normal) {
     store_.SetGuides({}, ObjectTest::kNone);
     return Status::Ok();
   }
@@ -184,13 +186,15 @@ Status Engine::LoadGuides() {
   DCM_RETURN_IF_ERROR(check(want.objectId, g.objectId.size(), "object ID"));
   DCM_RETURN_IF_ERROR(check(want.shaderId, g.shaderId.size(), "shader ID"));
   DCM_RETURN_IF_ERROR(check(want.texture, g.texture.size(), "texture"));
+  DCM_RETURN_IF_ERROR(check(want.normal, g.normal.size(), "normal"));
   // A pixel whose tau is not finite cannot be reconstructed as L_i*tau + L_c:
   // it is evaluated exactly.
   if (want.texture)
     for (int64_t i = 0; i < int64_t(n); ++i)
       if (!IsFinite(g.texture[size_t(i)]))
         store_.Request(int(i % caps_.width), int(i / caps_.width), SampleReason::kFallback);
-  store_.SetGuides(std::move(g), want.objectId ? opt_.objectTest : ObjectTest::kNone);
+  store_.SetGuides(std::move(g), want.objectId ? opt_.objectTest : ObjectTest::kNone,
+                   want.normal ? opt_.creaseAngle : 0.f);
   return Status::Ok();
 }
 
@@ -200,8 +204,8 @@ bool Engine::HasSurfaceChange(const Block& b) const {
   for (int y = b.y0; y <= b.y1; ++y)
     for (int x = b.x0; x <= b.x1; ++x) {
       const int64_t i = store_.Index(x, y);
-      if (x < b.x1 && !s.Same(i, i + 1)) return true;
-      if (y < b.y1 && !s.Same(i, i + store_.width())) return true;
+      if (x < b.x1 && !s.SameAdjacent(i, i + 1)) return true;
+      if (y < b.y1 && !s.SameAdjacent(i, i + store_.width())) return true;
     }
   return false;
 }
@@ -355,7 +359,7 @@ Status Engine::EvaluateBordersAdaptively(const std::vector<Block>& edges) {
   ForEach(sides, [&](Side& s, size_t) {
     for (int k = 0; k <= s.length; k += s.length) store_.Request(s.a.x + k * s.step.x, s.a.y + k * s.step.y, SampleReason::kBorder);
     for (int k = 0; k < s.length; ++k)
-      if (!surf.Same(index(s, k), index(s, k + 1)))
+      if (!surf.SameAdjacent(index(s, k), index(s, k + 1)))
         for (int j : {k, k + 1}) store_.Request(s.a.x + j * s.step.x, s.a.y + j * s.step.y, SampleReason::kBorder);
   });
   DCM_RETURN_IF_ERROR(Flush());

@@ -37,9 +37,11 @@ inline Value Lerp(const Value& p, const Value& q, float t) {
 class SurfaceTest {
  public:
   SurfaceTest() = default;
-  SurfaceTest(const uint32_t* objectId, const uint32_t* shaderId)
-      : objectId_(objectId), shaderId_(shaderId) {}
-  bool enabled() const { return objectId_ != nullptr; }
+  /// `crease`: per pixel, bit 1 when a crease separates it from its right
+  /// neighbour, bit 2 from the one below (from normal guides); may be null.
+  SurfaceTest(const uint32_t* objectId, const uint32_t* shaderId, const uint8_t* crease = nullptr, int width = 0)
+      : objectId_(objectId), shaderId_(shaderId), crease_(crease), width_(width) {}
+  bool enabled() const { return objectId_ != nullptr || crease_ != nullptr; }
   /// Without IDs everything is one surface; with object IDs only, equal IDs;
   /// with object and shader IDs, a surface changes where both differ.
   bool Same(int64_t i, int64_t j) const {
@@ -47,10 +49,23 @@ class SurfaceTest {
     if (objectId_[i] == objectId_[j]) return true;
     return shaderId_ && shaderId_[i] == shaderId_[j];
   }
+  /// For 4-neighbours i and j: Same(), and no crease between them. Creases
+  /// are local: they mark where a block has a surface change and where its
+  /// border needs samples, not which distant pixels may interpolate which.
+  bool SameAdjacent(int64_t i, int64_t j) const {
+    if (!Same(i, j)) return false;
+    if (!crease_) return true;
+    const int64_t lo = std::min(i, j), hi = std::max(i, j);
+    if (hi - lo == width_) return !(crease_[lo] & 2);
+    if (hi - lo == 1) return !(crease_[lo] & 1);
+    return true;  // not neighbours (the wrap of a degenerate block's loop)
+  }
 
  private:
   const uint32_t* objectId_ = nullptr;
   const uint32_t* shaderId_ = nullptr;
+  const uint8_t* crease_ = nullptr;
+  int width_ = 0;
 };
 
 class SampleStore {
@@ -106,7 +121,9 @@ class SampleStore {
                ReconstructionStats* stats, std::vector<Point2i>* pending);
 
   const SurfaceTest& surfaces() const { return surfaces_; }
-  void SetGuides(GuideImage guides, ObjectTest test);
+  /// `creaseAngle` (degrees, 0: off) turns the normal guides, if any, into
+  /// crease marks between neighbouring pixels.
+  void SetGuides(GuideImage guides, ObjectTest test, float creaseAngle = 0.f);
 
   /// The radiance of every pixel: exact L where exact, a*tau+b elsewhere.
   const std::vector<RGB>& radiance() const { return out_; }
@@ -122,7 +139,7 @@ class SampleStore {
   std::vector<RGB> out_, tau_;
   std::vector<std::array<float, 2>> var_;  // (varA, varB) with variance only
   std::vector<SampleReason> reason_;
-  std::vector<uint8_t> finite_, filled_;
+  std::vector<uint8_t> finite_, filled_, crease_;
   GuideImage guides_;
   SurfaceTest surfaces_;
   tbb::enumerable_thread_specific<std::vector<uint64_t>> requests_;

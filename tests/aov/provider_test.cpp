@@ -104,6 +104,43 @@ TEST(AovProvider, GenericSplitDense) {
   EXPECT_EQ(Sample(*q, 14, 17).L, sc.L(14, 17));
 }
 
+TEST(AovProvider, NormalGuides) {
+  // Generic N.X/Y/Z, --map N=..., and the Blender Normal pass become the
+  // normal guide; an incomplete set is an error naming what is missing.
+  ScratchDir dir;
+  const Scene sc{16, 8};
+  std::vector<TestChannel> ch = sc.GenericChannels(false);
+  ch.push_back(Fill("N.X", 16, 8, [](int x, int) { return x < 8 ? 1.f : 0.f; }));
+  ch.push_back(Fill("N.Y", 16, 8, [](int x, int) { return x < 8 ? 0.f : 1.f; }));
+  ch.push_back(Fill("N.Z", 16, 8, [](int, int y) { return 0.1f * float(y); }));
+  WriteExr(dir / "n.exr", 16, 8, ch);
+  auto p = MustOpen({dir / "n.exr"});
+  ASSERT_TRUE(p);
+  EXPECT_TRUE(p->Capabilities().normal);
+  GuideRequest req;
+  req.normal = true;
+  const GuideImage g = AllGuides(*p, req);
+  ASSERT_EQ(g.normal.size(), size_t(16 * 8));
+  EXPECT_EQ(g.normal[size_t(3 * 16 + 2)].x, 1.f);
+  EXPECT_EQ(g.normal[size_t(3 * 16 + 12)].y, 1.f);
+  EXPECT_FLOAT_EQ(g.normal[size_t(3 * 16 + 12)].z, 0.3f);
+
+  std::vector<TestChannel> other = sc.GenericChannels(false);
+  for (const char* c : {"nrm.X", "nrm.Y", "nrm.Z"}) other.push_back(Fill(c, 16, 8, [](int, int) { return 0.5f; }));
+  WriteExr(dir / "m.exr", 16, 8, other);
+  AovOptions o;
+  ASSERT_TRUE(ParseMapping("N=nrm", &o.mappings).ok());
+  auto q = MustOpen({dir / "m.exr"}, o);
+  ASSERT_TRUE(q);
+  EXPECT_EQ(AllGuides(*q, req).normal[5].y, 0.5f);
+
+  std::vector<TestChannel> partial = sc.GenericChannels(false);
+  partial.push_back(Fill("N.X", 16, 8, [](int, int) { return 1.f; }));
+  WriteExr(dir / "p.exr", 16, 8, partial);
+  const Status st = OpenError({dir / "p.exr"});
+  EXPECT_NE(st.message().find("N.X found but not N.Y, N.Z"), std::string::npos) << st.message();
+}
+
 TEST(AovProvider, SeveralInputFilesAndMissingOptionalRoles) {
   ScratchDir dir;
   Scene sc{16, 16};

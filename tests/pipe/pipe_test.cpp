@@ -206,6 +206,31 @@ TEST(PipeProvider, VarianceOfANoisyProvider) {
   EXPECT_LT(exactFraction(1.5f), exactFraction(0.f));
 }
 
+TEST(PipeProvider, NormalGuides) {
+  // With --normals the provider announces `normal` and serves 3 floats per
+  // pixel after the other guides; without, dcm never asks for them.
+  std::unique_ptr<dcm::pipe::PipeProvider> p;
+  ASSERT_TRUE(Start(Analytic("--width 96 --height 64 --normals"), &p).ok());
+  ASSERT_TRUE(p->Capabilities().normal);
+  dcm::GuideRequest req;
+  req.objectId = req.texture = req.normal = true;
+  dcm::GuideImage g;
+  ASSERT_TRUE(p->Guides({{0, 0}, {96, 64}}, req, &g).ok());
+  ASSERT_EQ(g.normal.size(), size_t(96 * 64));
+  for (size_t i = 0; i < g.normal.size(); ++i) {
+    const bool disc = g.objectId[i] == 2;
+    ASSERT_EQ(g.normal[i].z, disc ? 1.f : 0.f) << "pixel " << i;
+    ASSERT_EQ(g.normal[i].y, disc ? 0.f : 1.f) << "pixel " << i;
+  }
+  ASSERT_TRUE(p->Finish().ok());
+  std::unique_ptr<dcm::pipe::PipeProvider> q;
+  ASSERT_TRUE(Start(Analytic("--width 96 --height 64"), &q).ok());
+  EXPECT_FALSE(q->Capabilities().normal);
+  ASSERT_TRUE(q->Guides({{0, 0}, {4, 4}}, req, &g).ok());
+  EXPECT_TRUE(g.normal.empty());
+  ASSERT_TRUE(q->Finish().ok());
+}
+
 struct FaultCase {
   const char* mode;
   const char* message;

@@ -20,6 +20,7 @@ ProviderCapabilities AnalyticProvider::Capabilities() const {
   c.shaderId = channels_.ids && channels_.shaders;
   c.texture = channels_.texture;
   c.splitRadiance = channels_.texture;
+  c.normal = channels_.normals;
   c.name = "analytic";
   return c;
 }
@@ -30,6 +31,7 @@ Status AnalyticProvider::Guides(const Bounds2i& region, const GuideRequest& what
   out->objectId.assign(what.objectId ? n : 0, 0);
   out->shaderId.assign(what.shaderId ? n : 0, 0);
   out->texture.assign(what.texture ? n : 0, RGB{});
+  out->normal.assign(what.normal ? n : 0, Vec3f{});
   for (int y = region.min.y; y < region.max.y; ++y)
     for (int x = region.min.x; x < region.max.x; ++x) {
       const PixelTruth t = scene_(x, y);
@@ -37,6 +39,7 @@ Status AnalyticProvider::Guides(const Bounds2i& region, const GuideRequest& what
       if (what.objectId) out->objectId[i] = t.objectId;
       if (what.shaderId) out->shaderId[i] = t.shaderId;
       if (what.texture) out->texture[i] = t.tau;
+      if (what.normal) out->normal[i] = t.normal;
     }
   return Status::Ok();
 }

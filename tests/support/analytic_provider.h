@@ -22,6 +22,7 @@ struct PixelTruth {
   /// L as a renderer measured it, when it is not exactly Li * tau + Lc (a
   /// renderer that divides L_t by a tiny tau, or leaves garbage in L_i).
   std::optional<RGB> renderedL;
+  Vec3f normal{0.f, 0.f, 1.f};  ///< surface normal (a guide with AnalyticChannels::normals)
   RGB L() const { return renderedL.value_or(Li * tau + Lc); }
 };
 
@@ -32,6 +33,7 @@ struct AnalyticChannels {
   bool ids = true;
   bool shaders = true;
   bool texture = true;
+  bool normals = false;  ///< advertise the normal guide
 };
 
 /// Serves a SceneFunction; counts how often each pixel is evaluated.

@@ -45,6 +45,7 @@ nlohmann::json OptionsToJson(const ReconstructionOptions& o) {
   j["fallback_max_changes"] = o.fallbackMaxChanges;
   j["finest_centre_probe"] = o.finestCentreProbe;
   j["noise_significance"] = o.noiseSignificance;
+  j["crease_angle"] = o.creaseAngle;
   j["denoise_samples"] = o.denoiseSamples;
   j["downsample"] = o.downsample;
   j["full_evaluation"] = o.fullEvaluation;
@@ -75,7 +76,8 @@ nlohmann::json StatsToJson(const ReconstructionStats& s) {
   j["non_finite_samples"] = s.nonFiniteSamples;
   j["denoised_samples"] = s.denoisedSamples;
   j["provider_calls"] = s.providerCalls;
-  j["used"] = {{"split", s.usedSplit}, {"object_id", s.usedObjectId}, {"shader_id", s.usedShaderId}};
+  j["used"] = {{"split", s.usedSplit}, {"object_id", s.usedObjectId}, {"shader_id", s.usedShaderId},
+               {"normals", s.usedNormals}};
   return j;
 }
 

@@ -30,6 +30,9 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
   app->add_option("--downsample", f->downsample, "the input is supersampled N times per axis; box-filter the result down");
   app->add_option("--threads", f->threads, "worker threads (0: all cores)");
   app->add_option("--tile-size", f->tile, "pixels per side of a unit of parallel work (default 64)");
+  app->add_option("--crease-angle", f->creaseAngle,
+                  "with normal guides: neighbours whose normals differ by more degrees are a surface change "
+                  "(default 30; 0: normals unused)");
   app->add_flag("--no-denoise-samples", f->noDenoise, "noisy samples: interpolate the raw exact samples");
   app->add_option("--noise-significance", f->noiseSignificance,
                   "with noisy samples (a variance channel or samples_per_pixel > 1): a difference counts when it "
@@ -64,6 +67,7 @@ Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {
   o->threads = f.threads;
   if (f.tile) o->tileSize = f.tile;
   if (f.noDenoise) o->denoiseSamples = false;
+  if (f.creaseAngle >= 0) o->creaseAngle = f.creaseAngle;
   if (f.noiseSignificance >= 0) o->noiseSignificance = f.noiseSignificance;
   if (!f.progressive.empty()) {
     std::error_code ec;

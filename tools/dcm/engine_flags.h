@@ -14,6 +14,7 @@ struct EngineFlags {
   std::string method = "dcm";  ///< dcm | paper | guo
   float threshold = -1;        ///< <0: the method's default
   float noiseSignificance = -1;  ///< <0: the method's default
+  float creaseAngle = -1;        ///< <0: the method's default
   int block = 0, minBlock = 0, directions = 0, downsample = 1, threads = 0, tile = 0;
   bool noThin = false, noTextureSplit = false, noLazy = false, noFallback = false;
   bool noSurfaceAware = false, full = false;
@@ -29,7 +30,7 @@ struct EngineFlags {
 /// Adds --method, --threshold, --block, --min-block, --directions, --no-thin,
 /// --thin-test, --no-texture-split, --object-test, --contrast, --no-lazy,
 /// --no-fallback, --no-surface-aware, --downsample, --threads, --tile-size,
-/// --noise-significance, --no-denoise-samples,
+/// --noise-significance, --no-denoise-samples, --crease-angle,
 /// --progressive, -v, --quiet.
 void AddEngineFlags(CLI::App* app, EngineFlags* flags);
 

@@ -182,6 +182,12 @@ DCM_API void dcmSetShaderIds(DCMReconstructor r, const uint32_t* ids);
  *  function has DCM_SAMPLE_SPLIT. */
 DCM_API void dcmSetTexture(DCMReconstructor r, const float* rgb);
 
+/** Sets the normal guide: width*height*3 floats (x, y, z; any consistent
+ *  space, need not be unit length, zero where there is none), row-major,
+ *  copied. NULL removes it. Neighbours whose normals differ by more than the
+ *  option "crease_angle" (degrees) are a surface change. Since API version 2. */
+DCM_API void dcmSetNormals(DCMReconstructor r, const float* xyz);
+
 /** Sets the function that evaluates exact samples, its user pointer and
  *  DCM_SAMPLE_* flags. Without DCM_SAMPLE_THREAD_SAFE it is called from one
  *  thread at a time. */

@@ -14,6 +14,11 @@ struct Point2i {
   friend bool operator==(const Point2i&, const Point2i&) = default;
 };
 
+/// A direction in 3-D (surface normals of the guides), in any consistent space.
+struct Vec3f {
+  float x = 0.f, y = 0.f, z = 0.f;
+};
+
 /// A half-open pixel region [min.x, max.x) x [min.y, max.y).
 struct Bounds2i {
   Point2i min;

@@ -60,6 +60,12 @@ struct ReconstructionOptions {
   /// Interpolate (L_i, L_c) and re-apply tau per pixel (paper 3.3).
   bool textureSplit = true;
 
+  /// With normal guides: neighbouring pixels whose normals differ by more
+  /// than this many degrees are a surface change, as an ID change is (a
+  /// crease inside one object with one material, such as a room's walls and
+  /// ceiling, which no ID marks). 0: normals are not used.
+  float creaseAngle = 30.f;
+
   SmoothRefinement smoothRefinement = SmoothRefinement::kCentreProbe;
   /// Edge-block borders: evaluate the pixels at surface changes and bisect
   /// every gap whose ends differ significantly; fill the rest along the border

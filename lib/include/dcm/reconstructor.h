@@ -59,7 +59,7 @@ struct ReconstructionStats {
   double timeGuidesS = 0;    ///< in the provider's Guides()
   double timeProviderS = 0;  ///< in the provider's Evaluate() (the illumination)
   double timeEngineS = 0;    ///< everything else
-  bool usedSplit = false, usedObjectId = false, usedShaderId = false;
+  bool usedSplit = false, usedObjectId = false, usedShaderId = false, usedNormals = false;
   double exactFraction() const { return totalPixels ? double(exactPixels) / double(totalPixels) : 0.0; }
 };
 

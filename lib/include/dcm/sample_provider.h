@@ -22,6 +22,7 @@ struct ProviderCapabilities {
   bool objectId = false;       ///< guides carry an object ID per pixel
   bool shaderId = false;       ///< guides carry a shader (material) ID per pixel
   bool texture = false;        ///< guides carry the texture value tau per pixel
+  bool normal = false;         ///< guides carry the surface normal per pixel (creases inside one object)
   bool splitRadiance = false;  ///< samples carry (L_i, L_c) with L = L_i*tau + L_c
   bool variance = false;       ///< samples carry the variance of their estimate of L
   /// Evaluate() may be called concurrently from several threads on disjoint
@@ -35,6 +36,7 @@ struct GuideRequest {
   bool objectId = false;
   bool shaderId = false;
   bool texture = false;
+  bool normal = false;
 };
 
 /// Guides for a region, row-major over `region`; arrays not requested stay empty.
@@ -43,6 +45,7 @@ struct GuideImage {
   std::vector<uint32_t> objectId;
   std::vector<uint32_t> shaderId;
   std::vector<RGB> texture;  ///< tau
+  std::vector<Vec3f> normal; ///< surface normal (need not be unit length; zero: none)
 };
 
 /// Which parts of an exact sample to compute.

@@ -24,12 +24,13 @@ using detail::Quote;
 namespace {
 
 constexpr std::array<std::string_view, kRoleCount> kRoleNames = {
-    "id",   "shader", "u",    "v",    "tau.R", "tau.G", "tau.B", "Li.R",  "Li.G",  "Li.B",
+    "id",   "shader", "u",    "v",    "tau.R", "tau.G", "tau.B", "N.X",   "N.Y",   "N.Z", "Li.R",  "Li.G",  "Li.B",
     "Lc.R", "Lc.G",   "Lc.B", "L.R",  "L.G",   "L.B",   "var.R", "var.G", "var.B", "mask"};
 
 constexpr const char* kComp[3] = {"R", "G", "B"};
 
 /// First role of each RGB group.
+constexpr Role kNormal = Role::kNX;
 constexpr Role kTau = Role::kTauR, kLi = Role::kLiR, kLc = Role::kLcR, kL = Role::kLR,
                kVar = Role::kVarR;
 
@@ -164,6 +165,7 @@ Status PresetExprs(Preset preset, const std::string& viewLayer, const ChannelSet
       set1(Role::kU, "u");
       set1(Role::kV, "v");
       setRgb(kTau, "tau.");
+      for (int c = 0; c < 3; ++c) set1(Comp(kNormal, c), std::string("N.") + "XYZ"[c]);
     }
     setRgb(kLi, "Li.");
     setRgb(kLc, "Lc.");
@@ -200,6 +202,7 @@ Status PresetExprs(Preset preset, const std::string& viewLayer, const ChannelSet
     set1(Role::kU, p + "UV.U");
     set1(Role::kV, p + "UV.V");
     setRgb(kTau, p + "DiffCol.");
+    for (int c = 0; c < 3; ++c) set1(Comp(kNormal, c), p + "Normal." + "XYZ"[c]);
   }
   setRgb(kL, p + "Combined.");
   for (int c = 0; c < 3; ++c) {
@@ -383,10 +386,12 @@ Status ParseMapping(std::string_view text, std::vector<Mapping>* out) {
     return Status::Error("--map '" + std::string(text) + "': expected ROLE=CHANNEL");
   const std::string role(OIIO::Strutil::strip(text.substr(0, eq)));
   const std::string expr(OIIO::Strutil::strip(text.substr(eq + 1)));
-  for (const char* group : {"tau", "Li", "Lc", "L", "var"}) {
+  for (const char* group : {"tau", "Li", "Lc", "L", "var", "N"}) {
     if (role == group) {
+      const bool vector = role == "N";  // components X, Y, Z
+      const char* const comps[3] = {vector ? "X" : "R", vector ? "Y" : "G", vector ? "Z" : "B"};
       Role first;
-      DCM_RETURN_IF_ERROR(ParseRole(role + ".R", &first));
+      DCM_RETURN_IF_ERROR(ParseRole(role + "." + comps[0], &first));
       for (int c = 0; c < 3; ++c) {
         // "tau=albedo" -> albedo.R, albedo.G, albedo.B (each channel name of
         // a sum or product gets the component).
@@ -394,7 +399,7 @@ Status ParseMapping(std::string_view text, std::vector<Mapping>* out) {
         DCM_RETURN_IF_ERROR(ParseExpr(expr, &e));
         if (!e.crypto.empty()) return Status::Error("--map " + role + ": Cryptomatte gives IDs only");
         for (auto& term : e.terms)
-          for (auto& f : term) f += std::string(".") + kComp[c];
+          for (auto& f : term) f += std::string(".") + comps[c];
         out->push_back({Comp(first, c), e.Text()});
       }
       return Status::Ok();
@@ -425,6 +430,7 @@ struct AovProvider::Data {
   bool dense = true;
   std::vector<uint32_t> objectId, shaderId;
   std::vector<RGB> tau, L, Li, Lc, var;
+  std::vector<Vec3f> normal;
   std::vector<uint8_t> have;  ///< sparse mode: 1 where a sample was read
   int64_t haveCount = 0;
   std::vector<std::string> notes, warnings, sampleChannels;
@@ -691,6 +697,15 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
     d->notes.push_back("tau: " + RgbText(roles, kTau));
     DCM_RETURN_IF_ERROR(guideEval.Report(roles, {kTau}, nullptr, &d->warnings));
   }
+  bool hasNormal = false;
+  DCM_RETURN_IF_ERROR(RgbPresent(roles, kNormal, guides, &hasNormal));
+  if (hasNormal) {
+    std::vector<RGB> n;
+    DCM_RETURN_IF_ERROR(guideEval.EvalRgb(roles, kNormal, &n));
+    d->normal.resize(n.size());
+    for (size_t i = 0; i < n.size(); ++i) d->normal[i] = {n[i].r, n[i].g, n[i].b};
+    d->notes.push_back("normal: " + RgbText(roles, kNormal) + " (creases inside one object are surface changes)");
+  }
   if (!options.textures.empty()) {
     DCM_RETURN_IF_ERROR(LookupTextures(guides, roles, options.textures, shaderExpr, d.get()));
     hasTau = true;
@@ -867,6 +882,7 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
   c.shaderId = !d->shaderId.empty();
   c.texture = split;
   c.splitRadiance = split;
+  c.normal = !d->normal.empty();
   c.variance = !d->var.empty();
   c.threadSafe = true;
   c.name = "aov:" + inputs[0];
@@ -882,7 +898,7 @@ Status AovProvider::Guides(const Bounds2i& region, const GuideRequest& what, Gui
   if (Intersect(region, full) != region)
     return Status::Error("guides requested outside the image");
   if ((what.objectId && d_->objectId.empty()) || (what.shaderId && d_->shaderId.empty()) ||
-      (what.texture && d_->tau.empty()))
+      (what.texture && d_->tau.empty()) || (what.normal && d_->normal.empty()))
     return Status::Error("guides requested that the inputs do not carry");
   out->region = region;
   const size_t count = size_t(region.area());
@@ -897,6 +913,8 @@ Status AovProvider::Guides(const Bounds2i& region, const GuideRequest& what, Gui
   out->objectId.clear();
   out->shaderId.clear();
   out->texture.clear();
+  out->normal.clear();
+  if (what.normal) copy(d_->normal, &out->normal);
   if (what.objectId) copy(d_->objectId, &out->objectId);
   if (what.shaderId) copy(d_->shaderId, &out->shaderId);
   if (what.texture) copy(d_->tau, &out->texture);

@@ -202,6 +202,7 @@ Status PipeProvider::Handshake() {
         if (c == "object_id") caps_.objectId = true;
         else if (c == "shader_id") caps_.shaderId = true;
         else if (c == "texture") caps_.texture = true;
+        else if (c == "normal") caps_.normal = true;
         else if (c == "split") caps_.splitRadiance = true;
         else if (c == "variance") caps_.variance = true;
         // Unknown capabilities are ignored (newer providers).
@@ -226,7 +227,7 @@ Status PipeProvider::Guides(const Bounds2i& region, const GuideRequest& what, Gu
   if (region.empty() || Intersect(region, all) != region)
     return Status::Error(Prefix() + ": guide region outside the image");
   const bool ids = what.objectId && caps_.objectId, shaders = what.shaderId && caps_.shaderId,
-             tex = what.texture && caps_.texture;
+             tex = what.texture && caps_.texture, normal = what.normal && caps_.normal;
   std::string kinds;
   auto add = [&](bool on, const char* name) {
     if (!on) return;
@@ -236,10 +237,12 @@ Status PipeProvider::Guides(const Bounds2i& region, const GuideRequest& what, Gu
   add(ids, "object_id");
   add(shaders, "shader_id");
   add(tex, "texture");
+  add(normal, "normal");
   out->region = region;
   out->objectId.clear();
   out->shaderId.clear();
   out->texture.clear();
+  out->normal.clear();
   if (kinds.empty()) return Status::Ok();
 
   const std::string request = "guides " + std::to_string(region.min.x) + " " + std::to_string(region.min.y) + " " +
@@ -276,6 +279,13 @@ Status PipeProvider::Guides(const Bounds2i& region, const GuideRequest& what, Gu
       return Fail(failure);
     out->texture.resize(size_t(n));
     for (size_t i = 0; i < size_t(n); ++i) out->texture[i] = {f[3 * i], f[3 * i + 1], f[3 * i + 2]};
+  }
+  if (normal) {
+    std::vector<float> f(size_t(n) * 3);
+    if (!ReadPayload(*child_, f.data(), f.size() * 4, request, options_.timeoutSeconds, &failure).ok())
+      return Fail(failure);
+    out->normal.resize(size_t(n));
+    for (size_t i = 0; i < size_t(n); ++i) out->normal[i] = {f[3 * i], f[3 * i + 1], f[3 * i + 2]};
   }
   return Status::Ok();
 }
