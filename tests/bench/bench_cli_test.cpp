@@ -212,7 +212,9 @@ TEST(BenchNoise, SppSweepAgainstAConvergedReference) {
     EXPECT_LT(Num(byLabel["dcm" + sfx]["exact_fraction"]), Num(byLabel["paper" + sfx]["exact_fraction"]));
     EXPECT_TRUE(std::isfinite(Num(byLabel["dcm" + sfx]["psnr_db"])));
   }
-  if (DCM_HAVE_MATPLOTLIB) EXPECT_TRUE(fs::is_regular_file(dir / "room_noise.png"));
+  if (DCM_HAVE_MATPLOTLIB) {
+    EXPECT_TRUE(fs::is_regular_file(dir / "room_noise.png"));
+  }
   fs::remove_all(dir);
 }
 

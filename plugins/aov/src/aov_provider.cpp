@@ -700,10 +700,10 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
   bool hasNormal = false;
   DCM_RETURN_IF_ERROR(RgbPresent(roles, kNormal, guides, &hasNormal));
   if (hasNormal) {
-    std::vector<RGB> n;
-    DCM_RETURN_IF_ERROR(guideEval.EvalRgb(roles, kNormal, &n));
-    d->normal.resize(n.size());
-    for (size_t i = 0; i < n.size(); ++i) d->normal[i] = {n[i].r, n[i].g, n[i].b};
+    std::vector<RGB> xyz;
+    DCM_RETURN_IF_ERROR(guideEval.EvalRgb(roles, kNormal, &xyz));
+    d->normal.resize(xyz.size());
+    for (size_t i = 0; i < xyz.size(); ++i) d->normal[i] = {xyz[i].r, xyz[i].g, xyz[i].b};
     d->notes.push_back("normal: " + RgbText(roles, kNormal) + " (creases inside one object are surface changes)");
   }
   if (!options.textures.empty()) {
