@@ -6,6 +6,8 @@
 # timeout-*) and its path printed.
 #
 #   scripts/fuzz.sh [SECONDS]
+#   DCM_FUZZ_SEED=N scripts/fuzz.sh   # libFuzzer's -seed (0, the default: random;
+#                                     # the test command uses a fixed one)
 #   DCM_FUZZ_BUILD_DIR=/x scripts/fuzz.sh 300
 #
 # Packages: clang-14 and libclang-rt-14-dev (libFuzzer and the sanitizer
@@ -43,7 +45,7 @@ for target in fuzz_scene fuzz_exr; do
   set +e
   "$build/$target" "$corpus" "$seeds" "${dict[@]}" \
     -max_total_time="$seconds" -timeout=60 -rss_limit_mb=2560 -malloc_limit_mb=2048 \
-    -max_len=65536 -print_final_stats=1 \
+    -max_len=65536 -print_final_stats=1 -seed="${DCM_FUZZ_SEED:-0}" \
     -artifact_prefix="$build/artifacts/$target/" >"$build/$target.log" 2>&1
   rc=$?
   set -e

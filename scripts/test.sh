@@ -1,11 +1,19 @@
 #!/usr/bin/env bash
 # Sets up a fresh Debian 12 machine and runs dcm's whole test suite:
-# installs the packages, configures, builds (-j2), runs ctest.
+# installs the packages, configures, builds (-j2), runs ctest, then the engine
+# and robustness suites under ASan+UBSan (DCM_NO_SANITIZE=1 skips that step)
+# and a 30-s fuzz run per target (DCM_NO_FUZZ=1 skips it).
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 build=${DCM_BUILD_DIR:-$here/build}
 "$here/scripts/install-deps.sh"
 cmake -S "$here" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$build" -j2
-cd "$build"
-ctest --output-on-failure -j2 --timeout 600
+(cd "$build" && ctest --output-on-failure -j2 --timeout 600)
+# The engine and robustness suites again under AddressSanitizer and
+# UndefinedBehaviorSanitizer (scripts/sanitize.sh runs everything; ~1 min here).
+[ "${DCM_NO_SANITIZE:-0}" = 1 ] || DCM_ASAN_BUILD_DIR="$build-asan" "$here/scripts/sanitize.sh" --quick
+# A short fuzz run of the scene parser and the EXR/AOV path (libFuzzer,
+# clang-14; 30 s each with a fixed seed, so that a run is repeatable).
+[ "${DCM_NO_FUZZ:-0}" = 1 ] || DCM_FUZZ_SEED=${DCM_FUZZ_SEED:-1} DCM_FUZZ_BUILD_DIR="$build-fuzz" \
+  "$here/scripts/fuzz.sh" "${DCM_FUZZ_SECONDS:-30}"
