@@ -1,5 +1,6 @@
 #include "embree/embree_scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -48,6 +49,40 @@ Status EmbreeScene::AddMesh(TriangleMesh mesh, int object, int light) {
   return Status::Ok();
 }
 
+namespace {
+
+/// True when p lies strictly inside the convex solid `mesh` bounds (a box, a
+/// tessellated sphere, a capped cylinder): on the centroid's side of every
+/// face plane, whatever the winding of the triangles.
+bool InsideConvex(const TriangleMesh& mesh, Vec3 p) {
+  if (mesh.positions.empty() || mesh.indices.empty()) return false;
+  Vec3 c{0.f, 0.f, 0.f};
+  for (const Vec3& v : mesh.positions) c = c + v;
+  c = c * (1.f / float(mesh.positions.size()));
+  for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+    const Vec3 a = mesh.positions[mesh.indices[t]], b = mesh.positions[mesh.indices[t + 1]],
+               d = mesh.positions[mesh.indices[t + 2]];
+    const Vec3 n = Cross(b - a, d - a);
+    const float len = Length(n);
+    if (!(len > 0.f)) continue;  // a degenerate triangle bounds nothing
+    const float sc = Dot(n, c - a) / len, sp = Dot(n, p - a) / len;
+    // On a face, or on the other side than the centroid: not inside.
+    if (!(sc * sp > 0.f) || std::fabs(sp) < 1e-6f * std::max(1.f, Length(p))) return false;
+  }
+  return true;
+}
+
+const char* ShapeName(ShapeKind k) {
+  switch (k) {
+    case ShapeKind::kBox: return "box";
+    case ShapeKind::kSphere: return "sphere";
+    case ShapeKind::kCylinder: return "cylinder";
+    default: return "object";
+  }
+}
+
+}  // namespace
+
 Status EmbreeScene::Build(const Scene& scene, std::unique_ptr<EmbreeScene>* out) {
   std::unique_ptr<EmbreeScene> s(new EmbreeScene());
   s->device_ = rtcNewDevice(nullptr);
@@ -65,6 +100,16 @@ Status EmbreeScene::Build(const Scene& scene, std::unique_ptr<EmbreeScene>* out)
       mesh = TessellateShape(o);
     }
     ApplyTransform(o.transform, &mesh);
+    // A camera inside a closed solid sees only its inside: almost certainly a
+    // mistake in the scene (the solid hides everything else).
+    const bool closedConvex = o.shape == ShapeKind::kBox || o.shape == ShapeKind::kSphere ||
+                              (o.shape == ShapeKind::kCylinder && o.caps);
+    if (closedConvex && InsideConvex(mesh, scene.camera.position)) {
+      const Vec3 c = scene.camera.position;
+      return Status::Error(prefix + "camera.position (" + std::to_string(c.x) + ", " + std::to_string(c.y) + ", " +
+                           std::to_string(c.z) + ") is inside " + o.path + " (a " + ShapeName(o.shape) +
+                           "): every camera ray would start inside it");
+    }
     DCM_RETURN_IF_ERROR(s->AddMesh(std::move(mesh), int(i), -1));
   }
   for (size_t i = 0; i < scene.lights.size(); ++i) {

@@ -262,6 +262,34 @@ TEST(RenderBadInput, ZeroLights) {
   ExpectRejected(dir, "scene.json: lights: the scene has no lights");
 }
 
+TEST(RenderBadInput, CameraInsideAClosedObject) {
+  // Inside a box, a sphere, a rotated and scaled box: rejected, naming the
+  // object. Inside a room built of quads (open surfaces) is normal.
+  const std::string camera = R"({"position": [0.2, 0.5, 0.1], "look_at": [0, 0.5, -3], "resolution": [16, 16]})";
+  const std::string light = R"([{"type": "point", "position": [0, 3, 2], "intensity": 10}])";
+  const std::pair<std::string, std::string> cases[] = {
+      {kBox, "objects[0] (a box)"},
+      {R"([{"type": "quad", "material": "m", "origin": [-3, 0, 3], "edge_u": [6, 0, 0], "edge_v": [0, 0, -6]},
+           {"type": "sphere", "material": "m", "center": [0, 0.5, 0], "radius": 0.6}])",
+       "objects[1] (a sphere)"},
+      {R"([{"type": "box", "material": "m", "min": [-0.5, -0.5, -0.5], "max": [0.5, 0.5, 0.5],
+            "transform": {"scale": [1, 2, 1], "rotate": [0, 45, 0], "translate": [0, 0.5, 0]}}])",
+       "objects[0] (a box)"},
+  };
+  for (const auto& [objects, what] : cases) {
+    TempDir dir;
+    dir.Write("scene.json", Scene(objects, light, camera));
+    ExpectRejected(dir, "scene.json: camera.position (0.200000, 0.500000, 0.100000) is inside " + what +
+                            ": every camera ray would start inside it");
+  }
+  TempDir room;
+  room.Write("scene.json", Scene(R"([{"type": "quad", "material": "m", "origin": [-3, 0, 3], "edge_u": [6, 0, 0], "edge_v": [0, 0, -6]},
+      {"type": "quad", "material": "m", "origin": [-3, 3, -3], "edge_u": [6, 0, 0], "edge_v": [0, 0, 6]}])",
+                                 light, camera));
+  const Result ok = RunDcm(room.path(), {"render", "scene.json", "-o", "room.exr", "--quiet"});
+  EXPECT_TRUE(ok.exited && ok.code == 0) << ok.Describe();
+}
+
 TEST(RenderBadInput, MissingMesh) {
   TempDir dir;
   dir.Write("scene.json", Scene(R"([{"type": "mesh", "material": "m", "file": "gone.obj"}])"));
