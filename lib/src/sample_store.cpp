@@ -53,8 +53,16 @@ void SampleStore::SetGuides(GuideImage guides, ObjectTest test, float creaseAngl
         if (y + 1 < height_ && dot(i, i + size_t(width_), &d) && d < cosMax) crease_[i] |= 2;
       }
   }
-  surfaces_ = SurfaceTest(obj, shader, crease_.empty() ? nullptr : crease_.data(), width_);
+  tauZero_.clear();
+  if (split_ && tau_.size() == size_t(width_) * size_t(height_)) {
+    tauZero_.resize(tau_.size());
+    for (size_t i = 0; i < tau_.size(); ++i) tauZero_[i] = TauZero(tau_[i]) ? 1 : 0;
+  }
+  surfaces_ = SurfaceTest(obj, shader, crease_.empty() ? nullptr : crease_.data(), width_,
+                          tauZero_.empty() ? nullptr : tauZero_.data());
 }
+
+bool SampleStore::TauZero(RGB tau) { return tau.r == 0.f && tau.g == 0.f && tau.b == 0.f; }
 
 bool SampleStore::TauRecoverable(RGB tau) {
   for (int c = 0; c < 3; ++c)
@@ -158,11 +166,18 @@ Status SampleStore::Flush(SampleProvider& provider, const SampleRequest& what, i
       a_[i] = s.Li;
       b_[i] = s.Lc;
     }
-    const bool finite = dcm::IsFinite(s.L) && (!split_ || (dcm::IsFinite(s.Li) && dcm::IsFinite(s.Lc)));
+    // Where tau is exactly zero (a surface without diffuse texture: the sky,
+    // chrome, an emitter, a black texel) L = L_c and L_i means nothing: it is
+    // set to 0, and the sample interpolates L_c for pixels whose tau is zero
+    // too (the surface test keeps tau = 0 and tau != 0 apart).
+    const bool tauZero = split_ && TauZero(tau_[i]);
+    if (tauZero) a_[i] = RGB{};
+    const bool finite =
+        dcm::IsFinite(s.L) && (!split_ || ((tauZero || dcm::IsFinite(s.Li)) && dcm::IsFinite(s.Lc)));
     if (!finite) ++stats->nonFiniteSamples;
-    // Where tau is zero or denormal, L_i = L_t / tau is not recoverable: the
-    // sample keeps its own exact L but never serves to interpolate others.
-    finite_[i] = (finite && (!split_ || TauRecoverable(tau_[i]))) ? 1 : 0;
+    // Where tau is denormal, L_i = L_t / tau is not recoverable: the sample
+    // keeps its own exact L but never serves to interpolate others.
+    finite_[i] = (finite && (!split_ || tauZero || TauRecoverable(tau_[i]))) ? 1 : 0;
     if (!var_.empty()) var_[i] = LuminanceVariances(s.variance, split_ ? tau_[i] : RGB::Gray(1.f));
   }
   return Status::Ok();

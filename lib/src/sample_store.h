@@ -39,12 +39,17 @@ class SurfaceTest {
   SurfaceTest() = default;
   /// `crease`: per pixel, bit 1 when a crease separates it from its right
   /// neighbour, bit 2 from the one below (from normal guides); may be null.
-  SurfaceTest(const uint32_t* objectId, const uint32_t* shaderId, const uint8_t* crease = nullptr, int width = 0)
-      : objectId_(objectId), shaderId_(shaderId), crease_(crease), width_(width) {}
-  bool enabled() const { return objectId_ != nullptr || crease_ != nullptr; }
+  /// `tauZero`: per pixel, 1 where tau is exactly zero (with the texture
+  /// split); such pixels are another surface than those with tau != 0, since
+  /// their L_i is unknown. May be null.
+  SurfaceTest(const uint32_t* objectId, const uint32_t* shaderId, const uint8_t* crease = nullptr, int width = 0,
+              const uint8_t* tauZero = nullptr)
+      : objectId_(objectId), shaderId_(shaderId), crease_(crease), tauZero_(tauZero), width_(width) {}
+  bool enabled() const { return objectId_ != nullptr || crease_ != nullptr || tauZero_ != nullptr; }
   /// Without IDs everything is one surface; with object IDs only, equal IDs;
   /// with object and shader IDs, a surface changes where both differ.
   bool Same(int64_t i, int64_t j) const {
+    if (tauZero_ && tauZero_[i] != tauZero_[j]) return false;
     if (!objectId_) return true;
     if (objectId_[i] == objectId_[j]) return true;
     return shaderId_ && shaderId_[i] == shaderId_[j];
@@ -65,6 +70,7 @@ class SurfaceTest {
   const uint32_t* objectId_ = nullptr;
   const uint32_t* shaderId_ = nullptr;
   const uint8_t* crease_ = nullptr;
+  const uint8_t* tauZero_ = nullptr;
   int width_ = 0;
 };
 
@@ -84,6 +90,8 @@ class SampleStore {
   /// non-finite (L_i = L_t / tau is meaningless there).
   bool IsFinite(int64_t i) const { return finite_[i] != 0; }
   static bool TauRecoverable(RGB tau);
+  /// tau is exactly zero in all three channels (L = L_c).
+  static bool TauZero(RGB tau);
   /// (varA, varB) of a sample whose L has per-channel variance `varL`.
   static std::array<float, 2> LuminanceVariances(RGB varL, RGB tau);
   /// Without the split the interpolated quantity is L itself, stored once.
@@ -139,7 +147,7 @@ class SampleStore {
   std::vector<RGB> out_, tau_;
   std::vector<std::array<float, 2>> var_;  // (varA, varB) with variance only
   std::vector<SampleReason> reason_;
-  std::vector<uint8_t> finite_, filled_, crease_;
+  std::vector<uint8_t> finite_, filled_, crease_, tauZero_;
   GuideImage guides_;
   SurfaceTest surfaces_;
   tbb::enumerable_thread_specific<std::vector<uint64_t>> requests_;
