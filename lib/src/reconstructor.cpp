@@ -227,6 +227,10 @@ SampleReason Engine::Resolve(Point2i q, Interpolant* in) const {
   for (int k = 0; k < in->count; ++k) {
     const int64_t i = in->index[k];
     if (!store_.IsFinite(i)) continue;  // non-finite samples never spread
+    if (!store_.LiKnownFor(i, iq)) {  // tau = 0 there: its L_i is unknown here
+      anyOther = true;                 // (and it is another surface)
+      continue;
+    }
     finite.index[finite.count] = i, finite.weight[finite.count++] = in->weight[k];
     if (s.Same(iq, i)) {
       anySame = true;

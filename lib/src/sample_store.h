@@ -90,6 +90,9 @@ class SampleStore {
   /// non-finite (L_i = L_t / tau is meaningless there).
   bool IsFinite(int64_t i) const { return finite_[i] != 0; }
   static bool TauRecoverable(RGB tau);
+  /// Exact sample i can give L_i to pixel q: not when i has tau = 0 (its L_i
+  /// is unknown) and q has not. Holds whatever the surface-aware switch.
+  bool LiKnownFor(int64_t i, int64_t q) const { return tauZero_.empty() || !tauZero_[i] || tauZero_[q]; }
   /// tau is exactly zero in all three channels (L = L_c).
   static bool TauZero(RGB tau);
   /// (varA, varB) of a sample whose L has per-channel variance `varL`.
