@@ -427,6 +427,49 @@ INSTANTIATE_TEST_SUITE_P(
       return n;
     });
 
+TEST(DcmReconstruct, ProviderCmdIsDcmPipe) {
+  // `dcm reconstruct --provider-cmd` (the spelling) runs the same
+  // reconstruction as `dcm pipe`: same pixels, same exact-pixel count; the
+  // child's failures and the flags that need EXR inputs are errors.
+  TempDir dir;
+  const std::string provider = Quoted(Analytic("--width 96 --height 64"));
+  std::string log;
+  ASSERT_EQ(RunShell(std::string(DCM_BINARY) + " reconstruct --quiet --provider-cmd " + provider + " -o " +
+                         (dir / "r.exr") + " --stats " + (dir / "r.json"),
+                     &log),
+            0)
+      << log;
+  ASSERT_EQ(RunShell(std::string(DCM_BINARY) + " pipe --quiet --provider-cmd " + provider + " -o " + (dir / "p.exr") +
+                         " --stats " + (dir / "p.json"),
+                     &log),
+            0)
+      << log;
+  std::vector<dcm::RGB> a, b;
+  int w = 0, h = 0;
+  ASSERT_TRUE(dcm::toolkit::ReadRgb(dir / "r.exr", &w, &h, &a).ok());
+  ASSERT_TRUE(dcm::toolkit::ReadRgb(dir / "p.exr", &w, &h, &b).ok());
+  EXPECT_EQ(a, b);
+  std::ifstream rj(dir / "r.json"), pj(dir / "p.json");
+  EXPECT_EQ(nlohmann::json::parse(rj).at("exact_pixels"), nlohmann::json::parse(pj).at("exact_pixels"));
+
+  TempDir bad;
+  EXPECT_EQ(RunShell(std::string(DCM_BINARY) + " reconstruct --quiet --provider-cmd " + Quoted(Faulty("crash-on-eval")) +
+                         " -o " + (bad / "o.exr"),
+                     &log),
+            1)
+      << log;
+  EXPECT_TRUE(Contains(log, "dcm reconstruct: error: provider '")) << log;
+  EXPECT_EQ(RunShell(std::string(DCM_BINARY) + " reconstruct --quiet --provider-cmd " + provider + " in.exr -o " +
+                         (bad / "o.exr"),
+                     &log),
+            2)
+      << log;
+  EXPECT_TRUE(Contains(log, "--provider-cmd replaces the input files")) << log;
+  EXPECT_EQ(RunShell(std::string(DCM_BINARY) + " reconstruct --quiet -o " + (bad / "o.exr"), &log), 2) << log;
+  EXPECT_TRUE(Contains(log, "no input files (EXR AOVs), and no --provider-cmd")) << log;
+  EXPECT_TRUE(bad.empty());
+}
+
 TEST(DcmPipe, UsageErrors) {
   std::string log;
   EXPECT_EQ(RunShell(std::string(DCM_BINARY) + " pipe -o /tmp/never.exr", &log), 2) << log;

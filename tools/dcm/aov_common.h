@@ -33,9 +33,12 @@ struct AovFlags {
 };
 
 /// Adds INPUT... and --preset, --map, --texture, --layer, --samples.
+/// `dcm plan` needs its inputs; `dcm reconstruct` may take --provider-cmd
+/// instead (and checks that one of the two is given).
 inline void AddAovFlags(CLI::App* app, AovFlags* f, bool samplesHelpForPlan) {
-  app->add_option("inputs", f->inputs, "input EXR files (one multilayer EXR or several EXRs of one size)")
-      ->required();
+  auto* inputs =
+      app->add_option("inputs", f->inputs, "input EXR files (one multilayer EXR or several EXRs of one size)");
+  if (samplesHelpForPlan) inputs->required();
   app->add_option("--preset", f->preset, "channel names: generic (default) or blender (Cycles passes)")
       ->check(CLI::IsMember({"generic", "blender"}));
   app->add_option("--map", f->maps,

@@ -21,26 +21,24 @@
 #include "dcm/pipe/pipe_provider.h"
 #include "dcm/reconstructor.h"
 #include "engine_flags.h"
+#include "pipe_run.h"
 
 namespace dcm::cli {
-namespace {
 
-struct PipeFlags {
-  std::string command;
-  std::string output;
-  std::string stats;
-  std::string sampleMap;
-  double timeout = 600.0;
-  double startupTimeout = 600.0;
-  EngineFlags engine;
-};
-
-int Fail(const std::string& message, int code = kExitFailure) {
-  std::cerr << "dcm pipe: error: " << message << "\n";
-  return code;
+void AddProviderTimeoutFlags(CLI::App* app, PipeFlags* f) {
+  app->add_option("--provider-timeout", f->timeout,
+                  "seconds to wait for any later answer of the provider and for its exit (default 600)")
+      ->check(CLI::PositiveNumber);
+  app->add_option("--provider-startup-timeout", f->startupTimeout,
+                  "seconds to wait for the provider's handshake (default 600)")
+      ->check(CLI::PositiveNumber);
 }
 
-int RunPipe(const PipeFlags& f) {
+int RunPipe(const std::string& cmd, const PipeFlags& f) {
+  auto Fail = [&cmd](const std::string& message, int code = kExitFailure) {
+    std::cerr << "dcm " << cmd << ": error: " << message << "\n";
+    return code;
+  };
   ReconstructionOptions options;
   if (Status st = ToOptions(f.engine, &options); !st.ok()) return Fail(st.message(), kExitUsage);
 
@@ -112,6 +110,8 @@ int RunPipe(const PipeFlags& f) {
   return kExitOk;
 }
 
+namespace {
+
 Registration reg("pipe", "Reconstruct with an external renderer as a child process (dcm-pipe protocol)",
                  [](CLI::App* app) -> std::function<int()> {
                    auto f = std::make_shared<PipeFlags>();
@@ -121,14 +121,9 @@ Registration reg("pipe", "Reconstruct with an external renderer as a child proce
                    app->add_option("-o,--output", f->output, "output image (EXR)")->required();
                    app->add_option("--stats", f->stats, "write statistics (JSON)");
                    app->add_option("--sample-map", f->sampleMap, "write the sample map (PNG): which pixels were exact, why");
-                   app->add_option("--provider-timeout", f->timeout,
-                                   "seconds to wait for any later answer of the provider and for its exit (default 600)")
-                       ->check(CLI::PositiveNumber);
-                   app->add_option("--provider-startup-timeout", f->startupTimeout,
-                                   "seconds to wait for the provider's handshake (default 600)")
-                       ->check(CLI::PositiveNumber);
+                   AddProviderTimeoutFlags(app, f.get());
                    AddEngineFlags(app, &f->engine);
-                   return [f] { return RunPipe(*f); };
+                   return [f] { return RunPipe("pipe", *f); };
                  });
 
 }  // namespace

@@ -23,6 +23,7 @@
 #include "common/sample_map.h"
 #include "common/stats_json.h"
 #include "common/tiles.h"
+#include "pipe_run.h"
 #include "tile_flags.h"
 
 namespace dcm::cli {
@@ -34,6 +35,7 @@ struct ReconstructFlags {
   std::string output, stats, sampleMap, preview, errorMap, reference;
   bool alpha = false;
   TileFlags tiles;
+  PipeFlags pipe;  ///< --provider-cmd: a renderer in a child process instead of EXR inputs
 };
 
 nlohmann::json ErrorJson(const toolkit::ImageError& e) {
@@ -182,6 +184,28 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
 
 int RunReconstruct(const ReconstructFlags& f) {
   const std::string cmd = "reconstruct";
+  if (!f.pipe.command.empty()) {
+#ifdef DCM_HAVE_PIPE
+    if (!f.aov.inputs.empty())
+      return aov_common::Fail(cmd, "--provider-cmd replaces the input files; give one or the other", kExitUsage);
+    if (!f.aov.samples.empty() || !f.aov.secondRender.empty() || f.aov.estimateVariance || !f.reference.empty() ||
+        !f.errorMap.empty() || !f.preview.empty() || f.alpha || !f.tiles.tile.empty() || !f.tiles.region.empty())
+      return aov_common::Fail(cmd,
+                              "with --provider-cmd only -o, --stats, --sample-map, the provider timeouts and the "
+                              "engine flags apply (the provider reports its own variance and guides)",
+                              kExitUsage);
+    PipeFlags p = f.pipe;
+    p.output = f.output;
+    p.stats = f.stats;
+    p.sampleMap = f.sampleMap;
+    p.engine = f.engine;
+    return RunPipe(cmd, p);
+#else
+    return aov_common::Fail(cmd, "--provider-cmd needs plugins/pipe, which this build does not have", kExitUsage);
+#endif
+  }
+  if (f.aov.inputs.empty())
+    return aov_common::Fail(cmd, "no input files (EXR AOVs), and no --provider-cmd", kExitUsage);
   ReconstructionOptions options;
   Status st = ToOptions(f.engine, &options);
   if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
@@ -345,6 +369,12 @@ Registration reg("reconstruct", "Reconstruct an image from a renderer's EXR AOVs
                    app->add_flag("--alpha", f->alpha, "write RGBA with A = 1");
                    AddEngineFlags(app, &f->engine);
                    AddTileFlags(app, &f->tiles);
+                   app->add_option("--provider-cmd", f->pipe.command,
+                                   "instead of input files: a renderer started as a child process that speaks the "
+                                   "dcm-pipe protocol (plugins/pipe/PROTOCOL.md; as dcm pipe)");
+#ifdef DCM_HAVE_PIPE
+                   AddProviderTimeoutFlags(app, &f->pipe);
+#endif
                    return [f] { return RunReconstructFrames(*f); };
                  });
 
