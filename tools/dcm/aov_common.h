@@ -121,4 +121,24 @@ inline void RemoveAll(const std::vector<std::string>& paths) {
   }
 }
 
+/// A command's outputs, written one after another (each atomically): when
+/// one fails, those written before are removed too, and the error printed.
+class Outputs {
+ public:
+  explicit Outputs(std::string cmd) : cmd_(std::move(cmd)) {}
+  /// `status` of writing `path`: kExitOk, or the failure's exit code.
+  int Write(const std::string& path, Status status) {
+    if (!status.ok()) {
+      RemoveAll(written_);
+      return Fail(cmd_, status.message());
+    }
+    written_.push_back(path);
+    return kExitOk;
+  }
+
+ private:
+  std::string cmd_;
+  std::vector<std::string> written_;
+};
+
 }  // namespace dcm::cli::aov_common

@@ -107,15 +107,8 @@ int RunPlan(const PlanFlags& f) {
   const int w = provider->width(), h = provider->height();
   const auto channels = provider->SampleChannels();
 
-  std::vector<std::string> written;
-  auto check = [&](const std::string& path, Status s) -> int {
-    if (!s.ok()) {
-      aov_common::RemoveAll(written);
-      return aov_common::Fail(cmd, s.message());
-    }
-    written.push_back(path);
-    return kExitOk;
-  };
+  aov_common::Outputs outputs(cmd);
+  auto check = [&outputs](const std::string& path, Status s) { return outputs.Write(path, std::move(s)); };
   int rc = kExitOk;
   if (!f.mask.empty() && (rc = check(f.mask, WriteMask(f.mask, w, h, next, channels)))) return rc;
   if (!f.list.empty() && (rc = check(f.list, WriteList(f.list, w, h, next, channels)))) return rc;

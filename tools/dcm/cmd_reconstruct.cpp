@@ -153,15 +153,8 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
   meta.strings.push_back({"dcm:inputs", inputs});
   AddPartMetadata(tile, region, settings, r, info, &meta);
 
-  std::vector<std::string> written;
-  auto write = [&](const std::string& path, Status s) -> int {
-    if (!s.ok()) {
-      aov_common::RemoveAll(written);
-      return aov_common::Fail(cmd, s.message());
-    }
-    written.push_back(path);
-    return kExitOk;
-  };
+  aov_common::Outputs outputs(cmd);
+  auto write = [&outputs](const std::string& path, Status s) { return outputs.Write(path, std::move(s)); };
   int rc = write(f.output, toolkit::WritePartExr(f.output, frame.x, frame.y, region, r.image, meta, f.alpha));
   if (rc) return rc;
   if (!f.sampleMap.empty() && (rc = write(f.sampleMap, toolkit::WriteSampleMap(f.sampleMap, r)))) return rc;
@@ -292,15 +285,8 @@ int RunReconstruct(const ReconstructFlags& f) {
   if (haveRef && std::isfinite(error.psnr)) meta.floats.push_back({"dcm:psnr", float(error.psnr)});
 
   // Every output is atomic; if a later one fails, the earlier ones go too.
-  std::vector<std::string> written;
-  auto write = [&](const std::string& path, Status s) -> int {
-    if (!s.ok()) {
-      aov_common::RemoveAll(written);
-      return aov_common::Fail(cmd, s.message());
-    }
-    written.push_back(path);
-    return kExitOk;
-  };
+  aov_common::Outputs outputs(cmd);
+  auto write = [&outputs](const std::string& path, Status s) { return outputs.Write(path, std::move(s)); };
   int rc = write(f.output, toolkit::WriteRgbExr(f.output, r.width, r.height, r.image, meta, f.alpha));
   if (rc) return rc;
   if (!f.sampleMap.empty() && (rc = write(f.sampleMap, toolkit::WriteSampleMap(f.sampleMap, r)))) return rc;

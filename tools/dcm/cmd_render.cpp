@@ -94,6 +94,18 @@ int Fail(const Status& st) {
   return kExitFailure;
 }
 
+/// The provenance every render output carries in its EXR metadata.
+toolkit::Metadata RenderMetadata(const std::string& scene, const std::string& method,
+                                 const ReconstructionOptions& options, const std::vector<std::string>& effects) {
+  toolkit::Metadata meta;
+  meta.strings.push_back({"dcm:scene", scene});
+  meta.strings.push_back({"dcm:method", method});
+  meta.strings.push_back({"dcm:options", toolkit::OptionsToJson(options).dump()});
+  meta.strings.push_back({"dcm:effects", Join(effects)});
+  meta.strings.push_back({"dcm:provider", "embree"});
+  return meta;
+}
+
 /// --tile / --region: the region of the frame, written as a part for `dcm merge`.
 int RunRenderPart(const RenderFlags& f, const embree::Scene& scene, ReconstructionOptions options,
                   embree::EmbreeProvider& provider, toolkit::Progress& progress) {
@@ -131,12 +143,7 @@ int RunRenderPart(const RenderFlags& f, const embree::Scene& scene, Reconstructi
 
   const std::string method = options.fullEvaluation ? "full" : f.engine.method;
   const auto effects = provider.effects().Names();
-  toolkit::Metadata meta;
-  meta.strings.push_back({"dcm:scene", f.scene});
-  meta.strings.push_back({"dcm:method", method});
-  meta.strings.push_back({"dcm:options", toolkit::OptionsToJson(options).dump()});
-  meta.strings.push_back({"dcm:effects", Join(effects)});
-  meta.strings.push_back({"dcm:provider", "embree"});
+  toolkit::Metadata meta = RenderMetadata(f.scene, method, options, effects);
   AddPartMetadata(tile, region, settings, rec, info, &meta);
   if (Status st = toolkit::WritePartExr(f.output, frame.x, frame.y, region, rec.image, meta); !st.ok())
     return Fail(st);
@@ -250,12 +257,7 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
 
   const std::string method = options.fullEvaluation ? "full" : f.engine.method;
   const auto effects = provider->effects().Names();
-  toolkit::Metadata meta;
-  meta.strings.push_back({"dcm:scene", f.scene});
-  meta.strings.push_back({"dcm:method", method});
-  meta.strings.push_back({"dcm:options", toolkit::OptionsToJson(options).dump()});
-  meta.strings.push_back({"dcm:effects", Join(effects)});
-  meta.strings.push_back({"dcm:provider", "embree"});
+  toolkit::Metadata meta = RenderMetadata(f.scene, method, options, effects);
   meta.floats.push_back({"dcm:exact_fraction", float(stats.exactFraction())});
   meta.floats.push_back({"dcm:time_illum_s", float(stats.timeProviderS)});
   meta.floats.push_back({"dcm:time_dcm_s", float(stats.timeEngineS)});
