@@ -458,5 +458,51 @@ TEST(DcmReconstruct, ProgressiveWritesOneImagePerLevel) {
   EXPECT_EQ(ReadRgbExr(dir / "levels/level_2.exr"), ReadRgbExr(dir / "out.exr"));
 }
 
+TEST(DcmReconstruct, TextureMapJson) {
+  // --texture MAP.json binds shaders to texture files like repeated
+  // --texture SHADER=FILE (relative files from the JSON's folder): the same
+  // image. Bad maps name the file and the key.
+  ScratchDir dir;
+  std::vector<TestChannel> tex;
+  for (int c = 0; c < 3; ++c)
+    tex.push_back(Fill(std::string(1, "RGB"[c]), 4, 4, [c](int x, int y) { return 0.1f * float(x + y) + 0.3f * float(c); }));
+  fs::create_directories(dir.path() / "maps");
+  WriteExr(dir / "maps/wood.exr", 4, 4, tex);
+  const int w = 32, h = 16;
+  std::vector<TestChannel> ch;
+  ch.push_back(Fill("id", w, h, [](int x, int) { return x < 16 ? 1.f : 2.f; }));
+  ch.push_back(Fill("shader", w, h, [](int x, int) { return x < 16 ? 5.f : 6.f; }));
+  ch.push_back(Fill("u", w, h, [](int x, int) { return float(x % 16) / 16.f; }));
+  ch.push_back(Fill("v", w, h, [](int, int y) { return float(y) / 16.f; }));
+  for (const char* c : {"Li.R", "Li.G", "Li.B"}) ch.push_back(Fill(c, w, h, [](int x, int y) { return 0.01f * float(x + y); }));
+  for (const char* c : {"Lc.R", "Lc.G", "Lc.B"}) ch.push_back(Fill(c, w, h, [](int, int) { return 0.05f; }));
+  WriteExr(dir / "uv.exr", w, h, ch);
+  {
+    std::ofstream(dir / "maps/textures.json") << R"({"5": "wood.exr"})";
+  }
+  auto a = RunDcm({"reconstruct", dir / "uv.exr", "--texture", "5=" + (dir / "maps/wood.exr"), "-o", dir / "a.exr",
+                   "--quiet"},
+                  dir);
+  ASSERT_EQ(a.exitCode, 0) << a.err;
+  auto b = RunDcm({"reconstruct", dir / "uv.exr", "--texture", dir / "maps/textures.json", "-o", dir / "b.exr", "--quiet"},
+                  dir);
+  ASSERT_EQ(b.exitCode, 0) << b.err;
+  EXPECT_EQ(ReadRgbExr(dir / "a.exr"), ReadRgbExr(dir / "b.exr"));
+
+  const std::pair<std::string, std::string> bad[] = {
+      {R"(["wood.exr"])", "expected an object of SHADER: FILE pairs"},
+      {R"({"5": 7})", "\"5\": expected a texture file name"},
+      {R"({"5": )", "not JSON"},
+  };
+  for (const auto& [text, message] : bad) {
+    std::ofstream(dir / "maps/bad.json") << text;
+    auto r = RunDcm({"reconstruct", dir / "uv.exr", "--texture", dir / "maps/bad.json", "-o", dir / "c.exr", "--quiet"},
+                    dir);
+    EXPECT_EQ(r.exitCode, 2) << r.err;
+    EXPECT_THAT(r.err, HasSubstr("--texture '" + (dir / "maps/bad.json") + "': " + message));
+    EXPECT_FALSE(fs::exists(dir / "c.exr"));
+  }
+}
+
 }  // namespace
 }  // namespace dcm::aov::test

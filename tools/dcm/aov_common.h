@@ -7,7 +7,9 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <memory>
 #include <string>
 #include <vector>
@@ -47,7 +49,8 @@ inline void AddAovFlags(CLI::App* app, AovFlags* f, bool samplesHelpForPlan) {
       ->allow_extra_args(false);
   app->add_option("--texture", f->textures,
                   "SHADER=FILE: evaluate tau(u,v) of that shader ID (or Cryptomatte material name) "
-                  "from a texture file")
+                  "from a texture file; or MAP.json, an object {\"SHADER\": \"FILE\", ...} (relative files "
+                  "from the JSON's folder)")
       ->allow_extra_args(false);
   app->add_option("--layer", f->layer, "Blender view layer (default: the only one in the file)");
   app->add_option("--samples", f->samples,
@@ -64,11 +67,40 @@ inline void AddAovFlags(CLI::App* app, AovFlags* f, bool samplesHelpForPlan) {
                 "noisy renders without a variance channel: estimate the noise from the data (docs/NOISE.md)");
 }
 
+/// The bindings of a --texture MAP.json: {"SHADER": "FILE", ...}; relative
+/// texture files are taken from the JSON file's folder.
+inline Status ReadTextureMap(const std::string& path, std::vector<aov::TextureBinding>* out) {
+  const std::string what = "--texture '" + path + "'";
+  std::ifstream in(path);
+  if (!in) return Status::Error(what + ": cannot open the texture map");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    return Status::Error(what + ": not JSON (" + e.what() + ")");
+  }
+  if (!j.is_object() || j.empty())
+    return Status::Error(what + ": expected an object of SHADER: FILE pairs, e.g. {\"7\": \"wood.tx\"}");
+  const std::filesystem::path dir = std::filesystem::path(path).parent_path();
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    if (!it.value().is_string() || it.value().get<std::string>().empty())
+      return Status::Error(what + ": \"" + it.key() + "\": expected a texture file name (a string)");
+    std::filesystem::path file = it.value().get<std::string>();
+    if (file.is_relative()) file = dir / file;
+    out->push_back({it.key(), file.string()});
+  }
+  return Status::Ok();
+}
+
 /// The provider options the flags select; the message names the flag at fault.
 inline Status ToAovOptions(const AovFlags& f, bool sparse, bool split, aov::AovOptions* o) {
   DCM_RETURN_IF_ERROR(aov::ParsePreset(f.preset, &o->preset));
   for (const auto& m : f.maps) DCM_RETURN_IF_ERROR(aov::ParseMapping(m, &o->mappings));
   for (const auto& t : f.textures) {
+    if (t.find('=') == std::string::npos && t.size() > 5 && t.compare(t.size() - 5, 5, ".json") == 0) {
+      DCM_RETURN_IF_ERROR(ReadTextureMap(t, &o->textures));
+      continue;
+    }
     aov::TextureBinding b;
     DCM_RETURN_IF_ERROR(aov::ParseTextureBinding(t, &b));
     o->textures.push_back(b);
