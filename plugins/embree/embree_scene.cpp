@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <utility>
 #include <string>
 
 #include "embree/mesh_loader.h"
@@ -72,11 +74,62 @@ bool InsideConvex(const TriangleMesh& mesh, Vec3 p) {
   return true;
 }
 
+/// True when every edge of `mesh` is shared by exactly two triangles (a
+/// closed surface; positions compared by index, as the loader merges them).
+bool Watertight(const TriangleMesh& mesh) {
+  std::map<std::pair<uint32_t, uint32_t>, int> edges;
+  for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3)
+    for (int k = 0; k < 3; ++k) {
+      uint32_t a = mesh.indices[t + size_t(k)], b = mesh.indices[t + size_t((k + 1) % 3)];
+      if (a > b) std::swap(a, b);
+      ++edges[{a, b}];
+    }
+  if (edges.empty()) return false;
+  for (const auto& [e, n] : edges)
+    if (n != 2) return false;
+  return true;
+}
+
+/// Number of triangles of `mesh` the ray p + t d (t > 0) crosses
+/// (Moeller-Trumbore, in double).
+int Crossings(const TriangleMesh& mesh, Vec3 p, const double d[3]) {
+  int n = 0;
+  for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+    const Vec3 a = mesh.positions[mesh.indices[t]], b = mesh.positions[mesh.indices[t + 1]],
+               c = mesh.positions[mesh.indices[t + 2]];
+    const double e1[3] = {double(b.x) - a.x, double(b.y) - a.y, double(b.z) - a.z};
+    const double e2[3] = {double(c.x) - a.x, double(c.y) - a.y, double(c.z) - a.z};
+    const double q[3] = {d[1] * e2[2] - d[2] * e2[1], d[2] * e2[0] - d[0] * e2[2], d[0] * e2[1] - d[1] * e2[0]};
+    const double det = e1[0] * q[0] + e1[1] * q[1] + e1[2] * q[2];
+    if (std::fabs(det) < 1e-18) continue;
+    const double s[3] = {double(p.x) - a.x, double(p.y) - a.y, double(p.z) - a.z};
+    const double u = (s[0] * q[0] + s[1] * q[1] + s[2] * q[2]) / det;
+    if (u < 0 || u > 1) continue;
+    const double r[3] = {s[1] * e1[2] - s[2] * e1[1], s[2] * e1[0] - s[0] * e1[2], s[0] * e1[1] - s[1] * e1[0]};
+    const double v = (d[0] * r[0] + d[1] * r[1] + d[2] * r[2]) / det;
+    if (v < 0 || u + v > 1) continue;
+    if ((e2[0] * r[0] + e2[1] * r[1] + e2[2] * r[2]) / det > 0) ++n;
+  }
+  return n;
+}
+
+/// True when p lies inside the closed (watertight) mesh: an odd number of
+/// crossings along at least two of three skew directions (one ray may graze
+/// an edge and count it twice or not at all).
+bool InsideClosedMesh(const TriangleMesh& mesh, Vec3 p) {
+  if (!Watertight(mesh)) return false;
+  const double dirs[3][3] = {{0.5773, 0.5774, 0.5775}, {-0.6123, 0.3536, 0.7071}, {0.2673, -0.8018, 0.5345}};
+  int odd = 0;
+  for (const auto& d : dirs) odd += Crossings(mesh, p, d) % 2;
+  return odd >= 2;
+}
+
 const char* ShapeName(ShapeKind k) {
   switch (k) {
     case ShapeKind::kBox: return "box";
     case ShapeKind::kSphere: return "sphere";
     case ShapeKind::kCylinder: return "cylinder";
+    case ShapeKind::kMesh: return "closed mesh";
     default: return "object";
   }
 }
@@ -104,7 +157,8 @@ Status EmbreeScene::Build(const Scene& scene, std::unique_ptr<EmbreeScene>* out)
     // mistake in the scene (the solid hides everything else).
     const bool closedConvex = o.shape == ShapeKind::kBox || o.shape == ShapeKind::kSphere ||
                               (o.shape == ShapeKind::kCylinder && o.caps);
-    if (closedConvex && InsideConvex(mesh, scene.camera.position)) {
+    if ((closedConvex && InsideConvex(mesh, scene.camera.position)) ||
+        (o.shape == ShapeKind::kMesh && InsideClosedMesh(mesh, scene.camera.position))) {
       const Vec3 c = scene.camera.position;
       return Status::Error(prefix + "camera.position (" + std::to_string(c.x) + ", " + std::to_string(c.y) + ", " +
                            std::to_string(c.z) + ") is inside " + o.path + " (a " + ShapeName(o.shape) +

@@ -263,8 +263,9 @@ TEST(RenderBadInput, ZeroLights) {
 }
 
 TEST(RenderBadInput, CameraInsideAClosedObject) {
-  // Inside a box, a sphere, a rotated and scaled box: rejected, naming the
-  // object. Inside a room built of quads (open surfaces) is normal.
+  // Inside a box, a sphere, a rotated and scaled box, a closed mesh:
+  // rejected, naming the object. Inside a room built of quads or an open
+  // mesh (open surfaces) is normal.
   const std::string camera = R"({"position": [0.2, 0.5, 0.1], "look_at": [0, 0.5, -3], "resolution": [16, 16]})";
   const std::string light = R"([{"type": "point", "position": [0, 3, 2], "intensity": 10}])";
   const std::pair<std::string, std::string> cases[] = {
@@ -281,6 +282,21 @@ TEST(RenderBadInput, CameraInsideAClosedObject) {
     dir.Write("scene.json", Scene(objects, light, camera));
     ExpectRejected(dir, "scene.json: camera.position (0.200000, 0.500000, 0.100000) is inside " + what +
                             ": every camera ray would start inside it");
+  }
+  // A closed OBJ cube around the camera; the same cube with one face
+  // missing (open: being inside is fine).
+  const std::string cube =
+      "v -1 0 -1\nv 1 0 -1\nv 1 2 -1\nv -1 2 -1\nv -1 0 1\nv 1 0 1\nv 1 2 1\nv -1 2 1\n"
+      "f 1 2 3\nf 1 3 4\nf 5 7 6\nf 5 8 7\nf 1 5 6\nf 1 6 2\nf 4 3 7\nf 4 7 8\nf 1 4 8\nf 1 8 5\n";
+  {
+    TempDir dir;
+    dir.Write("cube.obj", cube + "f 2 6 7\nf 2 7 3\n");
+    dir.Write("scene.json", Scene(R"([{"type": "mesh", "material": "m", "file": "cube.obj"}])", light, camera));
+    ExpectRejected(dir, "is inside objects[0] (a closed mesh)");
+    dir.Write("open.obj", cube);
+    dir.Write("scene.json", Scene(R"([{"type": "mesh", "material": "m", "file": "open.obj"}])", light, camera));
+    const Result open = RunDcm(dir.path(), {"render", "scene.json", "-o", "open.exr", "--quiet"});
+    EXPECT_TRUE(open.exited && open.code == 0) << open.Describe();
   }
   TempDir room;
   room.Write("scene.json", Scene(R"([{"type": "quad", "material": "m", "origin": [-3, 0, 3], "edge_u": [6, 0, 0], "edge_v": [0, 0, -6]},
