@@ -45,6 +45,8 @@ struct DCMReconstructorImpl {
   int sampleFlags = 0;
   DCMProgressFunction progress = nullptr;
   void* progressUser = nullptr;
+  DCMLevelFunction level = nullptr;
+  void* levelUser = nullptr;
 
   bool hasResult = false;
   dcm::Reconstruction result;
@@ -527,6 +529,12 @@ DCM_API void dcmSetNoisySampleFunction(DCMReconstructor r, DCMNoisySampleFunctio
   r->sampleFlags = flags;
 }
 
+DCM_API void dcmSetLevelFunction(DCMReconstructor r, DCMLevelFunction fn, void* user) {
+  if (!r) return SetError(nullptr, DCM_ERROR_INVALID_ARGUMENT, "dcmSetLevelFunction: NULL reconstructor");
+  r->level = fn;
+  r->levelUser = user;
+}
+
 DCM_API void dcmSetProgressFunction(DCMReconstructor r, DCMProgressFunction fn, void* user) {
   if (!r) return SetError(nullptr, DCM_ERROR_INVALID_ARGUMENT, "dcmSetProgressFunction: NULL reconstructor");
   r->progress = fn;
@@ -569,6 +577,13 @@ DCM_API DCMError dcmExecute(DCMReconstructor r) {
       options.progress = [r](float v, std::string_view stage) {
         const std::string s(stage);
         r->progress(r->progressUser, v, s.c_str());
+      };
+    }
+    if (r->level) {
+      // RGB is three packed floats: the working image is passed as it is.
+      static_assert(sizeof(dcm::RGB) == 3 * sizeof(float));
+      options.onLevel = [r](int level, int w, int h, const std::vector<dcm::RGB>& image) {
+        r->level(r->levelUser, level, w, h, reinterpret_cast<const float*>(image.data()));
       };
     }
     dcm::Status st = dcm::Reconstruct(provider, options, &r->result);

@@ -438,3 +438,40 @@ TEST(CApi, NormalGuidesMarkCreases) {
   // Measured: float rounding against ~0.02; a factor 3 is asked.
   EXPECT_LT(3 * with, without) << "with normals " << with << ", without " << without;
 }
+
+namespace {
+
+struct Levels {
+  std::vector<int> seen;
+  std::vector<float> last;
+  int width = 0, height = 0;
+};
+
+void OnLevel(void* user, int level, int w, int h, const float* rgb) {
+  auto* l = static_cast<Levels*>(user);
+  l->seen.push_back(level);
+  l->width = w, l->height = h;
+  l->last.assign(rgb, rgb + 3 * w * h);
+}
+
+}  // namespace
+
+TEST(CApi, LevelFunctionGivesProgressiveImages) {
+  // A picture after refinement levels, coarsest first (a level the image no
+  // longer needs is skipped); the last one is the final working image (here
+  // the output: no downsampling).
+  Scene scene;
+  DCMReconstructor r = Make(scene);
+  Levels levels;
+  dcmSetLevelFunction(r, OnLevel, &levels);
+  ASSERT_EQ(dcmExecute(r), DCM_ERROR_NONE) << TakeError(r);
+  ASSERT_GE(levels.seen.size(), 2u);
+  EXPECT_EQ(levels.seen.front(), 0);
+  for (size_t i = 1; i < levels.seen.size(); ++i) EXPECT_GT(levels.seen[i], levels.seen[i - 1]);
+  int w = 0, h = 0;
+  const float* rgb = dcmGetImage(r, &w, &h);
+  ASSERT_EQ(levels.width, w);
+  ASSERT_EQ(levels.height, h);
+  EXPECT_EQ(levels.last, std::vector<float>(rgb, rgb + 3 * w * h));
+  dcmReleaseReconstructor(r);
+}

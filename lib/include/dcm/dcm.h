@@ -103,6 +103,13 @@ typedef int (*DCMNoisySampleFunction)(void* user, const int* xy, int count, floa
  *  the thread that runs dcmExecute(). */
 typedef void (*DCMProgressFunction)(void* user, float fraction, const char* stage);
 
+/** Progressive output (the paper's progressive refinement): after refinement
+ *  level `level` (0 = coarsest), a usable picture of the working image,
+ *  width*height*3 floats of linear RGB, valid during the call only. Called
+ *  from the thread that runs dcmExecute(); the last call is the final working
+ *  image. Since API version 2. */
+typedef void (*DCMLevelFunction)(void* user, int level, int width, int height, const float* rgb);
+
 /** The version of the library, e.g. "0.1.0". */
 DCM_API const char* dcmGetVersionString(void);
 
@@ -200,6 +207,11 @@ DCM_API void dcmSetNoisySampleFunction(DCMReconstructor r, DCMNoisySampleFunctio
 
 /** Sets (or with NULL removes) a progress function. */
 DCM_API void dcmSetProgressFunction(DCMReconstructor r, DCMProgressFunction fn, void* user);
+
+/** Sets (or with NULL removes) a function that receives a usable image after
+ *  each refinement level (progressive output; costs one pass over the image
+ *  per level). Since API version 2. */
+DCM_API void dcmSetLevelFunction(DCMReconstructor r, DCMLevelFunction fn, void* user);
 
 /** Runs the reconstruction: calls the sample function for the pixels it needs
  *  and keeps the result on `r`. Returns DCM_ERROR_NONE on success, otherwise
