@@ -313,6 +313,32 @@ bool CanSetGuide(DCMReconstructor r, const char* function) noexcept {
   }
 }
 
+/// Copies a guide of three floats per pixel (width*height*3, row-major) into
+/// `out` (RGB for tau, Vec3f for normals); NULL clears it.
+template <typename Triple>
+void CopyTriples(const DCMReconstructor r, const float* v, std::vector<Triple>* out) {
+  if (!v) return out->clear();
+  const size_t n = size_t(r->width) * size_t(r->height);
+  out->resize(n);
+  for (size_t i = 0; i < n; ++i) (*out)[i] = {v[3 * i], v[3 * i + 1], v[3 * i + 2]};
+}
+
+/// The one sample function of `r`: plain or noisy (the other is cleared).
+void SetSampleFunctions(DCMReconstructor r, const char* function, DCMSampleFunction plain,
+                        DCMNoisySampleFunction noisy, void* user, int flags) noexcept {
+  try {
+    if (!r) return SetError(nullptr, DCM_ERROR_INVALID_ARGUMENT, std::string(function) + ": NULL reconstructor");
+    if (flags & ~(DCM_SAMPLE_THREAD_SAFE | DCM_SAMPLE_SPLIT))
+      return SetError(r, DCM_ERROR_INVALID_ARGUMENT, std::string(function) + ": unknown flags");
+  } catch (...) {  // the message could not be built
+    return SetError(r, DCM_ERROR_OUT_OF_MEMORY, "out of memory");
+  }
+  r->sample = plain;
+  r->noisySample = noisy;
+  r->sampleUser = user;
+  r->sampleFlags = flags;
+}
+
 }  // namespace
 
 extern "C" {
@@ -491,42 +517,20 @@ DCM_API void dcmSetShaderIds(DCMReconstructor r, const uint32_t* ids) {
 
 DCM_API void dcmSetTexture(DCMReconstructor r, const float* rgb) {
   if (!CanSetGuide(r, "dcmSetTexture")) return;
-  Guard(r, [&] {
-    if (!rgb) return r->texture.clear();
-    const size_t n = size_t(r->width) * size_t(r->height);
-    r->texture.resize(n);
-    for (size_t i = 0; i < n; ++i) r->texture[i] = {rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]};
-  });
+  Guard(r, [&] { CopyTriples(r, rgb, &r->texture); });
 }
 
 DCM_API void dcmSetNormals(DCMReconstructor r, const float* xyz) {
   if (!CanSetGuide(r, "dcmSetNormals")) return;
-  Guard(r, [&] {
-    if (!xyz) return r->normals.clear();
-    const size_t n = size_t(r->width) * size_t(r->height);
-    r->normals.resize(n);
-    for (size_t i = 0; i < n; ++i) r->normals[i] = {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
-  });
+  Guard(r, [&] { CopyTriples(r, xyz, &r->normals); });
 }
 
 DCM_API void dcmSetSampleFunction(DCMReconstructor r, DCMSampleFunction fn, void* user, int flags) {
-  if (!r) return SetError(nullptr, DCM_ERROR_INVALID_ARGUMENT, "dcmSetSampleFunction: NULL reconstructor");
-  if (flags & ~(DCM_SAMPLE_THREAD_SAFE | DCM_SAMPLE_SPLIT))
-    return SetError(r, DCM_ERROR_INVALID_ARGUMENT, "dcmSetSampleFunction: unknown flags");
-  r->sample = fn;
-  r->noisySample = nullptr;
-  r->sampleUser = user;
-  r->sampleFlags = flags;
+  SetSampleFunctions(r, "dcmSetSampleFunction", fn, nullptr, user, flags);
 }
 
 DCM_API void dcmSetNoisySampleFunction(DCMReconstructor r, DCMNoisySampleFunction fn, void* user, int flags) {
-  if (!r) return SetError(nullptr, DCM_ERROR_INVALID_ARGUMENT, "dcmSetNoisySampleFunction: NULL reconstructor");
-  if (flags & ~(DCM_SAMPLE_THREAD_SAFE | DCM_SAMPLE_SPLIT))
-    return SetError(r, DCM_ERROR_INVALID_ARGUMENT, "dcmSetNoisySampleFunction: unknown flags");
-  r->noisySample = fn;
-  r->sample = nullptr;
-  r->sampleUser = user;
-  r->sampleFlags = flags;
+  SetSampleFunctions(r, "dcmSetNoisySampleFunction", nullptr, fn, user, flags);
 }
 
 DCM_API void dcmSetLevelFunction(DCMReconstructor r, DCMLevelFunction fn, void* user) {

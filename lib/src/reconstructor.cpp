@@ -624,12 +624,12 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
     });
     DCM_RETURN_IF_ERROR(Flush());
 
-    if (noisy_ && opt_.denoiseSamples) {
+    if (DenoisesSamples(opt_, caps_)) {
       Progress(0.93f, "denoising samples");
       // Averaging what the noise explains: the gate is wider than the
       // detection's significance (which errs towards refining), 2 sd at least.
       stats_.denoisedSamples =
-          DenoiseExactSamples(store_, opt_.elementaryBlock, contrast_, std::max(opt_.noiseSignificance, 2.f));
+          DenoiseExactSamples(store_, DenoiseRadius(opt_), contrast_, std::max(opt_.noiseSignificance, 2.f));
     }
     Progress(0.95f, "interpolation");
     ForEach(smoothLeaves_, [&](Leaf& l, size_t) { WriteSmooth(l); });

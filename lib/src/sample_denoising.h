@@ -9,9 +9,21 @@
 #include <cstdint>
 
 #include "contrast_test.h"
+#include "dcm/options.h"
+#include "dcm/sample_provider.h"
 #include "sample_store.h"
 
 namespace dcm::detail {
+
+/// Whether a reconstruction with `options` of a provider with `caps`
+/// denoises its exact samples: noisy samples (variance reported, the noise
+/// weighed) with denoiseSamples on, and not the full-evaluation baseline.
+inline bool DenoisesSamples(const ReconstructionOptions& options, const ProviderCapabilities& caps) {
+  return caps.variance && options.noiseSignificance > 0.f && options.denoiseSamples && !options.fullEvaluation;
+}
+
+/// How far (pixels) the denoising fits reach: one elementary block.
+inline int DenoiseRadius(const ReconstructionOptions& options) { return options.elementaryBlock; }
 
 /// Replaces every exact, finite sample with a variance by the value at its
 /// pixel of a weighted least-squares plane fitted to the exact samples within

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "dcm/downsample.h"
+#include "sample_denoising.h"
 
 namespace dcm {
 
@@ -87,12 +88,13 @@ Status WindowProvider::Evaluate(std::span<const Point2i> pixels, const SampleReq
 }
 
 int RegionHaloBlocks(const ReconstructionOptions& options, const ProviderCapabilities& caps) {
-  // Mirrors the engine's switch for sample denoising (reconstructor.cpp):
-  // noisy samples (variance reported, significance > 0) that are denoised
-  // over a radius of one elementary block.
-  const bool denoised = caps.variance && options.noiseSignificance > 0.f && options.denoiseSamples &&
-                        !options.fullEvaluation;
-  return denoised ? 2 : 1;
+  // One block: a block side is also set by the neighbouring block. Denoised
+  // samples reach further: a sample on a side depends on the exact samples
+  // within the denoising radius, whose state depends on the blocks they lie
+  // in: as many more blocks as the radius spans.
+  if (!detail::DenoisesSamples(options, caps)) return 1;
+  const int block = std::max(1, options.elementaryBlock);
+  return 1 + (detail::DenoiseRadius(options) + block - 1) / block;
 }
 
 Point2i OutputSize(int workWidth, int workHeight, int downsample) {

@@ -56,6 +56,39 @@ std::string PsnrText(double psnr) {
   return s.str();
 }
 
+/// The statistics of a whole reconstruction and of a part alike.
+nlohmann::json StatsJson(const std::string& cmd, const ReconstructFlags& f, const aov::AovProvider& provider,
+                         const Reconstruction& r, const ReconstructionOptions& options, double wallS) {
+  nlohmann::json stats = toolkit::StatsToJson(r.stats);
+  stats["command"] = cmd;
+  stats["inputs"] = f.aov.inputs;
+  if (!f.aov.samples.empty()) stats["samples"] = f.aov.samples;
+  stats["mode"] = provider.dense() ? "dense" : "sparse";
+  stats["method"] = f.engine.method;
+  stats["width"] = r.width;
+  stats["height"] = r.height;
+  stats["work_width"] = r.workWidth;
+  stats["work_height"] = r.workHeight;
+  stats["time_reconstruct_s"] = wallS;
+  stats["options"] = toolkit::OptionsToJson(options);
+  stats["warnings"] = provider.Warnings();
+  return stats;
+}
+
+/// The provenance every output EXR carries in its metadata.
+toolkit::Metadata ProvenanceMetadata(const ReconstructFlags& f, const aov::AovProvider& provider,
+                                     const ReconstructionOptions& options) {
+  toolkit::Metadata meta;
+  meta.strings.push_back({"Software", std::string("dcm ") + DCM_VERSION});
+  meta.strings.push_back({"dcm:method", f.engine.method});
+  meta.strings.push_back({"dcm:mode", provider.dense() ? "dense" : "sparse"});
+  meta.strings.push_back({"dcm:settings", toolkit::OptionsToJson(options).dump()});
+  std::string inputs;
+  for (const auto& in : f.aov.inputs) inputs += (inputs.empty() ? "" : " ") + in;
+  meta.strings.push_back({"dcm:inputs", inputs});
+  return meta;
+}
+
 /// --tile / --region: the region of the frame, written as a part for `dcm merge`.
 int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options, aov::AovProvider& provider) {
   const std::string cmd = "reconstruct";
@@ -127,30 +160,11 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
     }
   }
 
-  nlohmann::json stats = toolkit::StatsToJson(r.stats);
-  stats["command"] = cmd;
-  stats["inputs"] = f.aov.inputs;
-  if (!f.aov.samples.empty()) stats["samples"] = f.aov.samples;
-  stats["mode"] = provider.dense() ? "dense" : "sparse";
-  stats["method"] = f.engine.method;
-  stats["width"] = r.width;
-  stats["height"] = r.height;
-  stats["work_width"] = r.workWidth;
-  stats["work_height"] = r.workHeight;
-  stats["time_reconstruct_s"] = wall;
-  stats["options"] = toolkit::OptionsToJson(options);
-  stats["warnings"] = provider.Warnings();
+  nlohmann::json stats = StatsJson(cmd, f, provider, r, options, wall);
   stats["part"] = PartJson(tile, info);
   if (haveRef) stats["reference"] = ErrorJson(error);
 
-  toolkit::Metadata meta;
-  meta.strings.push_back({"Software", std::string("dcm ") + DCM_VERSION});
-  meta.strings.push_back({"dcm:method", f.engine.method});
-  meta.strings.push_back({"dcm:mode", provider.dense() ? "dense" : "sparse"});
-  meta.strings.push_back({"dcm:settings", toolkit::OptionsToJson(options).dump()});
-  std::string inputs;
-  for (const auto& in : f.aov.inputs) inputs += (inputs.empty() ? "" : " ") + in;
-  meta.strings.push_back({"dcm:inputs", inputs});
+  toolkit::Metadata meta = ProvenanceMetadata(f, provider, options);
   AddPartMetadata(tile, region, settings, r, info, &meta);
 
   aov_common::Outputs outputs(cmd);
@@ -254,33 +268,14 @@ int RunReconstruct(const ReconstructFlags& f) {
   toolkit::ImageError error;
   if (haveRef) error = toolkit::Compare(r.image, reference, r.width, r.height);
 
-  nlohmann::json stats = toolkit::StatsToJson(r.stats);
-  stats["command"] = cmd;
-  stats["inputs"] = f.aov.inputs;
-  if (sparse) stats["samples"] = f.aov.samples;
-  stats["mode"] = provider->dense() ? "dense" : "sparse";
-  stats["method"] = f.engine.method;
-  stats["width"] = r.width;
-  stats["height"] = r.height;
-  stats["work_width"] = r.workWidth;
-  stats["work_height"] = r.workHeight;
-  stats["time_reconstruct_s"] = wall;
-  stats["options"] = toolkit::OptionsToJson(options);
+  nlohmann::json stats = StatsJson(cmd, f, *provider, r, options, wall);
   const auto caps = provider->Capabilities();
   stats["capabilities"] = {{"object_id", caps.objectId}, {"shader_id", caps.shaderId},
                            {"texture", caps.texture},    {"split_radiance", caps.splitRadiance},
                            {"variance", caps.variance}};
-  stats["warnings"] = provider->Warnings();
   if (haveRef) stats["reference"] = ErrorJson(error);
 
-  toolkit::Metadata meta;
-  meta.strings.push_back({"Software", std::string("dcm ") + DCM_VERSION});
-  meta.strings.push_back({"dcm:method", f.engine.method});
-  meta.strings.push_back({"dcm:mode", provider->dense() ? "dense" : "sparse"});
-  meta.strings.push_back({"dcm:settings", toolkit::OptionsToJson(options).dump()});
-  std::string inputs;
-  for (const auto& in : f.aov.inputs) inputs += (inputs.empty() ? "" : " ") + in;
-  meta.strings.push_back({"dcm:inputs", inputs});
+  toolkit::Metadata meta = ProvenanceMetadata(f, *provider, options);
   meta.floats.push_back({"dcm:exact_fraction", float(r.stats.exactFraction())});
   if (haveRef && std::isfinite(error.psnr)) meta.floats.push_back({"dcm:psnr", float(error.psnr)});
 

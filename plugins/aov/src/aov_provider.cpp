@@ -572,14 +572,17 @@ Status ComputeSamples(const ChannelSet& set, Evaluator& ev, const RoleExprs& rol
   return Status::Ok();
 }
 
+/// Pixels i and j lie on the same surface for the noise estimates: equal
+/// object and shader IDs where the inputs carry them.
+bool SameSurface(const Data& d, size_t i, size_t j) {
+  return (d.objectId.empty() || d.objectId[i] == d.objectId[j]) &&
+         (d.shaderId.empty() || d.shaderId[i] == d.shaderId[j]);
+}
+
 /// Per pixel, the mean of `v` over the (2r+1)^2 window of pixels on the same
 /// surface (equal object and shader IDs where the inputs carry them).
 std::vector<RGB> SurfaceWindowMean(const std::vector<RGB>& v, const Data& d, int r) {
   const int W = d.width, H = d.height;
-  auto same = [&](size_t i, size_t j) {
-    return (d.objectId.empty() || d.objectId[i] == d.objectId[j]) &&
-           (d.shaderId.empty() || d.shaderId[i] == d.shaderId[j]);
-  };
   std::vector<RGB> out(v.size());
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x) {
@@ -589,7 +592,7 @@ std::vector<RGB> SurfaceWindowMean(const std::vector<RGB>& v, const Data& d, int
       for (int ny = std::max(0, y - r); ny <= std::min(H - 1, y + r); ++ny)
         for (int nx = std::max(0, x - r); nx <= std::min(W - 1, x + r); ++nx) {
           const size_t j = size_t(ny) * size_t(W) + size_t(nx);
-          if (!same(i, j) || !IsFinite(v[j])) continue;
+          if (!SameSurface(d, i, j) || !IsFinite(v[j])) continue;
           for (int c = 0; c < 3; ++c) sum[c] += v[j][c];
           ++count;
         }
@@ -603,10 +606,6 @@ std::vector<RGB> EstimateVarianceFromData(const Data& d) {
   const int W = d.width, H = d.height;
   const bool split = !d.Li.empty() && !d.tau.empty();
   const std::vector<RGB>& v = split ? d.Li : d.L;
-  auto same = [&](size_t i, size_t j) {
-    return (d.objectId.empty() || d.objectId[i] == d.objectId[j]) &&
-           (d.shaderId.empty() || d.shaderId[i] == d.shaderId[j]);
-  };
   constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
   std::vector<RGB> r2(v.size(), RGB::Gray(kNaN));
   for (int y = 0; y < H; ++y)
@@ -619,7 +618,7 @@ std::vector<RGB> EstimateVarianceFromData(const Data& d) {
         const int nx = x + dx, ny = y + dy;
         if (nx < 0 || ny < 0 || nx >= W || ny >= H) continue;
         const size_t j = size_t(ny) * size_t(W) + size_t(nx);
-        if (!same(i, j) || !IsFinite(v[j])) continue;
+        if (!SameSurface(d, i, j) || !IsFinite(v[j])) continue;
         mean += v[j];
         ++count;
       }
