@@ -96,9 +96,22 @@ Status WriteRgbExr(const std::string& path, int width, int height, std::span<con
 
 Status WriteRgbExr(const std::string& path, int width, int height, std::span<const RGB> pixels,
                    const Metadata& metadata, bool alpha) {
-  DCM_RETURN_IF_ERROR(CheckSize(path, width, height, pixels.size()));
+  const Bounds2i frame{{0, 0}, {width, height}};
+  return WriteRgbExr(path, frame, frame, pixels, metadata, alpha);
+}
+
+Status WriteRgbExr(const std::string& path, const Bounds2i& display, const Bounds2i& data,
+                   std::span<const RGB> pixels, const Metadata& metadata, bool alpha) {
+  DCM_RETURN_IF_ERROR(CheckSize(path, data.width(), data.height(), pixels.size()));
+  if (display.empty()) return Status::Error("cannot write '" + path + "': empty display window");
   const int nch = alpha ? 4 : 3;
-  ImageSpec spec(width, height, nch, TypeDesc::FLOAT);
+  ImageSpec spec(data.width(), data.height(), nch, TypeDesc::FLOAT);
+  spec.x = data.min.x;
+  spec.y = data.min.y;
+  spec.full_x = display.min.x;
+  spec.full_y = display.min.y;
+  spec.full_width = display.width();
+  spec.full_height = display.height();
   spec.channelnames = alpha ? std::vector<std::string>{"R", "G", "B", "A"}
                             : std::vector<std::string>{"R", "G", "B"};
   spec.alpha_channel = alpha ? 3 : -1;
@@ -151,9 +164,6 @@ Status ReadRgb(const std::string& path, int* width, int* height, std::vector<RGB
   const ImageSpec spec = in->spec();
   if (spec.deep) return Status::Error("'" + path + "': deep images are not supported");
   if (spec.depth > 1) return Status::Error("'" + path + "': volume images are not supported");
-  if (spec.x != spec.full_x || spec.y != spec.full_y || spec.width != spec.full_width ||
-      spec.height != spec.full_height)
-    return Status::Error("'" + path + "': the data window differs from the display window");
   DCM_RETURN_IF_ERROR(CheckImageDimensions(path, spec.width, spec.height, 3));
   int idx[3] = {spec.channelindex("R"), spec.channelindex("G"), spec.channelindex("B")};
   if (idx[0] < 0 || idx[1] < 0 || idx[2] < 0) {

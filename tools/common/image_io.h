@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "dcm/color.h"
+#include "dcm/geometry.h"
 #include "dcm/status.h"
 
 namespace dcm::toolkit {
@@ -31,6 +32,12 @@ Status WriteRgbExr(const std::string& path, int width, int height, std::span<con
 Status WriteRgbExr(const std::string& path, int width, int height, std::span<const RGB> pixels,
                    const Metadata& metadata, bool alpha);
 
+/// As above, for the `data` window of a frame whose display window is
+/// `display` (EXR data and display windows: a render region or a tile, or
+/// overscan); `pixels` cover the data window, row-major.
+Status WriteRgbExr(const std::string& path, const Bounds2i& display, const Bounds2i& data,
+                   std::span<const RGB> pixels, const Metadata& metadata, bool alpha);
+
 /// Writes an 8-bit RGB image atomically (PNG, or any format OIIO picks from the extension).
 Status WriteRgb8(const std::string& path, int width, int height, std::span<const uint8_t> rgb);
 
@@ -44,7 +51,7 @@ inline constexpr int64_t kMaxImageBytes = int64_t(8) << 30;
 Status CheckImageDimensions(const std::string& path, int width, int height, int channels);
 
 /// Reads the R, G, B channels of an image (by channel name; a 1-channel image
-/// is read as gray). The message names the file and what is wrong.
+/// is read as gray): the pixels of its data window. The message names the file and what is wrong.
 Status ReadRgb(const std::string& path, int* width, int* height, std::vector<RGB>* pixels);
 
 /// Runs `write(tmpPath)` and renames the temporary file to `path` on success;

@@ -141,34 +141,7 @@ Status WritePartExr(const std::string& path, int frameWidth, int frameHeight, co
   if (pixels.size() != size_t(region.area()))
     return Status::Error("cannot write '" + path + "': " + std::to_string(pixels.size()) + " pixels given for region " +
                          RegionText(region));
-  const int nch = alpha ? 4 : 3;
-  ImageSpec spec(region.width(), region.height(), nch, TypeDesc::FLOAT);
-  spec.x = region.min.x;
-  spec.y = region.min.y;
-  spec.full_x = 0;
-  spec.full_y = 0;
-  spec.full_width = frameWidth;
-  spec.full_height = frameHeight;
-  spec.channelnames = alpha ? std::vector<std::string>{"R", "G", "B", "A"} : std::vector<std::string>{"R", "G", "B"};
-  spec.alpha_channel = alpha ? 3 : -1;
-  spec.attribute("compression", "zip");
-  for (const auto& [name, value] : metadata.strings) spec.attribute(name, value);
-  for (const auto& [name, value] : metadata.floats) spec.attribute(name, value);
-  std::vector<float> buffer(pixels.size() * size_t(nch));
-  for (size_t i = 0; i < pixels.size(); ++i) {
-    for (int c = 0; c < 3; ++c) buffer[i * size_t(nch) + size_t(c)] = pixels[i][c];
-    if (alpha) buffer[i * 4 + 3] = 1.f;
-  }
-  return WriteAtomically(path, [&](const std::string& tmp) -> Status {
-    auto out = ImageOutput::create(tmp);
-    if (!out) return Status::Error("cannot write '" + path + "': " + OIIO::geterror());
-    if (!out->open(tmp, spec)) return Status::Error("cannot write '" + path + "': " + out->geterror());
-    bool ok = out->write_image(TypeDesc::FLOAT, buffer.data());
-    std::string err = ok ? "" : out->geterror();
-    if (!out->close() && ok) ok = false, err = out->geterror();
-    if (!ok) return Status::Error("cannot write '" + path + "': " + err);
-    return Status::Ok();
-  });
+  return WriteRgbExr(path, frame, region, pixels, metadata, alpha);
 }
 
 Status ReadPart(const std::string& path, Part* part, bool withPixels) {

@@ -5,7 +5,8 @@
 // Runs the engine on the guides and the samples rendered so far (the engine is
 // deterministic, so every round starts from the beginning) and writes the
 // pixels it needs next: an EXR mask (channel "mask", 1 where requested) and a
-// text list ("x y" per line, '#' comments). The renderer renders those pixels
+// text list ("x y" per line in the frame's coordinates, '#' comments); both
+// keep the guides' data window (a render region). The renderer renders those pixels
 // into a samples EXR (the channels plan names, plus "mask"); repeat with all
 // samples files until plan prints "done"; then `dcm reconstruct GUIDES.exr
 // --samples ...` gives the same image as dense mode.
@@ -31,11 +32,17 @@ struct PlanFlags {
   std::string mask, list, stats;
 };
 
-Status WriteMask(const std::string& path, int width, int height, const std::vector<Point2i>& pixels,
-                 const std::vector<std::string>& channels) {
-  std::vector<float> mask(size_t(width) * size_t(height), 0.f);
+/// The mask covers the guides' data window of their display window, so that
+/// a renderer reads it in its own frame's pixel coordinates.
+Status WriteMask(const std::string& path, const Bounds2i& display, const Bounds2i& data,
+                 const std::vector<Point2i>& pixels, const std::vector<std::string>& channels) {
+  const int width = data.width();
+  std::vector<float> mask(size_t(data.area()), 0.f);
   for (const auto& p : pixels) mask[size_t(p.y) * size_t(width) + size_t(p.x)] = 1.f;
-  OIIO::ImageSpec spec(width, height, 1, OIIO::TypeDesc::FLOAT);
+  OIIO::ImageSpec spec(width, data.height(), 1, OIIO::TypeDesc::FLOAT);
+  spec.x = data.min.x, spec.y = data.min.y;
+  spec.full_x = display.min.x, spec.full_y = display.min.y;
+  spec.full_width = display.width(), spec.full_height = display.height();
   spec.channelnames = {"mask"};
   spec.attribute("compression", "zip");
   std::string names;
@@ -56,16 +63,21 @@ Status WriteMask(const std::string& path, int width, int height, const std::vect
   });
 }
 
-Status WriteList(const std::string& path, int width, int height, const std::vector<Point2i>& pixels,
-                 const std::vector<std::string>& channels) {
+/// "x y" lines in the frame's pixel coordinates (EXR coordinates: the data
+/// window's origin added).
+Status WriteList(const std::string& path, const Bounds2i& display, const Bounds2i& data,
+                 const std::vector<Point2i>& pixels, const std::vector<std::string>& channels) {
   return toolkit::WriteAtomically(path, [&](const std::string& tmp) -> Status {
     std::ofstream out(tmp, std::ios::trunc);
     if (!out) return Status::Error("cannot write '" + path + "': cannot create a file in its folder");
     std::string names;
     for (const auto& c : channels) names += (names.empty() ? "" : ",") + c;
-    out << "# dcm plan: " << pixels.size() << " pixels of " << width << "x" << height
-        << " to render; samples EXR channels: " << names << "\n";
-    for (const auto& p : pixels) out << p.x << ' ' << p.y << '\n';
+    out << "# dcm plan: " << pixels.size() << " pixels of " << data.width() << "x" << data.height();
+    if (!(data == display))
+      out << " at " << data.min.x << "," << data.min.y << " (data window) of the " << display.width() << "x"
+          << display.height() << " frame";
+    out << " to render; samples EXR channels: " << names << "\n";
+    for (const auto& p : pixels) out << p.x + data.min.x << ' ' << p.y + data.min.y << '\n';
     out.close();
     if (!out) return Status::Error("cannot write '" + path + "': write failed");
     return Status::Ok();
@@ -104,21 +116,21 @@ int RunPlan(const PlanFlags& f) {
     if (next.empty())
       return aov_common::Fail(cmd, "the engine is pending on pixels that all have samples: " + st.message());
   }
-  const int w = provider->width(), h = provider->height();
+  const Bounds2i display = provider->DisplayWindow(), data = provider->DataWindow();
   const auto channels = provider->SampleChannels();
 
   aov_common::Outputs outputs(cmd);
   auto check = [&outputs](const std::string& path, Status s) { return outputs.Write(path, std::move(s)); };
   int rc = kExitOk;
-  if (!f.mask.empty() && (rc = check(f.mask, WriteMask(f.mask, w, h, next, channels)))) return rc;
-  if (!f.list.empty() && (rc = check(f.list, WriteList(f.list, w, h, next, channels)))) return rc;
+  if (!f.mask.empty() && (rc = check(f.mask, WriteMask(f.mask, display, data, next, channels)))) return rc;
+  if (!f.list.empty() && (rc = check(f.list, WriteList(f.list, display, data, next, channels)))) return rc;
   if (!f.stats.empty()) {
     nlohmann::json j;
     j["command"] = cmd;
     j["done"] = done;
     j["pending"] = next.size();
     j["samples_present"] = provider->SampleCount();
-    j["total_pixels"] = int64_t(w) * h;
+    j["total_pixels"] = data.area();
     j["channels"] = channels;
     j["options"] = toolkit::OptionsToJson(options);
     if (done) j["result"] = toolkit::StatsToJson(r.stats);

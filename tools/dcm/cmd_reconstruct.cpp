@@ -89,6 +89,30 @@ toolkit::Metadata ProvenanceMetadata(const ReconstructFlags& f, const aov::AovPr
   return meta;
 }
 
+/// The output's place in the frame: the inputs' data and display windows (a
+/// render region stays a region of its frame, overscan stays overscan), at
+/// the output resolution of --downsample N.
+Status OutputWindows(const aov::AovProvider& provider, int n, Bounds2i* display, Bounds2i* data) {
+  *display = provider.DisplayWindow();
+  *data = provider.DataWindow();
+  if (n <= 1) return Status::Ok();
+  const bool whole = *display == *data;
+  // A region must sit on the N-pixel lattice of its frame; a whole frame
+  // only needs its origin there (its size is rounded as the image's is).
+  for (int v : {display->min.x, display->min.y, display->max.x, display->max.y, data->min.x, data->min.y,
+                data->max.x, data->max.y})
+    if (v % n != 0 && !(whole && v != display->min.x && v != display->min.y))
+      return Status::Error("--downsample " + std::to_string(n) + ": the inputs' data window (" +
+                           toolkit::RegionText(*data) + ") or display window (" + toolkit::RegionText(*display) +
+                           ") does not lie on a multiple of " + std::to_string(n) + " pixels");
+  const Point2i size = OutputSize(data->width(), data->height(), n);
+  *data = {{data->min.x / n, data->min.y / n}, {data->min.x / n + size.x, data->min.y / n + size.y}};
+  *display = whole ? *data
+                   : Bounds2i{{display->min.x / n, display->min.y / n},
+                              {display->max.x / n, display->max.y / n}};
+  return Status::Ok();
+}
+
 /// --tile / --region: the region of the frame, written as a part for `dcm merge`.
 int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options, aov::AovProvider& provider) {
   const std::string cmd = "reconstruct";
@@ -97,6 +121,10 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
   if (!f.reference.empty() || !f.errorMap.empty())
     return aov_common::Fail(cmd, "--reference and --error-map need the whole frame; not with --tile or --region "
                                  "(compare the merged frame)", kExitUsage);
+  if (!(provider.DataWindow() == provider.DisplayWindow()))
+    return aov_common::Fail(cmd, "--tile and --region need inputs whose data window is their display window (the "
+                                 "whole frame); these are " + toolkit::RegionText(provider.DataWindow()) + " of " +
+                                 toolkit::RegionText(provider.DisplayWindow()), kExitUsage);
   const ProviderCapabilities caps = provider.Capabilities();
   const Point2i frame = OutputSize(caps.width, caps.height, options.downsample);
   Bounds2i region;
@@ -227,6 +255,9 @@ int RunReconstruct(const ReconstructFlags& f) {
   st = aov_common::OpenProvider(cmd, f.aov, aovOptions, f.engine, &provider);
   if (!st.ok()) return aov_common::Fail(cmd, st.message());
   if (IsPartial(f.tiles)) return RunReconstructPart(f, options, *provider);
+  Bounds2i display, data;
+  st = OutputWindows(*provider, options.downsample, &display, &data);
+  if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
 
   // An explicit reference is read (and checked) before the work starts.
   std::vector<RGB> reference;
@@ -282,7 +313,7 @@ int RunReconstruct(const ReconstructFlags& f) {
   // Every output is atomic; if a later one fails, the earlier ones go too.
   aov_common::Outputs outputs(cmd);
   auto write = [&outputs](const std::string& path, Status s) { return outputs.Write(path, std::move(s)); };
-  int rc = write(f.output, toolkit::WriteRgbExr(f.output, r.width, r.height, r.image, meta, f.alpha));
+  int rc = write(f.output, toolkit::WriteRgbExr(f.output, display, data, r.image, meta, f.alpha));
   if (rc) return rc;
   if (!f.sampleMap.empty() && (rc = write(f.sampleMap, toolkit::WriteSampleMap(f.sampleMap, r)))) return rc;
   if (!f.preview.empty() &&

@@ -426,6 +426,7 @@ Status ParseTextureBinding(std::string_view text, TextureBinding* out) {
 
 struct AovProvider::Data {
   int width = 0, height = 0;
+  detail::ImageWindows windows;
   ProviderCapabilities caps;
   bool dense = true;
   std::vector<uint32_t> objectId, shaderId;
@@ -659,6 +660,9 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
   for (const auto& path : inputs) DCM_RETURN_IF_ERROR(guides.Add(path));
   d->width = guides.width();
   d->height = guides.height();
+  d->windows = guides.windows();
+  if (d->windows.cropped())
+    d->notes.push_back("pixels: the " + d->windows.Text() + "; the outputs keep both");
   const size_t n = guides.pixels();
 
   // Guide roles.
@@ -748,10 +752,9 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
       // mean from their difference.
       ChannelSet second;
       for (const auto& path : options.secondRender) DCM_RETURN_IF_ERROR(second.Add(path));
-      if (second.width() != d->width || second.height() != d->height)
-        return Status::Error("second render " + Quote(options.secondRender[0]) + " is " +
-                             std::to_string(second.width()) + "x" + std::to_string(second.height()) + ", " +
-                             Quote(inputs[0]) + " is " + std::to_string(d->width) + "x" + std::to_string(d->height));
+      if (!(second.windows() == d->windows))
+        return Status::Error("second render " + Quote(options.secondRender[0]) + " is " + second.windows().Text() +
+                             ", " + Quote(inputs[0]) + " is " + d->windows.Text());
       RoleExprs roles2;
       DCM_RETURN_IF_ERROR(PresetExprs(options.preset, options.viewLayer, second, /*samples=*/true, &roles2, nullptr));
       roles2[size_t(Role::kMask)].reset();
@@ -803,11 +806,9 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
     for (const auto& path : options.samples) {
       ChannelSet s;
       DCM_RETURN_IF_ERROR(s.Add(path));
-      if (s.width() != d->width || s.height() != d->height)
-        return Status::Error("inputs of different resolutions: samples file " + Quote(path) + " is " +
-                             std::to_string(s.width()) + "x" + std::to_string(s.height()) + ", " +
-                             Quote(inputs[0]) + " is " + std::to_string(d->width) + "x" +
-                             std::to_string(d->height));
+      if (!(s.windows() == d->windows))
+        return Status::Error("inputs of different resolutions or data windows: samples file " + Quote(path) +
+                             " is " + s.windows().Text() + ", " + Quote(inputs[0]) + " is " + d->windows.Text());
       RoleExprs sroles;
       DCM_RETURN_IF_ERROR(PresetExprs(options.preset, options.viewLayer, s, true, &sroles, nullptr));
       DCM_RETURN_IF_ERROR(ApplyMappings(options.mappings, s, true, &sroles));
@@ -952,6 +953,8 @@ Status AovProvider::Evaluate(std::span<const Point2i> pixels, const SampleReques
 
 int AovProvider::width() const { return d_->width; }
 int AovProvider::height() const { return d_->height; }
+Bounds2i AovProvider::DataWindow() const { return d_->windows.data; }
+Bounds2i AovProvider::DisplayWindow() const { return d_->windows.display; }
 bool AovProvider::dense() const { return d_->dense; }
 bool AovProvider::HasSample(Point2i p) const {
   if (p.x < 0 || p.y < 0 || p.x >= d_->width || p.y >= d_->height) return false;

@@ -63,26 +63,20 @@ Status ChannelSet::Add(const std::string& path) {
     if (sp.deep) return Status::Error(Quote(path) + ": deep EXR images are not supported");
     DCM_RETURN_IF_ERROR(CheckDimensions(path, sp.full_width, sp.full_height));
     DCM_RETURN_IF_ERROR(CheckDimensions(path, sp.width, sp.height));
-    if (sp.x != sp.full_x || sp.y != sp.full_y || sp.width != sp.full_width ||
-        sp.height != sp.full_height)
-      return Status::Error(Quote(path) + ": the data window (" + std::to_string(sp.width) + "x" +
-                           std::to_string(sp.height) + " at " + std::to_string(sp.x) + "," +
-                           std::to_string(sp.y) +
-                           ") differs from the display window; expand it first, e.g. "
-                           "oiiotool IN --fullpixels -o OUT");
-    if (s > 0 && (sp.width != f.specs[0].width || sp.height != f.specs[0].height))
-      return Status::Error(Quote(path) + ": its parts have different resolutions");
+    if (s > 0 && (sp.x != f.specs[0].x || sp.y != f.specs[0].y || sp.width != f.specs[0].width ||
+                  sp.height != f.specs[0].height))
+      return Status::Error(Quote(path) + ": its parts have different data windows");
     f.specs.push_back(sp);
   }
   (void)f.in->geterror();
   if (f.specs.empty()) return Status::Error(Quote(path) + ": no image in the file");
-  const int w = f.specs[0].width, h = f.specs[0].height;
-  if (!files_.empty() && (w != width_ || h != height_))
-    return Status::Error("inputs of different resolutions: " + Quote(path) + " is " +
-                         std::to_string(w) + "x" + std::to_string(h) + ", " + Quote(files_[0].path) +
-                         " is " + std::to_string(width_) + "x" + std::to_string(height_));
-  width_ = w;
-  height_ = h;
+  const ImageSpec& sp = f.specs[0];
+  const ImageWindows w{{{sp.x, sp.y}, {sp.x + sp.width, sp.y + sp.height}},
+                       {{sp.full_x, sp.full_y}, {sp.full_x + sp.full_width, sp.full_y + sp.full_height}}};
+  if (!files_.empty() && !(w == windows_))
+    return Status::Error("inputs of different resolutions or data windows: " + Quote(path) + " is " + w.Text() +
+                         ", " + Quote(files_[0].path) + " is " + windows_.Text());
+  windows_ = w;
   const int fileIndex = int(files_.size());
   for (int s = 0; s < int(f.specs.size()); ++s) {
     const ImageSpec& sp = f.specs[size_t(s)];
@@ -92,6 +86,15 @@ Status ChannelSet::Add(const std::string& path) {
   files_.push_back(std::move(f));
   ScanCrypto(fileIndex);
   return Status::Ok();
+}
+
+std::string ImageWindows::Text() const {
+  auto text = [](const Bounds2i& b) {
+    return std::to_string(b.width()) + "x" + std::to_string(b.height()) + " at " + std::to_string(b.min.x) + "," +
+           std::to_string(b.min.y);
+  };
+  return cropped() ? "data window " + text(data) + " of display window " + text(display)
+                   : std::to_string(data.width()) + "x" + std::to_string(data.height());
 }
 
 void ChannelSet::ScanCrypto(int file) {
@@ -212,7 +215,7 @@ Status ChannelSet::ReadId(const std::string& name, std::vector<uint32_t>* plane)
     // Integers exactly representable in float32 span +-2^24; larger integral
     // values are accepted as stored (they are still integers).
     if (!std::isfinite(v) || v != std::floor(v) || v < -2147483648.f || v >= 4294967296.f) {
-      const int x = int(i % size_t(width_)), y = int(i / size_t(width_));
+      const int x = int(i % size_t(width())) + windows_.data.min.x, y = int(i / size_t(width())) + windows_.data.min.y;
       return Status::Error(Quote(Path(ref->file)) + ": channel " + Quote(name) +
                            " holds a non-integer ID " + std::to_string(v) + " at pixel (" +
                            std::to_string(x) + ", " + std::to_string(y) +

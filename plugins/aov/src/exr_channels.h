@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "dcm/geometry.h"
 #include "dcm/status.h"
 
 namespace dcm::aov::detail {
@@ -42,6 +43,17 @@ struct CryptoLayer {
   std::map<std::string, uint32_t> manifest;  ///< object/material name -> ID
 };
 
+/// Where an EXR's pixels lie: its data window, inside (a render region) or
+/// around (overscan) its display window, the frame.
+struct ImageWindows {
+  Bounds2i data;
+  Bounds2i display;
+  bool cropped() const { return !(data == display); }
+  /// "200x150 at 30,40 of 256x256 at 0,0", for messages.
+  std::string Text() const;
+  friend bool operator==(const ImageWindows&, const ImageWindows&) = default;
+};
+
 class ChannelSet {
  public:
   ChannelSet();
@@ -49,15 +61,16 @@ class ChannelSet {
   ChannelSet(ChannelSet&&) noexcept;
   ChannelSet& operator=(ChannelSet&&) noexcept;
 
-  /// Opens `path`: it must exist, be an OpenEXR file, not deep, with a data
-  /// window equal to its display window, of sane dimensions, and of the same
-  /// resolution as the files added before. Channels already present keep
-  /// their first file.
+  /// Opens `path`: it must exist, be an OpenEXR file, not deep, of sane
+  /// dimensions, and have the same data and display windows as the files
+  /// added before. Channels already present keep their first file. The
+  /// pixels are those of the data window.
   Status Add(const std::string& path);
 
-  int width() const { return width_; }
-  int height() const { return height_; }
-  size_t pixels() const { return size_t(width_) * size_t(height_); }
+  int width() const { return windows_.data.width(); }
+  int height() const { return windows_.data.height(); }
+  const ImageWindows& windows() const { return windows_; }
+  size_t pixels() const { return size_t(windows_.data.area()); }
   bool empty() const { return files_.empty(); }
 
   std::optional<ChannelRef> Find(const std::string& name) const;
@@ -95,7 +108,7 @@ class ChannelSet {
                  void* data) const;
   void ScanCrypto(int file);
 
-  int width_ = 0, height_ = 0;
+  ImageWindows windows_;
   std::vector<File> files_;
   std::map<std::string, ChannelRef> channels_;
   std::vector<CryptoLayer> crypto_;

@@ -117,7 +117,8 @@ struct AovOptions {
 /// so Guides() and Evaluate() only copy and are thread safe.
 class AovProvider final : public SampleProvider {
  public:
-  /// Reads `inputs` (one multilayer EXR or several EXRs of one resolution)
+  /// Reads `inputs` (one multilayer EXR or several EXRs of one resolution
+  /// and data window)
   /// and, in sparse mode, `options.samples`. Errors name the file and channel.
   static Status Open(const std::vector<std::string>& inputs, const AovOptions& options,
                      std::unique_ptr<AovProvider>* out);
@@ -130,8 +131,14 @@ class AovProvider final : public SampleProvider {
   Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what,
                   std::span<ExactSample> out) override;
 
+  /// The size of the inputs' data window: the image the engine reconstructs.
   int width() const;
   int height() const;
+  /// Where that image lies in the frame: the inputs' data window (a render
+  /// region, or overscan) and display window, in EXR pixel coordinates.
+  /// Engine pixel (x, y) is frame pixel DataWindow().min + (x, y).
+  Bounds2i DataWindow() const;
+  Bounds2i DisplayWindow() const;
   /// True when every pixel has an exact sample (dense input).
   bool dense() const;
   /// Whether pixel (x, y) has an exact sample.
