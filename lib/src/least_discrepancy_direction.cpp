@@ -16,39 +16,79 @@ double SquaredDifference(const Value& p, const Value& q) {
 }
 }  // namespace
 
-DirectionChoice LeastDiscrepancyDirection(const SampleStore& store, const Block& b,
-                                          std::span<const Point2i> border, int directions) {
-  DirectionChoice best{0, std::numeric_limits<double>::infinity()};
+BorderPairs::BorderPairs(int width, int height, int directions)
+    : width_(width), height_(height), directions_(directions) {
+  const Block local{0, 0, width, height};
+  std::vector<Point2i> loop;
+  BorderLoop(local, &loop);
+  // Border index of each pixel of the block's bounding grid.
+  std::vector<int> index(size_t(width + 1) * size_t(height + 1), -1);
+  for (size_t i = 0; i < loop.size(); ++i) index[size_t(loop[i].y) * size_t(width + 1) + size_t(loop[i].x)] = int(i);
+  auto at = [&](Point2i p) { return index[size_t(p.y) * size_t(width + 1) + size_t(p.x)]; };
+  start_.push_back(0);
   for (int k = 0; k < directions; ++k) {
     const Direction d = Direction::Of(k, directions);
-    double sum = 0;
-    int pairs = 0;
-    for (const Point2i& p : border) {
-      const int64_t ip = store.Index(p.x, p.y);
-      if (!store.IsFinite(ip)) continue;
+    for (size_t i = 0; i < loop.size(); ++i) {
+      const Point2i p = loop[i];
       BorderPoint e;
-      if (!ExitPoint(b, p.x, p.y, d, &e) && !ExitPoint(b, p.x, p.y, Direction{-d.dx, -d.dy}, &e))
+      if (!ExitPoint(local, p.x, p.y, d, &e) && !ExitPoint(local, p.x, p.y, Direction{-d.dx, -d.dy}, &e))
         continue;
-      const int64_t i0 = store.Index(e.p0.x, e.p0.y), i1 = store.Index(e.p1.x, e.p1.y);
-      if (!store.IsFinite(i0) || !store.IsFinite(i1)) continue;
-      Interpolant in;
-      in.index = {i0, i1, 0, 0};
-      in.weight = {1 - e.w1, e.w1, 0, 0};
-      in.count = 2;
-      const Value v = store.ValueAt(ip), predicted = Evaluate(store, in);
+      pairs_.push_back({int(i), at(e.p0), at(e.p1), e.w1});
+    }
+    start_.push_back(pairs_.size());
+  }
+}
+
+DirectionChoice LeastDiscrepancyDirection(const SampleStore& store, std::span<const Point2i> border,
+                                          const BorderPairs& pairs) {
+  // The border's samples, read once for all directions.
+  std::vector<Value> value(border.size());
+  std::vector<uint8_t> finite(border.size());
+  bool allFinite = true;
+  for (size_t i = 0; i < border.size(); ++i) {
+    const int64_t index = store.Index(border[i].x, border[i].y);
+    finite[i] = store.IsFinite(index);
+    allFinite = allFinite && finite[i];
+    value[i] = store.ValueAt(index);
+  }
+  auto valid = [&](const BorderPairs::Pair& q) {
+    return allFinite || (finite[size_t(q.p)] && finite[size_t(q.e0)] && finite[size_t(q.e1)]);
+  };
+  DirectionChoice best{0, std::numeric_limits<double>::infinity()};
+  for (int k = 0; k < pairs.directions(); ++k) {
+    const std::span<const BorderPairs::Pair> all = pairs.Of(k);
+    int count = 0;
+    for (const BorderPairs::Pair& q : all) count += valid(q);
+    if (count == 0) continue;
+    // The sum only grows: once its mean over all `count` pairs reaches the
+    // best so far, this direction cannot win (ties go to the smaller k), and
+    // the rest of its pairs are skipped. The choice is that of the full sums.
+    double sum = 0;
+    int done = 0;
+    for (const BorderPairs::Pair& q : all) {
+      if (!valid(q)) continue;
+      const Value* ends[2] = {&value[size_t(q.e0)], &value[size_t(q.e1)]};
+      const double weights[2] = {1 - q.w1, q.w1};
+      const Value& v = value[size_t(q.p)];
+      const Value predicted = WeightedSum(ends, weights, 2);
       // With noisy samples, each difference counts in units of its own
       // standard deviation (a chi-square): noisy pairs do not outvote clean
       // ones, and a direction along which only noise differs scores ~1.
       const double var = double(v.varA) + v.varB + predicted.varA + predicted.varB;
       sum += var > 0 ? SquaredDifference(v, predicted) / var : SquaredDifference(v, predicted);
-      ++pairs;
+      if ((++done & 7) == 0 && sum / count >= best.discrepancy) break;
     }
-    if (pairs == 0) continue;
-    const double mean = sum / pairs;
+    if (done < count) continue;
+    const double mean = sum / count;
     if (mean < best.discrepancy) best = {k, mean};
   }
   if (!std::isfinite(best.discrepancy)) best = {0, 0};
   return best;
+}
+
+DirectionChoice LeastDiscrepancyDirection(const SampleStore& store, const Block& b,
+                                          std::span<const Point2i> border, int directions) {
+  return LeastDiscrepancyDirection(store, border, BorderPairs(b.width(), b.height(), directions));
 }
 
 }  // namespace dcm::detail

@@ -62,45 +62,65 @@ bool ExitPoint(const Block& b, double px, double py, Direction d, BorderPoint* o
   return true;
 }
 
-bool OrientedInterpolant(const SampleStore& store, const Block& b, Point2i q, Direction d,
-                         Interpolant* out) {
+namespace {
+/// The oriented element of block-local pixel (x, y) of a width x height block.
+OrientedElements::Element LocalElement(int width, int height, int x, int y, Direction d) {
+  const Block local{0, 0, width, height};
+  OrientedElements::Element e;
   BorderPoint fwd, back;
-  if (!ExitPoint(b, q.x, q.y, d, &fwd) ||
-      !ExitPoint(b, q.x, q.y, Direction{-d.dx, -d.dy}, &back))
-    return false;
+  if (!ExitPoint(local, x, y, d, &fwd) || !ExitPoint(local, x, y, Direction{-d.dx, -d.dy}, &back)) return e;
   // The nearer border point gets the larger weight.
   const double total = fwd.t + back.t;
   const double wf = back.t / total, wb = fwd.t / total;
-  out->count = 0;
+  e.count = 0;
   auto add = [&](Point2i p, double w) {
     if (w <= 0) return;
-    out->index[out->count] = store.Index(p.x, p.y);
-    out->weight[out->count] = w;
-    ++out->count;
+    e.p[size_t(e.count)] = p;
+    e.weight[size_t(e.count)] = w;
+    ++e.count;
   };
   add(fwd.p0, wf * (1 - fwd.w1));
   add(fwd.p1, wf * fwd.w1);
   add(back.p0, wb * (1 - back.w1));
   add(back.p1, wb * back.w1);
+  return e;
+}
+
+bool ToInterpolant(const SampleStore& store, const Block& b, const OrientedElements::Element& e,
+                   Interpolant* out) {
+  if (e.count < 0) return false;
+  out->count = e.count;
+  for (int k = 0; k < e.count; ++k) {
+    out->index[size_t(k)] = store.Index(b.x0 + e.p[size_t(k)].x, b.y0 + e.p[size_t(k)].y);
+    out->weight[size_t(k)] = e.weight[size_t(k)];
+  }
   return true;
+}
+}  // namespace
+
+bool OrientedInterpolant(const SampleStore& store, const Block& b, Point2i q, Direction d,
+                         Interpolant* out) {
+  return ToInterpolant(store, b, LocalElement(b.width(), b.height(), q.x - b.x0, q.y - b.y0, d), out);
+}
+
+OrientedElements::OrientedElements(int width, int height, Direction d) : width_(width), height_(height), d_(d) {
+  for (int y = 1; y < height; ++y)
+    for (int x = 1; x < width; ++x) elements_.push_back(LocalElement(width, height, x, y, d));
+}
+
+bool OrientedElements::At(const SampleStore& store, const Block& b, Point2i q,
+                          Interpolant* out) const {
+  const int x = q.x - b.x0, y = q.y - b.y0;
+  if (b.width() != width_ || b.height() != height_ || x < 1 || y < 1 || x >= width_ || y >= height_)
+    return OrientedInterpolant(store, b, q, d_, out);
+  return ToInterpolant(store, b, elements_[size_t(y - 1) * size_t(width_ - 1) + size_t(x - 1)], out);
 }
 
 Value Evaluate(const SampleStore& store, const Interpolant& in) {
-  // Weights in double: a linear ramp is reproduced to float rounding.
-  double a[3] = {0, 0, 0}, bb[3] = {0, 0, 0}, varA = 0, varB = 0;
-  for (int k = 0; k < in.count; ++k) {
-    const Value v = store.ValueAt(in.index[k]);
-    const double w = in.weight[k];
-    for (int c = 0; c < 3; ++c) {
-      a[c] += w * v.a[c];
-      bb[c] += w * v.b[c];
-    }
-    // Independent samples: the variance of the weighted sum.
-    varA += w * w * v.varA;
-    varB += w * w * v.varB;
-  }
-  return {RGB(float(a[0]), float(a[1]), float(a[2])), RGB(float(bb[0]), float(bb[1]), float(bb[2])),
-          float(varA), float(varB)};
+  Value v[4];
+  const Value* p[4] = {&v[0], &v[1], &v[2], &v[3]};
+  for (int k = 0; k < in.count; ++k) v[k] = store.ValueAt(in.index[size_t(k)]);
+  return WeightedSum(p, in.weight.data(), in.count);
 }
 
 Value Bilinear(const SampleStore& store, const Block& b, Point2i q) {

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <vector>
 
 #include "block.h"
 #include "sample_store.h"
@@ -43,8 +44,50 @@ struct Interpolant {
 bool OrientedInterpolant(const SampleStore& store, const Block& b, Point2i q, Direction d,
                          Interpolant* out);
 
+/// The oriented elements of one block shape and direction: the interpolant
+/// of every interior pixel in block-local coordinates, computed once and
+/// shared by all blocks of that shape and direction (the same weights, to
+/// the bit, as OrientedInterpolant).
+class OrientedElements {
+ public:
+  /// `width`, `height` in pixel steps (Block::width()).
+  OrientedElements(int width, int height, Direction d);
+  /// OrientedInterpolant(store, b, q, d, out) for a block `b` of this shape.
+  bool At(const SampleStore& store, const Block& b, Point2i q, Interpolant* out) const;
+
+  struct Element {
+    int count = -1;  ///< -1: the line through the pixel does not cross the block
+    std::array<Point2i, 4> p{};
+    std::array<double, 4> weight{};
+  };
+
+ private:
+  int width_, height_;
+  Direction d_;
+  std::vector<Element> elements_;  ///< interior pixels, row-major
+};
+
 /// The weighted sum of the interpolant's values.
 Value Evaluate(const SampleStore& store, const Interpolant& in);
+
+/// The weighted sum of `count` values, with Evaluate's arithmetic (weights
+/// in double: a linear ramp is reproduced to float rounding; independent
+/// samples: the variances add with the squared weights).
+inline Value WeightedSum(const Value* const* values, const double* weights, int count) {
+  double a[3] = {0, 0, 0}, bb[3] = {0, 0, 0}, varA = 0, varB = 0;
+  for (int k = 0; k < count; ++k) {
+    const Value& v = *values[k];
+    const double w = weights[k];
+    for (int c = 0; c < 3; ++c) {
+      a[c] += w * v.a[c];
+      bb[c] += w * v.b[c];
+    }
+    varA += w * w * v.varA;
+    varB += w * w * v.varB;
+  }
+  return {RGB(float(a[0]), float(a[1]), float(a[2])), RGB(float(bb[0]), float(bb[1]), float(bb[2])),
+          float(varA), float(varB)};
+}
 
 /// Bilinear interpolation of the block's four corners at pixel q.
 Value Bilinear(const SampleStore& store, const Block& b, Point2i q);

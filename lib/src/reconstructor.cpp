@@ -12,6 +12,7 @@
 #include <atomic>
 #include <tuple>
 #include <chrono>
+#include <map>
 #include <cmath>
 #include <string>
 
@@ -138,9 +139,16 @@ class Engine {
   /// blocks split further interpolated bilinearly, edge blocks along their
   /// direction. Later passes overwrite every preview value.
   void WritePreview(int level, std::vector<Block>& splitSmooth, std::vector<EdgeBlock>& edges);
-  /// `final`: pixels it cannot interpolate are requested exactly (a preview
-  /// leaves them as they are).
-  void WriteOriented(const Leaf& leaf, bool final = true);
+  /// What InterpolateOriented does with the interior pixels of a leaf.
+  enum class OrientedPass {
+    kPreview,     ///< write what it can interpolate, leave the rest as it is
+    kThinObjects, ///< only request (with Resolve's reason) what it cannot
+    kFinal,       ///< write what it can, request the rest
+  };
+  /// Interpolates the pixels of an oriented leaf that are not exact along
+  /// the leaf's direction (2.3), the thin-object test (3.1) deciding which
+  /// ones must be exact instead.
+  void InterpolateOriented(const Leaf& leaf, OrientedPass pass);
   void RecordLeaves(Reconstruction* out);
 
   SampleProvider& provider_;
@@ -155,6 +163,20 @@ class Engine {
   ReconstructionStats stats_;
   std::vector<Point2i>* pending_ = nullptr;
   std::vector<Leaf> smoothLeaves_, orientedLeaves_, fallbackLeaves_;
+  /// The direction search's geometry per block shape (width, height), built
+  /// before each search; read-only while the blocks run in parallel.
+  std::map<std::pair<int, int>, BorderPairs> borderPairs_;
+  /// The interpolants of interior pixels per (width, height, direction) of
+  /// the oriented leaves, built by PrepareElements before the passes that
+  /// read them in parallel.
+  std::map<std::tuple<int, int, int>, OrientedElements> elements_;
+  void PrepareElements(const std::vector<Leaf>& leaves) {
+    for (const Leaf& l : leaves) {
+      const auto key = std::tuple(l.block.width(), l.block.height(), int(l.direction));
+      if (!elements_.contains(key))
+        elements_.try_emplace(key, l.block.width(), l.block.height(), Direction::Of(l.direction, opt_.directions));
+    }
+  }
 };
 
 Status Engine::LoadGuides() {
@@ -289,9 +311,11 @@ void Engine::WriteSmooth(const Leaf& leaf) {
   }
 }
 
-void Engine::WriteOriented(const Leaf& leaf, bool final) {
+void Engine::InterpolateOriented(const Leaf& leaf, OrientedPass pass) {
   const Block& b = leaf.block;
   const Direction d = Direction::Of(leaf.direction, opt_.directions);
+  const auto table = elements_.find(std::tuple(b.width(), b.height(), int(leaf.direction)));
+  const OrientedElements* elements = table == elements_.end() ? nullptr : &table->second;
   const bool lazy = leaf.type == BlockType::kLazy;
   const double hx = 0.5 * (b.x1 - b.x0), hy = 0.5 * (b.y1 - b.y0);
   for (int y = b.y0 + 1; y < b.y1; ++y)
@@ -299,12 +323,13 @@ void Engine::WriteOriented(const Leaf& leaf, bool final) {
       const int64_t i = store_.Index(x, y);
       if (store_.IsExact(i)) continue;
       Interpolant in;
-      if (!OrientedInterpolant(store_, b, {x, y}, d, &in) || Resolve({x, y}, &in) != SampleReason::kInterpolated) {
-        // Safety net: a pixel the thin-object pass did not foresee is
-        // evaluated exactly in one last round rather than left unwritten.
-        if (final) store_.Request(x, y, SampleReason::kFallback);
+      const bool found = elements ? elements->At(store_, b, {x, y}, &in) : OrientedInterpolant(store_, b, {x, y}, d, &in);
+      const SampleReason r = found ? Resolve({x, y}, &in) : SampleReason::kFallback;
+      if (r != SampleReason::kInterpolated) {
+        if (pass != OrientedPass::kPreview) store_.Request(x, y, r);
         continue;
       }
+      if (pass == OrientedPass::kThinObjects) continue;
       Value v = Evaluate(store_, in);
       if (lazy) {
         // The centre sample corrects the parent's interpolation with a tent
@@ -326,9 +351,9 @@ void Engine::WritePreview(int level, std::vector<Block>& splitSmooth, std::vecto
   ForEach(splitSmooth, [&](Block& b, size_t) { WriteSmooth(MakeLeaf(b, BlockType::kSmooth)); });
   ForEach(edges, [&](EdgeBlock& e, size_t) {
     WriteSmooth(MakeLeaf(e.block, BlockType::kSmooth));  // where the oriented pass skips a pixel
-    WriteOriented(MakeLeaf(e.block, BlockType::kComplexEdge, e.direction.index), false);
+    InterpolateOriented(MakeLeaf(e.block, BlockType::kComplexEdge, e.direction.index), OrientedPass::kPreview);
   });
-  ForEach(orientedLeaves_, [&](Leaf& l, size_t) { WriteOriented(l, false); });
+  ForEach(orientedLeaves_, [&](Leaf& l, size_t) { InterpolateOriented(l, OrientedPass::kPreview); });
   opt_.onLevel(level, store_.width(), store_.height(), store_.radiance());
 }
 
@@ -483,8 +508,14 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
       });
       if (opt_.adaptiveBorders) DCM_RETURN_IF_ERROR(EvaluateBordersAdaptively(edges));
       DCM_RETURN_IF_ERROR(Flush());
+      for (const EdgeBlock& e : eb) {
+        const auto shape = std::pair(e.block.width(), e.block.height());
+        if (!borderPairs_.contains(shape))
+          borderPairs_.try_emplace(shape, e.block.width(), e.block.height(), opt_.directions);
+      }
       ForEach(eb, [&](EdgeBlock& e, size_t) {
-        e.direction = LeastDiscrepancyDirection(store_, e.block, e.border, opt_.directions);
+        e.direction = LeastDiscrepancyDirection(store_, e.border,
+                                                borderPairs_.at(std::pair(e.block.width(), e.block.height())));
         e.crossings = SignificantChanges(store_, contrast_, e.border);
       });
 
@@ -606,35 +637,30 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
     // Flushed before the thin-object pass: a fallback block's border is also
     // its neighbours' border, and what the pass decides depends on it.
     DCM_RETURN_IF_ERROR(Flush());
-    // Thin objects (3.1): interior pixels whose interpolants lie on another surface.
-    Progress(0.9f, "thin objects");
+    // Thin objects (3.1): interior pixels whose interpolants lie on another
+    // surface are evaluated exactly. The interpolation reads block borders
+    // only, which are final now, unless the samples are to be denoised first:
+    // then the pass only requests, and the interpolation follows denoising.
+    const bool denoise = DenoisesSamples(opt_, caps_);
+    Progress(0.9f, "thin objects and interpolation");
+    PrepareElements(orientedLeaves_);
+    if (!denoise) ForEach(smoothLeaves_, [&](Leaf& l, size_t) { WriteSmooth(l); });
     ForEach(orientedLeaves_, [&](Leaf& l, size_t) {
-      const Direction d = Direction::Of(l.direction, opt_.directions);
-      for (int y = l.block.y0 + 1; y < l.block.y1; ++y)
-        for (int x = l.block.x0 + 1; x < l.block.x1; ++x) {
-          Interpolant in;
-          if (store_.IsExact(store_.Index(x, y))) continue;
-          if (!OrientedInterpolant(store_, l.block, {x, y}, d, &in)) {
-            store_.Request(x, y, SampleReason::kFallback);
-            continue;
-          }
-          const SampleReason r = Resolve({x, y}, &in);
-          if (r != SampleReason::kInterpolated) store_.Request(x, y, r);
-        }
+      InterpolateOriented(l, denoise ? OrientedPass::kThinObjects : OrientedPass::kFinal);
     });
     DCM_RETURN_IF_ERROR(Flush());
-
-    if (DenoisesSamples(opt_, caps_)) {
+    if (denoise) {
       Progress(0.93f, "denoising samples");
       // Averaging what the noise explains: the gate is wider than the
       // detection's significance (which errs towards refining), 2 sd at least.
       stats_.denoisedSamples =
           DenoiseExactSamples(store_, DenoiseRadius(opt_), contrast_, std::max(opt_.noiseSignificance, 2.f));
+      Progress(0.95f, "interpolation");
+      ForEach(smoothLeaves_, [&](Leaf& l, size_t) { WriteSmooth(l); });
+      ForEach(orientedLeaves_, [&](Leaf& l, size_t) { InterpolateOriented(l, OrientedPass::kFinal); });
+      // Nothing to evaluate unless the thin-object pass missed a pixel.
+      DCM_RETURN_IF_ERROR(Flush());
     }
-    Progress(0.95f, "interpolation");
-    ForEach(smoothLeaves_, [&](Leaf& l, size_t) { WriteSmooth(l); });
-    ForEach(orientedLeaves_, [&](Leaf& l, size_t) { WriteOriented(l); });
-    DCM_RETURN_IF_ERROR(Flush());
     if (opt_.onLevel) opt_.onLevel(levels - 1, W, H, store_.radiance());
     stats_.smoothBlocks = int64_t(smoothLeaves_.size());
     stats_.fallbackBlocks = int64_t(fallbackLeaves_.size());
