@@ -16,12 +16,14 @@ packages=(
   # tests/tiles/slurm_test.sh: a single-node Slurm cluster on loopback
   # (the test starts munged, slurmctld and slurmd itself; no systemd)
   slurm-wlm munge
+  # tests/povray: POV-Ray 3.7 driven for real (examples/povray)
+  povray
   # helper scripts (plots, checks): Debian's python, not the one first on PATH
   python3-numpy python3-matplotlib python3-openimageio
 )
 for arg in "$@"; do
   case "$arg" in
-    --with-renderers) packages+=(povray blender) ;;            # examples/blender, POV-Ray
+    --with-renderers) packages+=(blender) ;;                   # examples/blender
     --with-fuzz) packages+=(clang-14 libclang-rt-14-dev) ;;    # scripts/fuzz.sh (libFuzzer)
     *) echo "install-deps: unknown option $arg" >&2; exit 2 ;;
   esac
