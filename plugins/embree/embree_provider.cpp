@@ -124,8 +124,10 @@ Status EmbreeProvider::Guides(const Bounds2i& region, const GuideRequest& what, 
   // Rows in parallel: primary rays are independent and deterministic.
   tbb::parallel_for(region.min.y, region.max.y, [&](int y) {
     RayCounts counts;
+    std::vector<PixelGuide> row(size_t(region.width()));
+    integrator_->GuideRow(y, region.min.x, region.max.x, tau, &counts, row.data());
     for (int x = region.min.x; x < region.max.x; ++x) {
-      PixelGuide g = integrator_->Guide(x, y, tau, &counts);
+      const PixelGuide& g = row[size_t(x - region.min.x)];
       size_t i = size_t(region.offset({x, y}));
       if (what.objectId) out->objectId[i] = g.objectId;
       if (what.shaderId) out->shaderId[i] = g.shaderId;
@@ -165,6 +167,11 @@ PixelRadiance EmbreeProvider::EvaluatePixel(int x, int y) {
   PixelRadiance r = integrator_->Evaluate(x, y, &counts);
   AddCounts(counts);
   return r;
+}
+
+PixelGuide EmbreeProvider::GuidePixel(int x, int y, bool wantTau) {
+  RayCounts counts;
+  return integrator_->Guide(x, y, wantTau && effects_.textures, &counts);
 }
 
 void EmbreeProvider::AddCounts(const RayCounts& c) {

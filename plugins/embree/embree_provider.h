@@ -48,6 +48,9 @@ class EmbreeProvider final : public SampleProvider {
 
   /// One exact pixel with its tau (for tests and tools; same bits as Evaluate()).
   PixelRadiance EvaluatePixel(int x, int y);
+  /// The guides of one pixel, its primary ray traced alone (for tests: the
+  /// same as Guides(), which traces each row as one coherent stream).
+  PixelGuide GuidePixel(int x, int y, bool wantTau);
 
   /// The effects this scene calls for.
   const Effects& effects() const { return effects_; }

@@ -191,9 +191,8 @@ Vec3 EmbreeScene::Offset(Vec3 p, Vec3 n) {
   return p + n * (2e-5f * m);
 }
 
-bool EmbreeScene::Intersect(Vec3 org, Vec3 dir, float tnear, float tfar, SurfaceHit* hit) const {
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
+namespace {
+RTCRayHit MakeRayHit(Vec3 org, Vec3 dir, float tnear, float tfar) {
   RTCRayHit rh;
   rh.ray.org_x = org.x; rh.ray.org_y = org.y; rh.ray.org_z = org.z;
   rh.ray.dir_x = dir.x; rh.ray.dir_y = dir.y; rh.ray.dir_z = dir.z;
@@ -202,11 +201,38 @@ bool EmbreeScene::Intersect(Vec3 org, Vec3 dir, float tnear, float tfar, Surface
   rh.ray.mask = 0xffffffffu;
   rh.ray.flags = 0;
   rh.ray.time = 0.f;
+  rh.ray.id = 0;
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  return rh;
+}
+}  // namespace
+
+bool EmbreeScene::Intersect(Vec3 org, Vec3 dir, float tnear, float tfar, SurfaceHit* hit) const {
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  RTCRayHit rh = MakeRayHit(org, dir, tnear, tfar);
   rtcIntersect1(scene_, &ctx, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+  Shade(rh, dir, hit);
+  return true;
+}
 
+void EmbreeScene::IntersectCoherent(Vec3 org, std::span<const Vec3> dirs, std::span<SurfaceHit> hits,
+                                    std::span<uint8_t> found) const {
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  std::vector<RTCRayHit> rays(dirs.size());
+  for (size_t i = 0; i < dirs.size(); ++i) rays[i] = MakeRayHit(org, dirs[i], 0.f, std::numeric_limits<float>::infinity());
+  rtcIntersect1M(scene_, &ctx, rays.data(), unsigned(rays.size()), sizeof(RTCRayHit));
+  for (size_t i = 0; i < dirs.size(); ++i) {
+    found[i] = rays[i].hit.geomID != RTC_INVALID_GEOMETRY_ID;
+    if (found[i]) Shade(rays[i], dirs[i], &hits[i]);
+  }
+}
+
+void EmbreeScene::Shade(const RTCRayHit& rh, Vec3 dir, SurfaceHit* hit) const {
   const Geometry& g = geometries_[rh.hit.geomID];
   const TriangleMesh& m = g.mesh;
   const uint32_t i0 = m.indices[3 * rh.hit.primID], i1 = m.indices[3 * rh.hit.primID + 1],
@@ -248,7 +274,6 @@ bool EmbreeScene::Intersect(Vec3 org, Vec3 dir, float tnear, float tfar, Surface
   }
   hit->object = g.object;
   hit->light = g.light;
-  return true;
 }
 
 bool EmbreeScene::Occluded(Vec3 org, Vec3 dir, float tnear, float tfar) const {

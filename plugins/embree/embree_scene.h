@@ -3,7 +3,9 @@
 
 #include <embree3/rtcore.h>
 
+#include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -41,6 +43,11 @@ class EmbreeScene {
 
   /// Closest hit along org + t*dir, t in [tnear, tfar]; false on a miss.
   bool Intersect(Vec3 org, Vec3 dir, float tnear, float tfar, SurfaceHit* hit) const;
+  /// Closest hits of rays from one origin (a camera's primary rays), traced
+  /// as one coherent stream (Embree packs them into packets): hits[i] is
+  /// valid where found[i]. The same hits as Intersect() ray by ray.
+  void IntersectCoherent(Vec3 org, std::span<const Vec3> dirs, std::span<SurfaceHit> hits,
+                         std::span<uint8_t> found) const;
   /// True when something blocks org + t*dir for t in [tnear, tfar].
   bool Occluded(Vec3 org, Vec3 dir, float tnear, float tfar) const;
 
@@ -58,6 +65,8 @@ class EmbreeScene {
     int light = -1;
   };
   Status AddMesh(TriangleMesh mesh, int object, int light);
+  /// The surface at the hit Embree reported for a ray along `dir`.
+  void Shade(const RTCRayHit& rh, Vec3 dir, SurfaceHit* hit) const;
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
   std::vector<Geometry> geometries_;  // indexed by Embree geometry ID

@@ -312,11 +312,30 @@ PixelRadiance Integrator::Evaluate(int x, int y, RayCounts* counts) const {
 }
 
 PixelGuide Integrator::Guide(int x, int y, bool wantTau, RayCounts* counts) const {
-  PixelGuide g;
   const CameraRay cr = camera_.Generate(x, y);
   ++counts->guide;
   SurfaceHit h;
-  if (!bvh_.Intersect(cr.origin, cr.dir, 0.f, kInf, &h)) return g;
+  if (!bvh_.Intersect(cr.origin, cr.dir, 0.f, kInf, &h)) return PixelGuide{};
+  return GuideFromHit(cr, h, wantTau, counts);
+}
+
+void Integrator::GuideRow(int y, int x0, int x1, bool wantTau, RayCounts* counts, PixelGuide* out) const {
+  const size_t n = size_t(std::max(0, x1 - x0));
+  std::vector<CameraRay> rays(n);
+  std::vector<Vec3> dirs(n);
+  for (size_t i = 0; i < n; ++i) {
+    rays[i] = camera_.Generate(x0 + int(i), y);
+    dirs[i] = rays[i].dir;
+  }
+  std::vector<SurfaceHit> hits(n);
+  std::vector<uint8_t> found(n);
+  if (n > 0) bvh_.IntersectCoherent(rays[0].origin, dirs, hits, found);
+  counts->guide += uint64_t(n);
+  for (size_t i = 0; i < n; ++i) out[i] = found[i] ? GuideFromHit(rays[i], hits[i], wantTau, counts) : PixelGuide{};
+}
+
+PixelGuide Integrator::GuideFromHit(const CameraRay& cr, SurfaceHit h, bool wantTau, RayCounts* counts) const {
+  PixelGuide g;
   if (wantTau && h.light < 0) {
     const Material& m = materials_[size_t(objectMaterial_[size_t(h.object)])];
     if (m.diffuse()) {

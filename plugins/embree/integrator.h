@@ -80,6 +80,9 @@ class Integrator {
   /// Object ID, shader ID (through mirror chains: IDs of the whole chain) and
   /// tau of working pixel (x, y); `tau` only when `wantTau`.
   PixelGuide Guide(int x, int y, bool wantTau, RayCounts* counts) const;
+  /// Guide() of the pixels [x0, x1) of row y into out[0 .. x1-x0), the
+  /// primary rays traced as one coherent stream: the same guides, faster.
+  void GuideRow(int y, int x0, int x1, bool wantTau, RayCounts* counts, PixelGuide* out) const;
 
  private:
   struct Quality;
@@ -89,6 +92,8 @@ class Integrator {
     RGB constant;  ///< glossy, mirror: not multiplied by the albedo
   };
 
+  /// The guides of a primary ray `cr` that hit `h` (mirror chains followed).
+  PixelGuide GuideFromHit(const CameraRay& cr, SurfaceHit h, bool wantTau, RayCounts* counts) const;
   Shading Shade(const SurfaceHit& h, Vec3 wo, const Material& m, const Quality& q,
                 const Differentials* diff, Pcg32& rng, RayCounts* counts) const;
   /// Radiance leaving `h` towards -dir, emission excluded.

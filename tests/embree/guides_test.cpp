@@ -125,6 +125,44 @@ TEST(Guides, SubRegionMatchesFullImage) {
       ASSERT_EQ(part.objectId[size_t(region.offset({x, y}))], full.objectId[size_t(full.region.offset({x, y}))]);
 }
 
+// Guides() traces each row's primary rays as one coherent stream (Embree
+// packets); the result is that of tracing every pixel's ray alone, to the
+// bit: IDs through a mirror chain, and tau of an image-free procedural
+// texture filtered with the ray differentials.
+TEST(Guides, CoherentRowsEqualRayByRay) {
+  const std::string textured = R"({
+    "camera": {"position": [0, 2.2, 3.2], "look_at": [0, 0.3, 0], "fov": 40, "resolution": [48, 40]},
+    "render": {"shadow_rays": 1, "mirror_depth": 2},
+    "materials": {
+      "floor": {"type": "diffuse", "texture": {"type": "planks", "plank_length": 0.5, "plank_width": 0.1}},
+      "mirror": {"type": "mirror"},
+      "ball": {"type": "diffuse", "texture": {"type": "checker", "scale": 8}}
+    },
+    "objects": [
+      {"type": "quad", "material": "floor", "origin": [-3, 0, 3], "edge_u": [6, 0, 0], "edge_v": [0, 0, -6]},
+      {"type": "quad", "material": "mirror", "origin": [-1, 0, -1], "edge_u": [2, 0, 0], "edge_v": [0, 1.5, 0]},
+      {"type": "sphere", "material": "ball", "center": [0.3, 0.4, 0.2], "radius": 0.4}
+    ],
+    "lights": [{"type": "point", "position": [0, 3, 1], "intensity": 5}]
+  })";
+  for (const std::string& scene : {MirrorScene(R"({"type": "mirror"})"), textured}) {
+    auto p = MakeProvider(scene);
+    ASSERT_TRUE(p);
+    const GuideImage g = AllGuides(*p);
+    int hits = 0;
+    for (int y = 0; y < p->workHeight(); ++y)
+      for (int x = 0; x < p->workWidth(); ++x) {
+        const size_t i = size_t(g.region.offset({x, y}));
+        const PixelGuide one = p->GuidePixel(x, y, /*wantTau=*/true);
+        ASSERT_EQ(g.objectId[i], one.objectId) << x << "," << y;
+        ASSERT_EQ(g.shaderId[i], one.shaderId) << x << "," << y;
+        for (int c = 0; c < 3; ++c) ASSERT_EQ(g.texture[i][c], one.tau[c]) << x << "," << y;
+        hits += one.objectId != 0;
+      }
+    EXPECT_GT(hits, p->workWidth() * p->workHeight() / 2);
+  }
+}
+
 TEST(Guides, ObjectsAndBackgroundAtKnownPixels) {
   // Looking straight down at a floor quad (id 5) spanning x,z in [-1, 1] with
   // a box (id 6) in the middle; the corners of the view miss the floor.
