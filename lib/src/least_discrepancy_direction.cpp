@@ -14,6 +14,64 @@ double SquaredDifference(const Value& p, const Value& q) {
   }
   return s;
 }
+
+/// The term of one pair: |L(p) - L(p')|^2, in units of its variance when the
+/// samples carry one. `kOnlyA`: no split and no variance, so the second
+/// channel and the variances are zero and left out (the same sums: adding
+/// zeros changes no bit).
+template <bool kOnlyA>
+double PairTerm(const Value& v, const Value& e0, const Value& e1, double w1) {
+  if constexpr (kOnlyA) {
+    double s = 0;
+    for (int c = 0; c < 3; ++c) {
+      double a = 0;  // WeightedSum's arithmetic
+      a += (1 - w1) * e0.a[c];
+      a += w1 * e1.a[c];
+      const double d = double(v.a[c]) - float(a);
+      s += d * d;
+    }
+    return s;
+  } else {
+    const Value* ends[2] = {&e0, &e1};
+    const double weights[2] = {1 - w1, w1};
+    const Value predicted = WeightedSum(ends, weights, 2);
+    // With noisy samples, each difference counts in units of its own
+    // standard deviation (a chi-square): noisy pairs do not outvote clean
+    // ones, and a direction along which only noise differs scores ~1.
+    const double var = double(v.varA) + v.varB + predicted.varA + predicted.varB;
+    return var > 0 ? SquaredDifference(v, predicted) / var : SquaredDifference(v, predicted);
+  }
+}
+
+template <bool kOnlyA>
+DirectionChoice Search(std::span<const Value> value, std::span<const uint8_t> finite, bool allFinite,
+                       const BorderPairs& pairs) {
+  auto valid = [&](const BorderPairs::Pair& q) {
+    return allFinite || (finite[size_t(q.p)] && finite[size_t(q.e0)] && finite[size_t(q.e1)]);
+  };
+  DirectionChoice best{0, std::numeric_limits<double>::infinity()};
+  for (int k = 0; k < pairs.directions(); ++k) {
+    const std::span<const BorderPairs::Pair> all = pairs.Of(k);
+    int count = 0;
+    for (const BorderPairs::Pair& q : all) count += valid(q);
+    if (count == 0) continue;
+    // The sum only grows: once its mean over all `count` pairs reaches the
+    // best so far, this direction cannot win (ties go to the smaller k), and
+    // the rest of its pairs are skipped. The choice is that of the full sums.
+    double sum = 0;
+    int done = 0;
+    for (const BorderPairs::Pair& q : all) {
+      if (!valid(q)) continue;
+      sum += PairTerm<kOnlyA>(value[size_t(q.p)], value[size_t(q.e0)], value[size_t(q.e1)], q.w1);
+      if ((++done & 7) == 0 && sum / count >= best.discrepancy) break;
+    }
+    if (done < count) continue;
+    const double mean = sum / count;
+    if (mean < best.discrepancy) best = {k, mean};
+  }
+  if (!std::isfinite(best.discrepancy)) best = {0, 0};
+  return best;
+}
 }  // namespace
 
 BorderPairs::BorderPairs(int width, int height, int directions)
@@ -51,39 +109,8 @@ DirectionChoice LeastDiscrepancyDirection(const SampleStore& store, std::span<co
     allFinite = allFinite && finite[i];
     value[i] = store.ValueAt(index);
   }
-  auto valid = [&](const BorderPairs::Pair& q) {
-    return allFinite || (finite[size_t(q.p)] && finite[size_t(q.e0)] && finite[size_t(q.e1)]);
-  };
-  DirectionChoice best{0, std::numeric_limits<double>::infinity()};
-  for (int k = 0; k < pairs.directions(); ++k) {
-    const std::span<const BorderPairs::Pair> all = pairs.Of(k);
-    int count = 0;
-    for (const BorderPairs::Pair& q : all) count += valid(q);
-    if (count == 0) continue;
-    // The sum only grows: once its mean over all `count` pairs reaches the
-    // best so far, this direction cannot win (ties go to the smaller k), and
-    // the rest of its pairs are skipped. The choice is that of the full sums.
-    double sum = 0;
-    int done = 0;
-    for (const BorderPairs::Pair& q : all) {
-      if (!valid(q)) continue;
-      const Value* ends[2] = {&value[size_t(q.e0)], &value[size_t(q.e1)]};
-      const double weights[2] = {1 - q.w1, q.w1};
-      const Value& v = value[size_t(q.p)];
-      const Value predicted = WeightedSum(ends, weights, 2);
-      // With noisy samples, each difference counts in units of its own
-      // standard deviation (a chi-square): noisy pairs do not outvote clean
-      // ones, and a direction along which only noise differs scores ~1.
-      const double var = double(v.varA) + v.varB + predicted.varA + predicted.varB;
-      sum += var > 0 ? SquaredDifference(v, predicted) / var : SquaredDifference(v, predicted);
-      if ((++done & 7) == 0 && sum / count >= best.discrepancy) break;
-    }
-    if (done < count) continue;
-    const double mean = sum / count;
-    if (mean < best.discrepancy) best = {k, mean};
-  }
-  if (!std::isfinite(best.discrepancy)) best = {0, 0};
-  return best;
+  return store.split() || store.hasVariance() ? Search<false>(value, finite, allFinite, pairs)
+                                               : Search<true>(value, finite, allFinite, pairs);
 }
 
 DirectionChoice LeastDiscrepancyDirection(const SampleStore& store, const Block& b,

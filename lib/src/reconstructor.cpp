@@ -364,7 +364,11 @@ Status Engine::EvaluateBordersAdaptively(const std::vector<Block>& edges) {
   struct Side {
     Point2i a, step;
     int length;  // pixels - 1
-    auto key() const { return std::tuple(a.y, a.x, step.y, step.x, length); }
+    uint64_t key;  ///< (start pixel, vertical, length) in one integer
+  };
+  // Images have at most 2^30 pixels, sides at most 256 steps (Validate()).
+  auto side = [&](Point2i a, Point2i step, int length) {
+    return Side{a, step, length, (uint64_t(store_.Index(a.x, a.y)) << 10) | (uint64_t(step.y) << 9) | uint64_t(length)};
   };
   std::vector<Side> sides;
   for (const Block& b : edges) {
@@ -373,13 +377,13 @@ Status Engine::EvaluateBordersAdaptively(const std::vector<Block>& edges) {
         for (int x = b.x0; x <= b.x1; ++x) store_.Request(x, y, SampleReason::kBorder);
       continue;
     }
-    sides.push_back({{b.x0, b.y0}, {1, 0}, b.x1 - b.x0});
-    sides.push_back({{b.x0, b.y1}, {1, 0}, b.x1 - b.x0});
-    sides.push_back({{b.x0, b.y0}, {0, 1}, b.y1 - b.y0});
-    sides.push_back({{b.x1, b.y0}, {0, 1}, b.y1 - b.y0});
+    sides.push_back(side({b.x0, b.y0}, {1, 0}, b.x1 - b.x0));
+    sides.push_back(side({b.x0, b.y1}, {1, 0}, b.x1 - b.x0));
+    sides.push_back(side({b.x0, b.y0}, {0, 1}, b.y1 - b.y0));
+    sides.push_back(side({b.x1, b.y0}, {0, 1}, b.y1 - b.y0));
   }
-  std::sort(sides.begin(), sides.end(), [](const Side& l, const Side& r) { return l.key() < r.key(); });
-  sides.erase(std::unique(sides.begin(), sides.end(), [](const Side& l, const Side& r) { return l.key() == r.key(); }),
+  std::sort(sides.begin(), sides.end(), [](const Side& l, const Side& r) { return l.key < r.key; });
+  sides.erase(std::unique(sides.begin(), sides.end(), [](const Side& l, const Side& r) { return l.key == r.key; }),
               sides.end());
   auto index = [&](const Side& s, int k) { return store_.Index(s.a.x + k * s.step.x, s.a.y + k * s.step.y); };
   const SurfaceTest& surf = store_.surfaces();
@@ -674,8 +678,11 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
   out->image = BoxDownsample(out->workImage, W, H, opt_.downsample, &out->width, &out->height);
   RecordLeaves(out);
   stats_.totalPixels = int64_t(W) * H;
-  for (SampleReason r : out->sampleMap) ++stats_.byReason[size_t(r)];
-  stats_.exactPixels = stats_.totalPixels - stats_.byReason[size_t(SampleReason::kInterpolated)];
+  // Flush() counted the exact pixels by reason as it made them exact.
+  stats_.exactPixels = 0;
+  for (size_t r = 0; r < stats_.byReason.size(); ++r)
+    if (r != size_t(SampleReason::kInterpolated)) stats_.exactPixels += stats_.byReason[r];
+  stats_.byReason[size_t(SampleReason::kInterpolated)] = stats_.totalPixels - stats_.exactPixels;
   const double total = std::chrono::duration<double>(Clock::now() - tStart).count();
   stats_.timeEngineS = std::max(0.0, total - stats_.timeProviderS - stats_.timeGuidesS);
   out->stats = stats_;

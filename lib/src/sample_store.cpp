@@ -161,6 +161,7 @@ Status SampleStore::Flush(SampleProvider& provider, const SampleRequest& what, i
     const int64_t i = Index(pixels[k].x, pixels[k].y);
     const ExactSample& s = samples[k];
     reason_[i] = reasons[k];
+    ++stats->byReason[size_t(reasons[k])];
     out_[i] = s.L;
     if (split_) {
       a_[i] = s.Li;

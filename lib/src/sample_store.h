@@ -127,7 +127,8 @@ class SampleStore {
   }
 
   /// Evaluates every pixel requested since the last flush that is not exact
-  /// yet. On Status::Pending, `pending` receives those pixels.
+  /// yet, counting them by reason in stats->byReason. On Status::Pending,
+  /// `pending` receives those pixels.
   Status Flush(SampleProvider& provider, const SampleRequest& what, int batchSize, bool parallel,
                ReconstructionStats* stats, std::vector<Point2i>* pending);
 
