@@ -156,6 +156,7 @@ struct BoolOption {
 
 constexpr IntOption kIntOptions[] = {
     {"elementary_block", &Options::elementaryBlock},
+    {"noisy_elementary_block", &Options::noisyElementaryBlock},
     {"min_block", &Options::minBlock},
     {"directions", &Options::directions},
     {"fallback_max_changes", &Options::fallbackMaxChanges},

@@ -10,6 +10,7 @@ namespace dcm {
 ReconstructionOptions ReconstructionOptions::Guo() {
   ReconstructionOptions o;
   o.elementaryBlock = 8;  // Guo's and the paper's elementary blocks
+  o.noisyElementaryBlock = 0;
   o.contrastThreshold = 0.06f;
   o.objectTest = ObjectTest::kObjectId;
   o.thinObjects = ThinObjectTest::kOff;
@@ -86,6 +87,9 @@ Status ReconstructionOptions::Validate() const {
   };
   if (!IsPowerOfTwo(elementaryBlock) || elementaryBlock > 256)
     return bad("elementaryBlock", "must be a power of two from 1 to 256, got " + std::to_string(elementaryBlock));
+  if (noisyElementaryBlock != 0 && (!IsPowerOfTwo(noisyElementaryBlock) || noisyElementaryBlock > 256))
+    return bad("noisyElementaryBlock",
+               "must be 0 or a power of two from 1 to 256, got " + std::to_string(noisyElementaryBlock));
   if (!IsPowerOfTwo(minBlock) || minBlock > elementaryBlock)
     return bad("minBlock", "must be a power of two from 1 to elementaryBlock (" + std::to_string(elementaryBlock) +
                                "), got " + std::to_string(minBlock));

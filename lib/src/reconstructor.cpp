@@ -95,10 +95,11 @@ class Engine {
         opt_(opt),
         caps_(caps),
         split_(split),
-        noisy_(caps.variance && opt.noiseSignificance > 0.f),
+        noisy_(NoisySamples(opt, caps)),
+        block_(ElementaryBlock(opt, caps)),
         store_(caps.width, caps.height, split, noisy_),
         contrast_(opt.contrastMetric, opt.contrastThreshold, split, noisy_ ? opt.noiseSignificance : 0.f) {
-    const int blocksPerTile = std::max(1, opt.tileSize / std::max(1, opt.elementaryBlock));
+    const int blocksPerTile = std::max(1, opt.tileSize / std::max(1, block_));
     grain_ = size_t(blocksPerTile) * size_t(blocksPerTile);
     request_.split = split;
     request_.variance = noisy_;
@@ -156,6 +157,7 @@ class Engine {
   ProviderCapabilities caps_;
   bool split_;
   bool noisy_;  ///< samples carry their variance and the tests weigh it
+  int block_;   ///< the elementary block (ReconstructionOptions::ElementaryBlockFor)
   SampleStore store_;
   ContrastTest contrast_;
   SampleRequest request_;
@@ -448,14 +450,14 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
     Progress(0.f, "full evaluation");
     DCM_RETURN_IF_ERROR(Flush());
   } else {
-    std::vector<Block> classify = LatticeBlocks(W, H, opt_.elementaryBlock);
+    std::vector<Block> classify = LatticeBlocks(W, H, block_);
     std::vector<Block> edges;
     int levels = 1;
-    while ((opt_.elementaryBlock >> (levels - 1)) > opt_.minBlock) ++levels;
+    while ((block_ >> (levels - 1)) > opt_.minBlock) ++levels;
     std::vector<Point2i> loopScratch;
 
     for (int level = 0; level < levels && !(classify.empty() && edges.empty()); ++level) {
-      const int size = opt_.elementaryBlock >> level;
+      const int size = block_ >> level;
       const bool finest = level == levels - 1;
       const float f0 = float(level) / float(levels), df = 1.f / float(levels);
       std::vector<Block> nextClassify, nextEdges;
@@ -658,7 +660,7 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
       // Averaging what the noise explains: the gate is wider than the
       // detection's significance (which errs towards refining), 2 sd at least.
       stats_.denoisedSamples =
-          DenoiseExactSamples(store_, DenoiseRadius(opt_), contrast_, std::max(opt_.noiseSignificance, 2.f));
+          DenoiseExactSamples(store_, DenoiseRadius(opt_, caps_), contrast_, std::max(opt_.noiseSignificance, 2.f));
       Progress(0.95f, "interpolation");
       ForEach(smoothLeaves_, [&](Leaf& l, size_t) { WriteSmooth(l); });
       ForEach(orientedLeaves_, [&](Leaf& l, size_t) { InterpolateOriented(l, OrientedPass::kFinal); });

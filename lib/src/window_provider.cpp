@@ -93,8 +93,8 @@ int RegionHaloBlocks(const ReconstructionOptions& options, const ProviderCapabil
   // within the denoising radius, whose state depends on the blocks they lie
   // in: as many more blocks as the radius spans.
   if (!detail::DenoisesSamples(options, caps)) return 1;
-  const int block = std::max(1, options.elementaryBlock);
-  return 1 + (detail::DenoiseRadius(options) + block - 1) / block;
+  const int block = std::max(1, detail::ElementaryBlock(options, caps));
+  return 1 + (detail::DenoiseRadius(options, caps) + block - 1) / block;
 }
 
 Point2i OutputSize(int workWidth, int workHeight, int downsample) {
@@ -140,7 +140,7 @@ Status ReconstructRegion(SampleProvider& provider, const ReconstructionOptions& 
   const Bounds2i work = WorkRegion(outputRegion, caps.width, caps.height, s);
   if (haloBlocks < 0) haloBlocks = RegionHaloBlocks(options, caps);
   const Bounds2i window =
-      RegionWindow(outputRegion, caps.width, caps.height, s, options.elementaryBlock, haloBlocks);
+      RegionWindow(outputRegion, caps.width, caps.height, s, detail::ElementaryBlock(options, caps), haloBlocks);
 
   WindowProvider windowed(provider, window);
   DCM_RETURN_IF_ERROR(windowed.Validate());

@@ -377,12 +377,14 @@ int EvaluateNoisy(void* user, const int* xy, int count, float* rgb, float* li, f
 TEST(CApi, NoisySampleFunctionReportsVariance) {
   // With the variance reported, the engine does not chase the noise: fewer
   // exact pixels than with the noise taken at face value (noise_significance
-  // 0), on the same samples.
+  // 0), on the same samples and the same lattice (noisy_elementary_block 0:
+  // the 16-pixel blocks of noiseless samples for both).
   auto exactPixels = [](float significance, bool* sawVariance) {
     NoisyScene scene;
     DCMReconstructor r = Make(scene);
     dcmSetNoisySampleFunction(r, EvaluateNoisy, &scene, DCM_SAMPLE_THREAD_SAFE);
     dcmSetFloat(r, "noise_significance", significance);
+    dcmSetInt(r, "noisy_elementary_block", 0);
     EXPECT_FLOAT_EQ(dcmGetFloat(r, "noise_significance"), significance);
     EXPECT_EQ(dcmExecute(r), DCM_ERROR_NONE) << TakeError(r);
     *sawVariance = scene.sawVarianceBuffer;

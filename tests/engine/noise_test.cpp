@@ -3,6 +3,7 @@
 // and the exact samples are denoised before they are interpolated.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -42,8 +43,13 @@ ReconstructionOptions Significance(float k) {
 TEST(Noise, ZeroVarianceChangesNothing) {
   // A provider that reports a variance of zero everywhere must give the
   // noiseless result bit for bit: the noise terms vanish, nothing else moves.
+  // (A provider that reports variance gets the lattice of noisy samples,
+  // noisyElementaryBlock, before any sample is seen: the noiseless run uses
+  // the same lattice.)
   AnalyticProvider plain(kSize, kSize, FurnishedScene(kSize, kSize));
-  const Reconstruction expected = ReconstructOrFail(plain, {});
+  ReconstructionOptions sameLattice;
+  sameLattice.elementaryBlock = sameLattice.noisyElementaryBlock;
+  const Reconstruction expected = ReconstructOrFail(plain, sameLattice);
   const Outcome zero = ReconstructNoisy({0.f, 0.f});
   ASSERT_EQ(zero.r.workImage.size(), expected.workImage.size());
   for (size_t i = 0; i < expected.workImage.size(); ++i) {
@@ -72,12 +78,14 @@ TEST(Noise, SignificanceSamplesAtTheNoiselessRate) {
 
 TEST(Noise, DefaultSignificanceSamplesFarLessThanTheLiteralTests) {
   // The default (0.5 sd) errs towards refining, to keep faint features, yet
-  // spends at most 60 % of the samples the literal tests spend (measured:
-  // 30-50 %) at every noise level.
+  // spends at most 60 % of the samples the literal tests spend on the same
+  // lattice (measured: 30-50 %) at every noise level.
   for (float rel : {0.05f, 0.1f, 0.2f}) {
     const NoiseModel m{rel, 0.01f};
     const double aware = ReconstructNoisy(m).r.stats.exactFraction();
-    const double literal = ReconstructNoisy(m, Significance(0.f)).r.stats.exactFraction();
+    ReconstructionOptions literalOptions = Significance(0.f);
+    literalOptions.elementaryBlock = literalOptions.noisyElementaryBlock;
+    const double literal = ReconstructNoisy(m, literalOptions).r.stats.exactFraction();
     EXPECT_LE(aware, 0.6 * literal) << "relative noise " << rel;
   }
 }
@@ -93,6 +101,26 @@ TEST(Noise, CloserToTheTruthThanTheNoisyFullRender) {
     EXPECT_GE(dcm.psnr, NoisyFullPsnr(m) + 1.0) << "relative noise " << rel;
     EXPECT_LE(dcm.r.stats.exactFraction(), 0.35);
   }
+}
+
+TEST(Noise, NoisySamplesGetTheNoisyLattice) {
+  // Default options on noisy samples: the 8-pixel lattice of
+  // noisyElementaryBlock, bit for bit the run with elementaryBlock = 8, and
+  // not the 16-pixel lattice of noiseless samples.
+  const NoiseModel m{0.1f, 0.01f};
+  const Outcome byDefault = ReconstructNoisy(m);
+  ReconstructionOptions eight, sixteen;
+  eight.elementaryBlock = 8, eight.noisyElementaryBlock = 0;
+  sixteen.noisyElementaryBlock = 0;
+  const Outcome explicitEight = ReconstructNoisy(m, eight), noiselessLattice = ReconstructNoisy(m, sixteen);
+  ASSERT_EQ(byDefault.r.workImage.size(), explicitEight.r.workImage.size());
+  for (size_t i = 0; i < byDefault.r.workImage.size(); ++i)
+    ASSERT_EQ(byDefault.r.workImage[i], explicitEight.r.workImage[i]) << "pixel " << i;
+  EXPECT_NE(byDefault.r.stats.exactPixels, noiselessLattice.r.stats.exactPixels);
+  int widest = 0;  // of the level-0 leaves: 8 pixel steps (x1 - x0), 7 where clipped
+  for (const auto& b : byDefault.r.blocks)
+    if (b.level == 0) widest = std::max(widest, b.x1 - b.x0);
+  EXPECT_EQ(widest, 8);
 }
 
 TEST(Noise, DenoisingTheSamplesPaysOff) {

@@ -27,6 +27,7 @@ double Decimal(float v) {
 nlohmann::json OptionsToJson(const ReconstructionOptions& o) {
   nlohmann::json j;
   j["elementary_block"] = o.elementaryBlock;
+  j["noisy_elementary_block"] = o.noisyElementaryBlock;
   j["min_block"] = o.minBlock;
   j["contrast_threshold"] = Decimal(o.contrastThreshold);
   j["contrast_metric"] = std::string(ToString(o.contrastMetric));

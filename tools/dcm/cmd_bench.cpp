@@ -298,6 +298,7 @@ std::vector<Config> SweepConfigs(const BenchFlags& f, const Subject& s) {
   for (int b : blocks) {
     Config c = base("dcm");
     c.options.elementaryBlock = b;
+    c.options.noisyElementaryBlock = 0;  // the swept block, noisy or not
     c.options.minBlock = std::min(c.options.minBlock, b);
     c.label = "dcm block=" + std::to_string(b);
     c.sweeps = "block";

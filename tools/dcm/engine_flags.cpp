@@ -12,7 +12,7 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
   app->add_option("--method", f->method, "dcm (default), paper (Scheel et al. 2001) or guo (Guo 1998)")
       ->check(CLI::IsMember({"dcm", "paper", "guo"}));
   app->add_option("--threshold", f->threshold, "contrast threshold of the smooth/edge test (default 0.15; paper|guo: 0.06)");
-  app->add_option("--block", f->block, "elementary block size (power of two; default 16, --method paper|guo: 8)");
+  app->add_option("--block", f->block, "elementary block size (power of two; default 16, 8 with noisy samples; --method paper|guo: 8)");
   app->add_option("--min-block", f->minBlock, "finest block size (power of two, default 4)");
   app->add_option("--directions", f->directions, "candidate directions of the least-discrepancy search (default 8)");
   app->add_flag("--no-thin", f->noThin, "switch off the thin-object test (paper 3.1)");
@@ -48,7 +48,7 @@ Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {
   else if (f.method == "guo") *o = ReconstructionOptions::Guo();
   else *o = ReconstructionOptions{};
   if (f.threshold >= 0) o->contrastThreshold = f.threshold;
-  if (f.block) o->elementaryBlock = f.block;
+  if (f.block) o->elementaryBlock = f.block, o->noisyElementaryBlock = 0;  // with noisy samples too
   if (f.minBlock) o->minBlock = f.minBlock;
   if (f.directions) o->directions = f.directions;
   if (f.noThin) o->thinObjects = ThinObjectTest::kOff;

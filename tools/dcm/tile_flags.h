@@ -47,9 +47,11 @@ bool HasFramePattern(const std::string& name);
 /// length (room.####.exr, 7 -> room.0007.exr; longer numbers are not cut).
 std::string ExpandFrame(const std::string& pattern, int frame);
 
-/// The elementary block in output pixels: the tile alignment.
+/// The elementary block in output pixels: the tile alignment (the larger of
+/// the noisy and the noiseless block: whether the samples are noisy is known
+/// only once the provider is).
 inline int TileAlignment(const ReconstructionOptions& o) {
-  return std::max(1, o.elementaryBlock / std::max(1, o.downsample));
+  return std::max(1, o.LargestElementaryBlock() / std::max(1, o.downsample));
 }
 
 /// The attributes of a part (tile, region, fingerprint, settings, the counts
