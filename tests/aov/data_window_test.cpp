@@ -141,18 +141,27 @@ TEST(DataWindow, InputsWithDifferentWindowsFail) {
   EXPECT_FALSE(std::filesystem::exists(dir / "out.exr"));
 }
 
-TEST(DataWindow, DownsampleNeedsTheLattice) {
-  ScratchDir dir;
+/// A 32x32 image placed at `origin` of a 64x64 frame, reconstructed with
+/// `flags`: a usage error (exit 2) with `message`, and no output.
+void ExpectUsageError(const ScratchDir& dir, Point2i origin, const std::vector<std::string>& flags,
+                      const std::string& message) {
   Scene sc{32, 32};
   WriteExr(dir / "whole.exr", 32, 32, sc.GenericChannels(false));
-  Reframe(dir / "whole.exr", dir / "placed.exr", {3, 8}, OIIO::ROI(0, 64, 0, 64));
-  auto r = RunDcm({"reconstruct", dir / "placed.exr", "--downsample", "2", "-o", dir / "out.exr"}, dir);
+  Reframe(dir / "whole.exr", dir / "placed.exr", origin, OIIO::ROI(0, 64, 0, 64));
+  std::vector<std::string> args = {"reconstruct", dir / "placed.exr", "-o", dir / "out.exr"};
+  args.insert(args.end(), flags.begin(), flags.end());
+  auto r = RunDcm(args, dir);
   EXPECT_EQ(r.exitCode, 2);
-  EXPECT_THAT(r.err, HasSubstr("--downsample 2: the inputs' data window (3,8,32,32)"));
+  EXPECT_THAT(r.err, HasSubstr(message));
   EXPECT_FALSE(std::filesystem::exists(dir / "out.exr"));
+}
+
+TEST(DataWindow, DownsampleNeedsTheLattice) {
+  ScratchDir dir;
+  ExpectUsageError(dir, {3, 8}, {"--downsample", "2"}, "--downsample 2: the inputs' data window (3,8,32,32)");
   // On the lattice, the output is the region of the half-size frame.
   Reframe(dir / "whole.exr", dir / "placed.exr", {4, 8}, OIIO::ROI(0, 64, 0, 64));
-  r = RunDcm({"reconstruct", dir / "placed.exr", "--downsample", "2", "-o", dir / "out.exr", "--quiet"}, dir);
+  auto r = RunDcm({"reconstruct", dir / "placed.exr", "--downsample", "2", "-o", dir / "out.exr", "--quiet"}, dir);
   ASSERT_EQ(r.exitCode, 0) << r.err;
   const OIIO::ImageSpec s = SpecOf(dir / "out.exr");
   EXPECT_EQ(s.x, 2);
@@ -163,13 +172,8 @@ TEST(DataWindow, DownsampleNeedsTheLattice) {
 
 TEST(DataWindow, TilesNeedTheWholeFrame) {
   ScratchDir dir;
-  Scene sc{32, 32};
-  WriteExr(dir / "whole.exr", 32, 32, sc.GenericChannels(false));
-  Reframe(dir / "whole.exr", dir / "placed.exr", {8, 8}, OIIO::ROI(0, 64, 0, 64));
-  auto r = RunDcm({"reconstruct", dir / "placed.exr", "--tile", "1/2", "-o", dir / "out.exr"}, dir);
-  EXPECT_EQ(r.exitCode, 2);
-  EXPECT_THAT(r.err, HasSubstr("--tile and --region need inputs whose data window is their display window"));
-  EXPECT_FALSE(std::filesystem::exists(dir / "out.exr"));
+  ExpectUsageError(dir, {8, 8}, {"--tile", "1/2"},
+                   "--tile and --region need inputs whose data window is their display window");
 }
 
 }  // namespace
