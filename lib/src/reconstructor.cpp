@@ -245,6 +245,19 @@ bool Engine::IsSmooth(const Block& b) const {
 SampleReason Engine::Resolve(Point2i q, Interpolant* in) const {
   const int64_t iq = store_.Index(q.x, q.y);
   const SurfaceTest& s = store_.surfaces();
+  // The common case: every interpolant is finite and on q's surface, so it is
+  // used as it is (what the general case below would keep, in its order).
+  bool allUsable = in->count > 0;
+  for (int k = 0; k < in->count && allUsable; ++k) {
+    const int64_t i = in->index[k];
+    allUsable = store_.IsFinite(i) && store_.LiKnownFor(i, iq) && s.Same(iq, i);
+  }
+  if (allUsable) {
+    double sum = 0;
+    for (int k = 0; k < in->count; ++k) sum += in->weight[k];
+    for (int k = 0; k < in->count; ++k) in->weight[k] /= sum;
+    return SampleReason::kInterpolated;
+  }
   bool anyOther = false, anySame = false;
   Interpolant kept;
   Interpolant finite;
