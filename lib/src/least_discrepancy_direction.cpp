@@ -99,9 +99,12 @@ BorderPairs::BorderPairs(int width, int height, int directions)
 
 DirectionChoice LeastDiscrepancyDirection(const SampleStore& store, std::span<const Point2i> border,
                                           const BorderPairs& pairs) {
-  // The border's samples, read once for all directions.
-  std::vector<Value> value(border.size());
-  std::vector<uint8_t> finite(border.size());
+  // The border's samples, read once for all directions (into per-thread
+  // scratch: blocks are searched in parallel, thousands per level).
+  thread_local std::vector<Value> value;
+  thread_local std::vector<uint8_t> finite;
+  value.resize(border.size());
+  finite.resize(border.size());
   bool allFinite = true;
   for (size_t i = 0; i < border.size(); ++i) {
     const int64_t index = store.Index(border[i].x, border[i].y);
@@ -109,8 +112,9 @@ DirectionChoice LeastDiscrepancyDirection(const SampleStore& store, std::span<co
     allFinite = allFinite && finite[i];
     value[i] = store.ValueAt(index);
   }
-  return store.split() || store.hasVariance() ? Search<false>(value, finite, allFinite, pairs)
-                                               : Search<true>(value, finite, allFinite, pairs);
+  const std::span<const Value> v(value);
+  const std::span<const uint8_t> f(finite);
+  return store.split() || store.hasVariance() ? Search<false>(v, f, allFinite, pairs) : Search<true>(v, f, allFinite, pairs);
 }
 
 DirectionChoice LeastDiscrepancyDirection(const SampleStore& store, const Block& b,

@@ -6,15 +6,15 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
-#include <atomic>
-#include <tuple>
 #include <chrono>
-#include <map>
 #include <cmath>
+#include <map>
 #include <string>
+#include <tuple>
 
 #include "block.h"
 #include "contrast_test.h"
@@ -304,6 +304,7 @@ void Engine::WriteSmooth(const Leaf& leaf) {
   }
   const double sx = b.x1 > b.x0 ? 1.0 / (b.x1 - b.x0) : 0.0, sy = b.y1 > b.y0 ? 1.0 / (b.y1 - b.y0) : 0.0;
   const int channels = split_ ? 6 : 3;
+  const bool onlyL = !split_ && !store_.hasVariance();
   for (int y = b.y0; y <= ye; ++y) {
     const double v = (y - b.y0) * sy;
     double left[6], right[6];
@@ -315,6 +316,12 @@ void Engine::WriteSmooth(const Leaf& leaf) {
       const int64_t i = store_.Index(x, y);
       if (store_.IsExact(i) || store_.IsFilled(i)) continue;
       const double u = (x - b.x0) * sx;
+      if (onlyL) {
+        store_.SetInterpolatedL(i, RGB(float(u == 0 ? left[0] : (1 - u) * left[0] + u * right[0]),
+                                       float(u == 0 ? left[1] : (1 - u) * left[1] + u * right[1]),
+                                       float(u == 0 ? left[2] : (1 - u) * left[2] + u * right[2])));
+        continue;
+      }
       Value out;
       for (int ch = 0; ch < channels; ++ch) {
         const float f = float(u == 0 ? left[ch] : (1 - u) * left[ch] + u * right[ch]);
@@ -397,7 +404,7 @@ Status Engine::EvaluateBordersAdaptively(const std::vector<Block>& edges) {
     sides.push_back(side({b.x0, b.y0}, {0, 1}, b.y1 - b.y0));
     sides.push_back(side({b.x1, b.y0}, {0, 1}, b.y1 - b.y0));
   }
-  std::sort(sides.begin(), sides.end(), [](const Side& l, const Side& r) { return l.key < r.key; });
+  tbb::parallel_sort(sides.begin(), sides.end(), [](const Side& l, const Side& r) { return l.key < r.key; });
   sides.erase(std::unique(sides.begin(), sides.end(), [](const Side& l, const Side& r) { return l.key == r.key; }),
               sides.end());
   auto index = [&](const Side& s, int k) { return store_.Index(s.a.x + k * s.step.x, s.a.y + k * s.step.y); };
@@ -411,10 +418,14 @@ Status Engine::EvaluateBordersAdaptively(const std::vector<Block>& edges) {
         for (int j : {k, k + 1}) store_.Request(s.a.x + j * s.step.x, s.a.y + j * s.step.y, SampleReason::kBorder);
   });
   DCM_RETURN_IF_ERROR(Flush());
-  // Bisect every gap whose known ends differ, until none is left.
+  // Bisect every gap whose known ends differ, until none is left. A side
+  // that asked for nothing in a round has nothing new in the next (sides
+  // share only their ends, exact since round 0): only the others are read.
+  std::vector<uint8_t> active(sides.size(), 1);
   for (;;) {
-    std::atomic<int64_t> requested{0};
-    ForEach(sides, [&](Side& s, size_t) {
+    ForEach(sides, [&](Side& s, size_t i) {
+      if (!active[i]) return;
+      active[i] = 0;
       int last = 0;
       for (int k = 1; k <= s.length; ++k) {
         if (!store_.IsExact(index(s, k))) continue;
@@ -423,12 +434,12 @@ Status Engine::EvaluateBordersAdaptively(const std::vector<Block>& edges) {
             (!usable || contrast_.Differ(store_.ValueAt(index(s, last)), store_.ValueAt(index(s, k))))) {
           const int mid = (last + k) / 2;
           store_.Request(s.a.x + mid * s.step.x, s.a.y + mid * s.step.y, SampleReason::kBorder);
-          ++requested;
+          active[i] = 1;
         }
         last = k;
       }
     });
-    if (requested == 0) break;
+    if (std::find(active.begin(), active.end(), uint8_t(1)) == active.end()) break;
     DCM_RETURN_IF_ERROR(Flush());
   }
   // Fill the gaps along the side from known pixels of the same surface.

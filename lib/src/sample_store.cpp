@@ -1,6 +1,7 @@
 #include "sample_store.h"
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -113,7 +114,7 @@ Status SampleStore::Flush(SampleProvider& provider, const SampleRequest& what, i
   if (keys.empty()) return Status::Ok();
   // Sorted by pixel, then by reason: the first key of each pixel carries the
   // reason of highest priority, whatever order the requests came in.
-  std::sort(keys.begin(), keys.end());
+  tbb::parallel_sort(keys.begin(), keys.end());
   std::vector<Point2i> pixels;
   std::vector<SampleReason> reasons;
   pixels.reserve(keys.size());

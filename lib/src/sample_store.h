@@ -108,6 +108,11 @@ class SampleStore {
 
   /// Writes an interpolated value (never over an exact pixel).
   void SetInterpolated(int64_t i, const Value& v);
+  /// SetInterpolated() of L alone, for a store without the split and without
+  /// variances (the value's other fields would be zero).
+  void SetInterpolatedL(int64_t i, RGB L) {
+    if (!IsExact(i)) out_[i] = L;
+  }
   /// Writes a value filled along an edge-block border; block interiors then
   /// interpolate it, and smooth blocks leave it in place.
   void SetFilled(int64_t i, const Value& v) {
