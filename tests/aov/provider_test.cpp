@@ -404,7 +404,13 @@ void AddCrypto(std::vector<TestChannel>* ch, Attributes* attrs, const std::strin
   for (size_t i = 0; i < manifest.size(); ++i) {
     char hex[16];
     std::snprintf(hex, sizeof hex, "%08x", manifest[i].second);
-    json += (i ? "," : "") + std::string("\"") + manifest[i].first + "\":\"" + hex + "\"";
+    // Appends, not "literal" + string: GCC 12 warns falsely (-Wrestrict) on those.
+    if (i) json += ',';
+    json += '"';
+    json += manifest[i].first;
+    json += "\":\"";
+    json += hex;
+    json += '"';
   }
   json += "}";
   attrs->push_back({"cryptomatte/" + key + "/name", name});
