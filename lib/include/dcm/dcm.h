@@ -146,8 +146,10 @@ DCM_API DCMError dcmGetError(DCMReconstructor r, const char** message);
  *  An unknown name or value records DCM_ERROR_INVALID_ARGUMENT. */
 DCM_API void dcmSetString(DCMReconstructor r, const char* name, const char* value);
 
-/** Sets an integer option: "elementary_block", "min_block", "directions",
- *  "fallback_max_changes", "downsample", "threads" (0: all cores),
+/** Sets an integer option: "elementary_block", "noisy_elementary_block" (the
+ *  elementary block with noisy samples, default 8; 0: elementary_block),
+ *  "min_block", "directions", "fallback_max_changes", "downsample",
+ *  "threads" (0: all cores),
  *  "tile_size", "batch_size" (pixels per callback call). Bool options accept
  *  0/1 here too. Ranges are checked by dcmExecute(). */
 DCM_API void dcmSetInt(DCMReconstructor r, const char* name, int value);
