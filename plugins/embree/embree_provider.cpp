@@ -14,6 +14,7 @@ std::vector<std::string> Effects::Names() const {
   if (mirror) n.push_back("mirror");
   if (textures) n.push_back("textures");
   if (indirect) n.push_back("indirect");
+  if (shadowGuide) n.push_back("shadow_guide");
   return n;
 }
 
@@ -74,6 +75,9 @@ Status EmbreeProvider::Create(const Scene& scene, std::unique_ptr<EmbreeProvider
     else fx.areaLights = true;
   }
   fx.indirect = rs.indirectBounces > 0;
+  using SG = RenderSettings::ShadowGuide;
+  fx.shadowGuide = fx.pointLights && (rs.shadowGuide == SG::kOn ||
+                                      (rs.shadowGuide == SG::kAuto && (rs.samplesPerPixel > 1 || fx.indirect)));
   p->effects_ = fx;
 
   DCM_RETURN_IF_ERROR(EmbreeScene::Build(scene, &p->bvh_));
@@ -89,6 +93,7 @@ Status EmbreeProvider::Create(const Scene& scene, std::unique_ptr<EmbreeProvider
   cfg.samplesPerPixel = rs.samplesPerPixel;
   cfg.seed = rs.seed;
   cfg.background = rs.background;
+  cfg.shadowGuide = fx.shadowGuide;
   p->integrator_ = std::make_unique<Integrator>(*p->bvh_, *p->camera_, cfg, std::move(materials), std::move(lights),
                                                 std::move(objectMaterial), std::move(objectId), std::move(lightId));
   *out = std::move(p);

@@ -25,8 +25,9 @@ struct Effects {
   bool mirror = false;        ///< mirror paths (a mirror material and mirror_depth > 0)
   bool textures = false;      ///< a textured material: tau guides and split radiance
   bool indirect = false;      ///< indirect diffuse (render.indirect.bounces > 0)
+  bool shadowGuide = false;   ///< point-light visibility in the guides (render.shadow_guide)
   /// Names of the active effects ("point_lights", "area_lights", "glossy",
-  /// "mirror", "textures", "indirect").
+  /// "mirror", "textures", "indirect", "shadow_guide").
   std::vector<std::string> Names() const;
 };
 

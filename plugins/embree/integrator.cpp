@@ -360,7 +360,18 @@ PixelGuide Integrator::GuideFromHit(const CameraRay& cr, SurfaceHit h, bool want
     objects[n] = objectId_[size_t(h.object)];
     shaders[n] = uint32_t(mat) + 1;
     ++n;
-    if (materials_[size_t(mat)].kind != MaterialKind::kMirror || n > cfg_.mirrorDepth || n >= kMaxChain) break;
+    if (materials_[size_t(mat)].kind != MaterialKind::kMirror || n > cfg_.mirrorDepth || n >= kMaxChain) {
+      // A hard shadow's edge is a surface change, and a shadow thinner than
+      // the lattice a thin object: the lights the surface sees are part of
+      // its identity (the surface shown, at the end of a mirror chain).
+      if (cfg_.shadowGuide) {
+        if (const uint32_t lit = PointLightVisibility(h, counts)) {
+          objects[n - 1] = objects[n - 1] * 2654435761u + lit;
+          shaders[n - 1] = shaders[n - 1] * 2654435761u + lit;
+        }
+      }
+      break;
+    }
     Vec3 next = Normalize(Reflect(dir, h.ns));
     if (Dot(next, h.ng) <= 0.f) break;
     ++counts->guide;
@@ -376,6 +387,23 @@ PixelGuide Integrator::GuideFromHit(const CameraRay& cr, SurfaceHit h, bool want
   g.objectId = ChainId(objects, n);
   g.shaderId = ChainId(shaders, n);
   return g;
+}
+
+uint32_t Integrator::PointLightVisibility(const SurfaceHit& h, RayCounts* counts) const {
+  const Vec3 org = EmbreeScene::Offset(h.p, h.ng);
+  uint32_t lit = 0;
+  for (size_t l = 0; l < lights_.size() && l < 32; ++l) {
+    const Light& light = lights_[l];
+    if (light.kind != LightKind::kPoint) continue;
+    const Vec3 toLight = light.position - org;
+    const float dist = Length(toLight);
+    if (dist <= 0.f) continue;
+    const Vec3 wi = toLight / dist;
+    if (Dot(h.ns, wi) <= 0.f || Dot(h.ng, wi) <= 0.f) continue;
+    ++counts->guide;
+    if (!bvh_.Occluded(org, wi, 0.f, dist * (1.f - 1e-4f))) lit |= 1u << l;
+  }
+  return lit;
 }
 
 }  // namespace dcm::embree

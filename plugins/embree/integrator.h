@@ -61,6 +61,7 @@ struct IntegratorConfig {
   int samplesPerPixel = 1;  ///< independent estimates averaged per pixel
   uint32_t seed = 0;
   RGB background;
+  bool shadowGuide = false;  ///< point-light visibility folded into the guides' IDs
 };
 
 /// Evaluates pixels of the working image. Thread safe: all state is const and
@@ -94,6 +95,9 @@ class Integrator {
 
   /// The guides of a primary ray `cr` that hit `h` (mirror chains followed).
   PixelGuide GuideFromHit(const CameraRay& cr, SurfaceHit h, bool wantTau, RayCounts* counts) const;
+  /// Bit l set when point light l (of the first 32) lights `h`: the same
+  /// shadow ray as DirectLight's (counted as a guide ray).
+  uint32_t PointLightVisibility(const SurfaceHit& h, RayCounts* counts) const;
   Shading Shade(const SurfaceHit& h, Vec3 wo, const Material& m, const Quality& q,
                 const Differentials* diff, Pcg32& rng, RayCounts* counts) const;
   /// Radiance leaving `h` towards -dir, emission excluded.

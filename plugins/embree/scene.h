@@ -129,6 +129,12 @@ struct RenderSettings {
   /// also reports the variance of its mean (a Monte Carlo renderer's "spp").
   int samplesPerPixel = 1;
   uint32_t seed = 0;             ///< changes the per-pixel random streams
+  /// Point-light visibility as a guide: which point lights a pixel's surface
+  /// sees, one shadow ray each, so that hard shadow edges are surface changes
+  /// and thin shadows are found like thin objects. kAuto: when an exact pixel
+  /// is a Monte Carlo estimate (samples_per_pixel > 1 or indirect light),
+  /// where one ray per point light is cheap beside it.
+  enum class ShadowGuide { kAuto, kOn, kOff } shadowGuide = ShadowGuide::kAuto;
   RGB background{0.f, 0.f, 0.f}; ///< radiance of rays that leave the scene
 };
 

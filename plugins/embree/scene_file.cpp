@@ -74,6 +74,14 @@ Status ReadRender(const Json& j, const std::string& file, RenderSettings* s) {
   r.Int("samples_per_pixel", &s->samplesPerPixel, false, 1, 1 << 20);
   r.Uint32("seed", &s->seed, 0, UINT32_MAX);
   r.Color("background", &s->background);
+  if (const Json* g = r.Get("shadow_guide"); g && r.ok()) {
+    if (g->is_boolean())
+      s->shadowGuide = g->get<bool>() ? RenderSettings::ShadowGuide::kOn : RenderSettings::ShadowGuide::kOff;
+    else if (g->is_string() && g->get<std::string>() == "auto")
+      s->shadowGuide = RenderSettings::ShadowGuide::kAuto;
+    else
+      r.Fail("shadow_guide", "expected true, false or \"auto\", got " + TypeName(*g));
+  }
   if (const Json* ind = r.Get("indirect"); ind && r.ok()) {
     FieldReader ri(*ind, r.Path("indirect"), file);
     ri.Int("bounces", &s->indirectBounces, false, 0, 16);

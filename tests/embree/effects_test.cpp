@@ -138,5 +138,55 @@ TEST(Effects, PointLightsOnlyTraceOneShadowRayPerLight) {
   EXPECT_EQ(p->effects().Names(), std::vector<std::string>{"point_lights"});
 }
 
+// The point-light visibility guide (render.shadow_guide): one shadow ray per
+// point light and pixel in the guides, traced only where the scene has point
+// lights, and by default ("auto") only where an exact pixel is a Monte Carlo
+// estimate that costs far more.
+TEST(Effects, ShadowGuideOnlyWithPointLightsAndByDefaultOnlyForMonteCarloPixels) {
+  const char* point = R"({"type": "point", "position": [0, 4, 0], "intensity": 10})";
+  auto guideRays = [](EmbreeProvider& p) {
+    p.ResetRayCounts();
+    GuideImage g;
+    GuideRequest req;
+    req.objectId = req.shaderId = true;
+    EXPECT_TRUE(p.Guides({{0, 0}, {p.workWidth(), p.workHeight()}}, req, &g).ok());
+    return p.rayCounts().guide;
+  };
+  const uint64_t pixels = 32 * 32;
+  struct Case {
+    const char* render;
+    const char* lights;
+    bool on;
+  } cases[] = {
+      {R"({"shadow_rays": 4})", point, false},                                   // one estimate: auto is off
+      {R"({"shadow_rays": 4, "samples_per_pixel": 4})", point, true},            // Monte Carlo: auto is on
+      {R"({"shadow_rays": 4, "indirect": {"bounces": 1, "rays": 1}})", point, true},
+      {R"({"shadow_rays": 4, "samples_per_pixel": 4, "shadow_guide": false})", point, false},
+      {R"({"shadow_rays": 4, "shadow_guide": true})", point, true},
+      {R"({"shadow_rays": 4, "samples_per_pixel": 4, "shadow_guide": true})", "", false},  // area light only
+  };
+  for (const Case& c : cases) {
+    auto p = MakeProvider(SceneJson(kDiffuse, c.render, c.lights));
+    ASSERT_TRUE(p) << c.render;
+    EXPECT_EQ(p->effects().shadowGuide, c.on) << c.render;
+    const uint64_t rays = guideRays(*p);
+    // One camera ray per pixel (no mirrors), plus one shadow ray per point
+    // light at each pixel whose surface faces it.
+    if (c.on) {
+      EXPECT_GT(rays, pixels) << c.render;
+      EXPECT_LE(rays, 2 * pixels) << c.render;
+    } else {
+      EXPECT_EQ(rays, pixels) << c.render;
+    }
+  }
+}
+
+TEST(Effects, ShadowGuideRejectsOtherValues) {
+  Scene scene;
+  const Status st = testing::Parse(SceneJson(kDiffuse, R"({"shadow_guide": "yes"})"), &scene);
+  EXPECT_FALSE(st.ok());
+  EXPECT_NE(st.message().find("render.shadow_guide"), std::string::npos) << st.message();
+}
+
 }  // namespace
 }  // namespace dcm::embree
