@@ -24,4 +24,18 @@ CameraRay Camera::Generate(int x, int y) const {
   return {origin_, Direction(fx, fy), Direction(fx + 1.f, fy), Direction(fx, fy + 1.f)};
 }
 
+void Camera::GenerateRow(int y, int x0, int x1, bool differentials, CameraRay* out) const {
+  const float fy = float(y) + 0.5f;
+  for (int x = x0; x < x1; ++x) {
+    CameraRay& r = out[x - x0];
+    r.origin = origin_;
+    r.dir = r.dirDx = r.dirDy = Direction(float(x) + 0.5f, fy);
+  }
+  if (!differentials || x1 <= x0) return;
+  for (int x = x0; x < x1; ++x) {
+    out[x - x0].dirDx = x + 1 < x1 ? out[x + 1 - x0].dir : Direction(float(x) + 0.5f + 1.f, fy);
+    out[x - x0].dirDy = Direction(float(x) + 0.5f, fy + 1.f);
+  }
+}
+
 }  // namespace dcm::embree

@@ -23,6 +23,10 @@ class Camera {
 
   /// The ray through the centre of working pixel (x, y).
   CameraRay Generate(int x, int y) const;
+  /// Generate() of pixels [x0, x1) of row y into out[0 .. x1-x0): the same
+  /// rays, each direction computed once (pixel x's dirDx is pixel x+1's dir).
+  /// Without `differentials`, dirDx and dirDy are left equal to dir.
+  void GenerateRow(int y, int x0, int x1, bool differentials, CameraRay* out) const;
 
  private:
   Vec3 Direction(float fx, float fy) const;

@@ -323,10 +323,9 @@ void Integrator::GuideRow(int y, int x0, int x1, bool wantTau, RayCounts* counts
   const size_t n = size_t(std::max(0, x1 - x0));
   std::vector<CameraRay> rays(n);
   std::vector<Vec3> dirs(n);
-  for (size_t i = 0; i < n; ++i) {
-    rays[i] = camera_.Generate(x0 + int(i), y);
-    dirs[i] = rays[i].dir;
-  }
+  // Ray differentials only filter textures: without tau they are not needed.
+  camera_.GenerateRow(y, x0, x1, wantTau, rays.data());
+  for (size_t i = 0; i < n; ++i) dirs[i] = rays[i].dir;
   std::vector<SurfaceHit> hits(n);
   std::vector<uint8_t> found(n);
   if (n > 0) bvh_.IntersectCoherent(rays[0].origin, dirs, hits, found);
