@@ -47,22 +47,6 @@ Status CheckSize(const std::string& path, int width, int height, size_t count) {
   return Status::Ok();
 }
 
-Status WriteSpec(const std::string& tmp, const std::string& path, const ImageSpec& spec,
-                 const void* data, TypeDesc format) {
-  auto out = ImageOutput::create(tmp);
-  if (!out) return Status::Error("cannot write '" + path + "': " + OIIO::geterror());
-  if (!out->open(tmp, spec))
-    return Status::Error("cannot write '" + path + "': " + out->geterror());
-  bool ok = out->write_image(format, data);
-  std::string err = ok ? "" : out->geterror();
-  if (!out->close() && ok) {
-    ok = false;
-    err = out->geterror();
-  }
-  if (!ok) return Status::Error("cannot write '" + path + "': " + err);
-  return Status::Ok();
-}
-
 }  // namespace
 
 Status WriteAtomically(const std::string& path,
@@ -87,6 +71,22 @@ Status WriteAtomically(const std::string& path,
     return Status::Error("cannot write '" + path + "': " + ec.message());
   }
   return Status::Ok();
+}
+
+Status WriteImage(const std::string& path, const ImageSpec& spec, const void* pixels, TypeDesc format) {
+  return WriteAtomically(path, [&](const std::string& tmp) -> Status {
+    auto out = ImageOutput::create(tmp);
+    if (!out) return Status::Error("cannot write '" + path + "': " + OIIO::geterror());
+    if (!out->open(tmp, spec)) return Status::Error("cannot write '" + path + "': " + out->geterror());
+    bool ok = out->write_image(format, pixels);
+    std::string err = ok ? "" : out->geterror();
+    if (!out->close() && ok) {
+      ok = false;
+      err = out->geterror();
+    }
+    if (!ok) return Status::Error("cannot write '" + path + "': " + err);
+    return Status::Ok();
+  });
 }
 
 Status WriteRgbExr(const std::string& path, int width, int height, std::span<const RGB> pixels,
@@ -125,9 +125,7 @@ Status WriteRgbExr(const std::string& path, const Bounds2i& display, const Bound
     buffer[i * nch + 2] = pixels[i].b;
     if (alpha) buffer[i * nch + 3] = 1.f;
   }
-  return WriteAtomically(path, [&](const std::string& tmp) {
-    return WriteSpec(tmp, path, spec, buffer.data(), TypeDesc::FLOAT);
-  });
+  return WriteImage(path, spec, buffer.data(), TypeDesc::FLOAT);
 }
 
 Status WriteRgb8(const std::string& path, int width, int height, std::span<const uint8_t> rgb) {
@@ -135,9 +133,7 @@ Status WriteRgb8(const std::string& path, int width, int height, std::span<const
     return Status::Error("cannot write '" + path + "': RGB data size is not a multiple of 3");
   DCM_RETURN_IF_ERROR(CheckSize(path, width, height, rgb.size() / 3));
   ImageSpec spec(width, height, 3, TypeDesc::UINT8);
-  return WriteAtomically(path, [&](const std::string& tmp) {
-    return WriteSpec(tmp, path, spec, rgb.data(), TypeDesc::UINT8);
-  });
+  return WriteImage(path, spec, rgb.data(), TypeDesc::UINT8);
 }
 
 Status CheckImageDimensions(const std::string& path, int width, int height, int channels) {

@@ -3,6 +3,8 @@
 // partial or truncated file under the requested name.
 #pragma once
 
+#include <OpenImageIO/imageio.h>
+
 #include <cstdint>
 #include <functional>
 #include <span>
@@ -37,6 +39,11 @@ Status WriteRgbExr(const std::string& path, int width, int height, std::span<con
 /// overscan); `pixels` cover the data window, row-major.
 Status WriteRgbExr(const std::string& path, const Bounds2i& display, const Bounds2i& data,
                    std::span<const RGB> pixels, const Metadata& metadata, bool alpha);
+
+/// Writes `pixels` (interleaved, `format`, covering spec's data window) with
+/// `spec` atomically; the format comes from the extension. The one place
+/// that drives OpenImageIO's writer: every image output goes through it.
+Status WriteImage(const std::string& path, const OIIO::ImageSpec& spec, const void* pixels, OIIO::TypeDesc format);
 
 /// Writes an 8-bit RGB image atomically (PNG, or any format OIIO picks from the extension).
 Status WriteRgb8(const std::string& path, int width, int height, std::span<const uint8_t> rgb);

@@ -18,7 +18,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using OIIO::ImageInput;
-using OIIO::ImageOutput;
 using OIIO::ImageSpec;
 using OIIO::TypeDesc;
 
@@ -341,16 +340,7 @@ Status WriteMergedExr(const std::string& path, const MergedFrame& frame, const M
     for (const auto& [name, value] : m->strings) spec.attribute(name, value);
     for (const auto& [name, value] : m->floats) spec.attribute(name, value);
   }
-  return WriteAtomically(path, [&](const std::string& tmp) -> Status {
-    auto out = ImageOutput::create(tmp);
-    if (!out) return Status::Error("cannot write '" + path + "': " + OIIO::geterror());
-    if (!out->open(tmp, spec)) return Status::Error("cannot write '" + path + "': " + out->geterror());
-    bool ok = out->write_image(TypeDesc::FLOAT, frame.pixels.data());
-    std::string err = ok ? "" : out->geterror();
-    if (!out->close() && ok) ok = false, err = out->geterror();
-    if (!ok) return Status::Error("cannot write '" + path + "': " + err);
-    return Status::Ok();
-  });
+  return WriteImage(path, spec, frame.pixels.data(), TypeDesc::FLOAT);
 }
 
 }  // namespace dcm::toolkit

@@ -49,18 +49,7 @@ Status WriteMask(const std::string& path, const Bounds2i& display, const Bounds2
   for (const auto& c : channels) names += (names.empty() ? "" : ",") + c;
   spec.attribute("dcm:channels", names);
   spec.attribute("dcm:pending", int(pixels.size()));
-  return toolkit::WriteAtomically(path, [&](const std::string& tmp) -> Status {
-    auto out = OIIO::ImageOutput::create(tmp);
-    if (!out) return Status::Error("cannot write '" + path + "': " + OIIO::geterror());
-    if (!out->open(tmp, spec)) return Status::Error("cannot write '" + path + "': " + out->geterror());
-    bool ok = out->write_image(OIIO::TypeDesc::FLOAT, mask.data());
-    std::string err = ok ? "" : out->geterror();
-    if (!out->close() && ok) {
-      ok = false;
-      err = out->geterror();
-    }
-    return ok ? Status::Ok() : Status::Error("cannot write '" + path + "': " + err);
-  });
+  return toolkit::WriteImage(path, spec, mask.data(), OIIO::TypeDesc::FLOAT);
 }
 
 /// "x y" lines in the frame's pixel coordinates (EXR coordinates: the data
