@@ -82,6 +82,17 @@ nlohmann::json StatsToJson(const ReconstructionStats& s) {
   return j;
 }
 
+nlohmann::json RunToJson(const Reconstruction& r, const std::string& method, const ReconstructionOptions& o,
+                         double wallS) {
+  nlohmann::json j = StatsToJson(r.stats);
+  j["method"] = method;
+  j["options"] = OptionsToJson(o);
+  j["resolution"] = {r.width, r.height};
+  j["working_resolution"] = {r.workWidth, r.workHeight};
+  j["time_wall_s"] = wallS;
+  return j;
+}
+
 Status WriteJson(const std::string& path, const nlohmann::json& j) {
   std::string text;
   try {

@@ -20,6 +20,12 @@ nlohmann::json OptionsToJson(const ReconstructionOptions& o);
 /// used {split, object_id, shader_id}.
 nlohmann::json StatsToJson(const ReconstructionStats& s);
 
+/// What every command's --stats file says of one reconstruction: StatsToJson()
+/// of its stats, plus method, options, resolution, working_resolution and
+/// time_wall_s.
+nlohmann::json RunToJson(const Reconstruction& r, const std::string& method, const ReconstructionOptions& o,
+                         double wallS);
+
 /// Writes JSON (pretty, 2 spaces) atomically. Non-finite numbers become null
 /// (JSON has no infinity).
 Status WriteJson(const std::string& path, const nlohmann::json& j);

@@ -102,16 +102,11 @@ int RunMerge(const MergeFlags& f) {
   if (frames.empty()) return MergeOne(f.parts, f.output, f.stats, f.quiet);
   if (!HasFramePattern(f.output))
     return Fail("--frames " + f.frames.frames + ": the output name has no '#' frame pattern", kExitUsage);
-  for (int frame : frames) {
+  return RunFrames("merge", frames, [&](int frame) {
     std::vector<std::string> parts;
     for (const auto& p : f.parts) parts.push_back(ExpandFrame(p, frame));
-    const int rc = MergeOne(parts, ExpandFrame(f.output, frame), ExpandFrame(f.stats, frame), f.quiet);
-    if (rc != kExitOk) {
-      std::cerr << "dcm merge: frame " << frame << " failed\n";
-      return rc;
-    }
-  }
-  return kExitOk;
+    return MergeOne(parts, ExpandFrame(f.output, frame), ExpandFrame(f.stats, frame), f.quiet);
+  });
 }
 
 Registration reg("merge", "Assemble the parts of --tile/--region runs into the frame (checks coverage and settings)",

@@ -88,15 +88,10 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
     if (Status w = toolkit::WriteSampleMap(f.sampleMap, rec); !w.ok()) return Fail(w.message());
   }
   if (!f.stats.empty()) {
-    nlohmann::json j = toolkit::StatsToJson(stats);
+    nlohmann::json j = toolkit::RunToJson(rec, method, options, wallS);
     j["provider"] = "pipe";
     j["provider_name"] = caps.name;
     j["provider_cmd"] = f.command;
-    j["method"] = method;
-    j["options"] = toolkit::OptionsToJson(options);
-    j["resolution"] = {rec.width, rec.height};
-    j["working_resolution"] = {rec.workWidth, rec.workHeight};
-    j["time_wall_s"] = wallS;
     if (Status w = toolkit::WriteJson(f.stats, j); !w.ok()) return Fail(w.message());
   }
 

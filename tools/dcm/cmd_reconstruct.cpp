@@ -99,9 +99,10 @@ Status OutputWindows(const aov::AovProvider& provider, int n, Bounds2i* display,
   const bool whole = *display == *data;
   // A region must sit on the N-pixel lattice of its frame; a whole frame
   // only needs its origin there (its size is rounded as the image's is).
-  for (int v : {display->min.x, display->min.y, display->max.x, display->max.y, data->min.x, data->min.y,
-                data->max.x, data->max.y})
-    if (v % n != 0 && !(whole && v != display->min.x && v != display->min.y))
+  std::vector<int> onLattice = {display->min.x, display->min.y, data->min.x, data->min.y};
+  if (!whole) onLattice.insert(onLattice.end(), {display->max.x, display->max.y, data->max.x, data->max.y});
+  for (int v : onLattice)
+    if (v % n != 0)
       return Status::Error("--downsample " + std::to_string(n) + ": the inputs' data window (" +
                            toolkit::RegionText(*data) + ") or display window (" + toolkit::RegionText(*display) +
                            ") does not lie on a multiple of " + std::to_string(n) + " pixels");
@@ -346,26 +347,24 @@ int RunReconstructFrames(const ReconstructFlags& f) {
   if (Status st = FrameList(f.tiles, &frames); !st.ok())
     return aov_common::Fail("reconstruct", st.message(), kExitUsage);
   if (frames.empty()) return RunReconstruct(f);
-  auto expand = [](ReconstructFlags* g, int frame, bool* any) {
+  // Every file name of the flags, each handed to `each`.
+  auto names = [](ReconstructFlags* g, const std::function<void(std::string*)>& each) {
     for (auto* list : {&g->aov.inputs, &g->aov.samples, &g->aov.secondRender})
-      for (auto& name : *list) *any = *any || HasFramePattern(name), name = ExpandFrame(name, frame);
-    for (auto* name : {&g->output, &g->stats, &g->sampleMap, &g->preview, &g->errorMap, &g->reference})
-      *any = *any || HasFramePattern(*name), *name = ExpandFrame(*name, frame);
+      for (auto& name : *list) each(&name);
+    for (auto* name : {&g->output, &g->stats, &g->sampleMap, &g->preview, &g->errorMap, &g->reference}) each(name);
   };
-  for (int frame : frames) {
+  bool any = false;
+  ReconstructFlags probe = f;
+  names(&probe, [&](std::string* name) { any = any || HasFramePattern(*name); });
+  if (!any)
+    return aov_common::Fail("reconstruct", "--frames " + f.tiles.frames +
+                                               ": no '#' frame pattern in the input or output names",
+                            kExitUsage);
+  return RunFrames("reconstruct", frames, [&](int frame) {
     ReconstructFlags g = f;
-    bool any = false;
-    expand(&g, frame, &any);
-    if (!any)
-      return aov_common::Fail("reconstruct", "--frames " + f.tiles.frames +
-                                                 ": no '#' frame pattern in the input or output names",
-                              kExitUsage);
-    if (int rc = RunReconstruct(g); rc != kExitOk) {
-      std::cerr << "dcm reconstruct: frame " << frame << " failed\n";
-      return rc;
-    }
-  }
-  return kExitOk;
+    names(&g, [frame](std::string* name) { *name = ExpandFrame(*name, frame); });
+    return RunReconstruct(g);
+  });
 }
 
 Registration reg("reconstruct", "Reconstruct an image from a renderer's EXR AOVs with DCM",

@@ -154,13 +154,8 @@ int RunRenderPart(const RenderFlags& f, const embree::Scene& scene, Reconstructi
     if (Status st = toolkit::WritePreview(f.preview, rec.width, rec.height, rec.image); !st.ok()) return Fail(st);
   }
   if (!f.stats.empty()) {
-    nlohmann::json j = toolkit::StatsToJson(rec.stats);
+    nlohmann::json j = toolkit::RunToJson(rec, method, options, wallS);
     j["scene"] = f.scene;
-    j["method"] = method;
-    j["options"] = toolkit::OptionsToJson(options);
-    j["resolution"] = {rec.width, rec.height};
-    j["working_resolution"] = {rec.workWidth, rec.workHeight};
-    j["time_wall_s"] = wallS;
     j["effects"] = effects;
     j["rays"] = RaysToJson(rays);
     j["part"] = PartJson(tile, info);
@@ -282,17 +277,9 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
   if (reference) error = toolkit::Compare(rec.image, *reference, rec.width, rec.height);
 
   if (!f.stats.empty()) {
-    nlohmann::json j = toolkit::StatsToJson(stats);
+    nlohmann::json j = toolkit::RunToJson(rec, method, options, run.wallS);
     j["scene"] = f.scene;
-    j["method"] = method;
-    j["options"] = toolkit::OptionsToJson(options);
-    j["resolution"] = {rec.width, rec.height};
-    j["working_resolution"] = {rec.workWidth, rec.workHeight};
-    j["exact_fraction"] = stats.exactFraction();
-    j["time_illum_s"] = stats.timeProviderS;
-    j["time_dcm_s"] = stats.timeEngineS;
-    j["time_guides_s"] = stats.timeGuidesS;
-    j["time_wall_s"] = run.wallS;
+    j["time_dcm_s"] = stats.timeEngineS;  // the name for the engine time ("time_s")
     j["effects"] = effects;
     j["rays"] = RaysToJson(run.rays);
     if (error) j["reference"] = ErrorToJson(*error);
@@ -346,15 +333,11 @@ int RunRenderFrames(const RenderFlags& f, CLI::App* app) {
     std::cerr << "dcm render: --frames " << f.tiles.frames << ": no '#' frame pattern in the scene or output names\n";
     return kExitUsage;
   }
-  for (int frame : frames) {
+  return RunFrames("render", frames, [&](int frame) {
     RenderFlags g = f;
     for (auto name : names) g.*name = ExpandFrame(f.*name, frame);
-    if (int rc = RunRender(g, app); rc != kExitOk) {
-      std::cerr << "dcm render: frame " << frame << " failed\n";
-      return rc;
-    }
-  }
-  return kExitOk;
+    return RunRender(g, app);
+  });
 }
 
 Registration reg("render", "Ray trace a scene file (Embree) with DCM: a few percent of the pixels exact",

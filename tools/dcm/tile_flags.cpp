@@ -62,6 +62,16 @@ Status FrameList(const TileFlags& f, std::vector<int>* frames) {
   return Status::Ok();
 }
 
+int RunFrames(const std::string& cmd, const std::vector<int>& frames, const std::function<int(int)>& run) {
+  for (int frame : frames) {
+    if (const int rc = run(frame); rc != 0) {
+      std::fprintf(stderr, "dcm %s: frame %d failed\n", cmd.c_str(), frame);
+      return rc;
+    }
+  }
+  return 0;
+}
+
 bool HasFramePattern(const std::string& name) { return name.find('#') != std::string::npos; }
 
 std::string ExpandFrame(const std::string& pattern, int frame) {

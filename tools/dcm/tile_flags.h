@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,10 @@ Status ResolveRegion(const TileFlags& f, int width, int height, int align, Bound
 
 /// The frames of --frames ("7" or "1-10"); empty when the flag is absent.
 Status FrameList(const TileFlags& f, std::vector<int>* frames);
+
+/// Runs `run(frame)` for each of `frames` in order; at the first that fails,
+/// prints "dcm CMD: frame N failed" and returns its exit code.
+int RunFrames(const std::string& cmd, const std::vector<int>& frames, const std::function<int(int)>& run);
 
 /// True when `name` contains a '#' frame pattern.
 bool HasFramePattern(const std::string& name);
