@@ -11,35 +11,20 @@
 set -euo pipefail
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
-root="$(cd "$here/../.." && pwd)"
-DCM="${DCM:-$root/build/tools/dcm/dcm}"
-BLENDER="${BLENDER:-blender}"
-THREADS="${THREADS:-2}"
+# shellcheck source=common.sh
+. "$here/common.sh"
 SPP="${SPP:-64}"
 REF_SPP="${REF_SPP:-2048}"
 view="${1:-a}"
-command -v "$BLENDER" >/dev/null || { echo "noise.sh: no '$BLENDER' (sudo apt-get install --no-install-recommends blender)" >&2; exit 1; }
+require_tools noise.sh
 command -v oiiotool >/dev/null || { echo "noise.sh: no oiiotool (scripts/install-deps.sh)" >&2; exit 1; }
-[ -x "$DCM" ] || { echo "noise.sh: no dcm binary at $DCM (build it, or set DCM=...)" >&2; exit 1; }
-out="$here/out"
-mkdir -p "$out"
-
-render() {  # samples seed exr
-  [ -f "$3" ] && return 0
-  echo "rendering $(basename "$3") (256x256, $1 spp, seed $2)" >&2
-  local t0=$SECONDS
-  "$BLENDER" -b --factory-startup --python "$here/make_and_render.py" -- \
-    --out "$3" --view "$view" --res 256 --samples "$1" --seed "$2" --threads "$THREADS" > "$out/blender.log" 2>&1 ||
-    { tail -20 "$out/blender.log" >&2; exit 1; }
-  echo "$(basename "$3"): $((SECONDS - t0)) s" >&2
-}
 
 a="$out/noise_${view}_${SPP}_s1.exr"
 b="$out/noise_${view}_${SPP}_s2.exr"
 ref="$out/noise_${view}_${REF_SPP}_s3.exr"
-render "$SPP" 1 "$a"
-render "$SPP" 2 "$b"
-render "$REF_SPP" 3 "$ref"
+render_room "$a" "$view" 256 "$SPP" 1
+render_room "$b" "$view" 256 "$SPP" 2
+render_room "$ref" "$view" 256 "$REF_SPP" 3
 # The reference's beauty as plain R, G, B for --reference.
 layer=$(oiiotool --info -v "$ref" | sed -n 's/.*channel list: \([^ ,]*\)\.Combined\.R.*/\1/p' | head -1)
 layer=${layer:-ViewLayer}

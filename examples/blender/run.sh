@@ -19,28 +19,15 @@
 set -euo pipefail
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
-root="$(cd "$here/../.." && pwd)"
-DCM="${DCM:-$root/build/tools/dcm/dcm}"
-BLENDER="${BLENDER:-blender}"
+# shellcheck source=common.sh
+. "$here/common.sh"
 SAMPLES="${SAMPLES:-256}"
 SS="${SS:-0}"
-THREADS="${THREADS:-2}"
 DCM_ARGS="${DCM_ARGS:-}"
 views=("$@")
 [ ${#views[@]} -eq 0 ] && views=(a b c)
 
-command -v "$BLENDER" >/dev/null || { echo "run.sh: no '$BLENDER' (sudo apt-get install --no-install-recommends blender)" >&2; exit 1; }
-[ -x "$DCM" ] || { echo "run.sh: no dcm binary at $DCM (build it, or set DCM=...)" >&2; exit 1; }
-out="$here/out"
-mkdir -p "$out"
-
-render() {  # view res samples exr
-  [ -f "$4" ] && return 0
-  echo "rendering $(basename "$4") (${2}x${2}, $3 spp; about 2-3 min on 2 cores)" >&2
-  "$BLENDER" -b --factory-startup --python "$here/make_and_render.py" -- \
-    --out "$4" --view "$1" --res "$2" --samples "$3" --threads "$THREADS" > "$out/blender.log" 2>&1 ||
-    { tail -20 "$out/blender.log" >&2; exit 1; }
-}
+require_tools run.sh
 
 reconstruct() {  # exr dir [flags...]
   local exr="$1" dir="$2"
@@ -62,11 +49,11 @@ EOF
 
 for v in "${views[@]}"; do
   exr="$out/room_${v}_256.exr"
-  render "$v" 256 "$SAMPLES" "$exr"
+  render_room "$exr" "$v" 256 "$SAMPLES" 1
   reconstruct "$exr" "$out/room_${v}_256"
   if [ "$SS" = 1 ]; then
     exr="$out/room_${v}_512.exr"
-    render "$v" 512 $(( (SAMPLES + 3) / 4 )) "$exr"
+    render_room "$exr" "$v" 512 $(( (SAMPLES + 3) / 4 )) 1
     reconstruct "$exr" "$out/room_${v}_512" --downsample 2
   fi
 done

@@ -1,0 +1,28 @@
+# Shared by run.sh and noise.sh (sourced, with `here` set to this folder):
+# the tools with their checks, and one Cycles render of the example room.
+# Environment: DCM (default build/tools/dcm/dcm of this repository),
+# BLENDER (default blender), THREADS (Cycles render threads, default 2).
+root="$(cd "$here/../.." && pwd)"
+DCM="${DCM:-$root/build/tools/dcm/dcm}"
+BLENDER="${BLENDER:-blender}"
+THREADS="${THREADS:-2}"
+out="$here/out"
+
+# require_tools SCRIPT: blender and the dcm binary are there.
+require_tools() {
+  command -v "$BLENDER" >/dev/null ||
+    { echo "$1: no '$BLENDER' (sudo apt-get install --no-install-recommends blender)" >&2; exit 1; }
+  [ -x "$DCM" ] || { echo "$1: no dcm binary at $DCM (build it, or set DCM=...)" >&2; exit 1; }
+  mkdir -p "$out"
+}
+
+# render_room EXR VIEW RES SAMPLES SEED: renders EXR unless it exists.
+render_room() {
+  [ -f "$1" ] && return 0
+  echo "rendering $(basename "$1") (${3}x${3}, $4 spp, seed $5)" >&2
+  local t0=$SECONDS
+  "$BLENDER" -b --factory-startup --python "$here/make_and_render.py" -- \
+    --out "$1" --view "$2" --res "$3" --samples "$4" --seed "$5" --threads "$THREADS" > "$out/blender.log" 2>&1 ||
+    { tail -20 "$out/blender.log" >&2; exit 1; }
+  echo "$(basename "$1"): $((SECONDS - t0)) s" >&2
+}
