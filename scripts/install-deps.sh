@@ -19,7 +19,10 @@ packages=(
   # tests/povray: POV-Ray 3.7 driven for real (examples/povray)
   povray
   # helper scripts (plots, checks): Debian's python, not the one first on PATH
-  python3-numpy python3-matplotlib python3-openimageio
+  # (tools/bench/error_strip.py imports PIL itself)
+  python3-numpy python3-matplotlib python3-openimageio python3-pil
+  # scripts/tiles-benchmark.sh: wall time and peak memory per process
+  time
 )
 for arg in "$@"; do
   case "$arg" in

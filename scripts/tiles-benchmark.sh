@@ -15,7 +15,7 @@ scene=${1:-$here/examples/scenes/room.json}
 tiles=${2:-8}
 shift $(($# > 2 ? 2 : $#))
 [[ -x $dcm ]] || { echo "tiles-benchmark: no dcm binary at $dcm (build first, or set DCM_BUILD_DIR)" >&2; exit 2; }
-[[ -x /usr/bin/time ]] || { echo "tiles-benchmark: needs /usr/bin/time (apt-get install time)" >&2; exit 2; }
+[[ -x /usr/bin/time ]] || { echo "tiles-benchmark: needs /usr/bin/time (scripts/install-deps.sh installs it)" >&2; exit 2; }
 out=$(mktemp -d /tmp/dcm-tiles-bench.XXXXXX)
 trap 'rm -rf "$out"' EXIT
 
