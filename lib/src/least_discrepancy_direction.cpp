@@ -117,9 +117,4 @@ DirectionChoice LeastDiscrepancyDirection(const SampleStore& store, std::span<co
   return store.split() || store.hasVariance() ? Search<false>(v, f, allFinite, pairs) : Search<true>(v, f, allFinite, pairs);
 }
 
-DirectionChoice LeastDiscrepancyDirection(const SampleStore& store, const Block& b,
-                                          std::span<const Point2i> border, int directions) {
-  return LeastDiscrepancyDirection(store, border, BorderPairs(b.width(), b.height(), directions));
-}
-
 }  // namespace dcm::detail

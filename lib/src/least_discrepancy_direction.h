@@ -53,8 +53,4 @@ class BorderPairs {
 DirectionChoice LeastDiscrepancyDirection(const SampleStore& store, std::span<const Point2i> border,
                                           const BorderPairs& pairs);
 
-/// As above, with the table of `b`'s shape built for this one call.
-DirectionChoice LeastDiscrepancyDirection(const SampleStore& store, const Block& b,
-                                          std::span<const Point2i> border, int directions);
-
 }  // namespace dcm::detail
