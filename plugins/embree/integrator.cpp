@@ -116,15 +116,12 @@ void Integrator::DirectLight(const SurfaceHit& h, Vec3 wo, const Material& m, in
   const Vec3 wr = Reflect(-wo, h.ns);
   for (const Light& light : lights_) {
     if (light.kind == LightKind::kPoint) {
-      Vec3 toLight = light.position - org;
-      float dist = Length(toLight);
-      if (dist <= 0.f) continue;
-      Vec3 wi = toLight / dist;
-      float cosS = Dot(h.ns, wi);
-      if (cosS <= 0.f || Dot(h.ng, wi) <= 0.f) continue;
+      PointLightRay r;
+      if (!FacesPointLight(h, org, light, &r)) continue;
       ++counts->shadow;
-      if (bvh_.Occluded(org, wi, 0.f, dist * (1.f - 1e-4f))) continue;
-      RGB E = light.intensity * (cosS / (dist * dist));
+      if (!Unoccluded(org, r)) continue;
+      const Vec3 wi = r.wi;
+      RGB E = light.intensity * (r.cosS / (r.dist * r.dist));
       out->diffuse += E * (1.f / kPi);
       if (glossy) out->constant += m.specular * E * PhongLobe(wr, wi, m.exponent);
       continue;
@@ -392,17 +389,25 @@ uint32_t Integrator::PointLightVisibility(const SurfaceHit& h, RayCounts* counts
   const Vec3 org = EmbreeScene::Offset(h.p, h.ng);
   uint32_t lit = 0;
   for (size_t l = 0; l < lights_.size() && l < 32; ++l) {
-    const Light& light = lights_[l];
-    if (light.kind != LightKind::kPoint) continue;
-    const Vec3 toLight = light.position - org;
-    const float dist = Length(toLight);
-    if (dist <= 0.f) continue;
-    const Vec3 wi = toLight / dist;
-    if (Dot(h.ns, wi) <= 0.f || Dot(h.ng, wi) <= 0.f) continue;
+    PointLightRay r;
+    if (lights_[l].kind != LightKind::kPoint || !FacesPointLight(h, org, lights_[l], &r)) continue;
     ++counts->guide;
-    if (!bvh_.Occluded(org, wi, 0.f, dist * (1.f - 1e-4f))) lit |= 1u << l;
+    if (Unoccluded(org, r)) lit |= 1u << l;
   }
   return lit;
+}
+
+bool Integrator::FacesPointLight(const SurfaceHit& h, Vec3 org, const Light& light, PointLightRay* r) const {
+  const Vec3 toLight = light.position - org;
+  r->dist = Length(toLight);
+  if (r->dist <= 0.f) return false;
+  r->wi = toLight / r->dist;
+  r->cosS = Dot(h.ns, r->wi);
+  return !(r->cosS <= 0.f || Dot(h.ng, r->wi) <= 0.f);  // (a NaN normal still traces, as before)
+}
+
+bool Integrator::Unoccluded(Vec3 org, const PointLightRay& r) const {
+  return !bvh_.Occluded(org, r.wi, 0.f, r.dist * (1.f - 1e-4f));
 }
 
 }  // namespace dcm::embree

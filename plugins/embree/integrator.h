@@ -98,6 +98,17 @@ class Integrator {
   /// Bit l set when point light l (of the first 32) lights `h`: the same
   /// shadow ray as DirectLight's (counted as a guide ray).
   uint32_t PointLightVisibility(const SurfaceHit& h, RayCounts* counts) const;
+  /// The shadow ray from `org` (just above `h`) to a point light.
+  struct PointLightRay {
+    Vec3 wi;           ///< unit, towards the light
+    float dist = 0.f;  ///< to the light
+    float cosS = 0.f;  ///< at the shading normal
+  };
+  /// Fills `r`; false when `h` faces away from the light (no ray to trace).
+  /// DirectLight and PointLightVisibility share it, so the guide tests the
+  /// very ray the illumination traces.
+  bool FacesPointLight(const SurfaceHit& h, Vec3 org, const Light& light, PointLightRay* r) const;
+  bool Unoccluded(Vec3 org, const PointLightRay& r) const;
   Shading Shade(const SurfaceHit& h, Vec3 wo, const Material& m, const Quality& q,
                 const Differentials* diff, Pcg32& rng, RayCounts* counts) const;
   /// Radiance leaving `h` towards -dir, emission excluded.
