@@ -89,6 +89,18 @@ toolkit::Metadata ProvenanceMetadata(const ReconstructFlags& f, const aov::AovPr
   return meta;
 }
 
+/// The sparse round trip ran out of samples: how many of the pixels the
+/// engine asked for (`forWhat`: " for this part" or "") were not rendered.
+int FailMissingSamples(const aov::AovProvider& provider, const std::vector<Point2i>& pending,
+                       const std::string& forWhat) {
+  int64_t missing = 0;
+  for (const auto& p : pending) missing += provider.HasSample(p) ? 0 : 1;
+  return aov_common::Fail("reconstruct", "the samples lack " + std::to_string(missing) +
+                                             " pixels the engine needs" + forWhat +
+                                             "; run `dcm plan` with the same inputs, flags and samples, render what "
+                                             "it asks for, and repeat");
+}
+
 /// The output's place in the frame: the inputs' data and display windows (a
 /// render region stays a region of its frame, overscan stays overscan), at
 /// the output resolution of --downsample N.
@@ -164,11 +176,7 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   progress.Done();
   if (st.pending()) {
-    int64_t missing = 0;
-    for (const auto& p : pending) missing += provider.HasSample(p) ? 0 : 1;
-    return aov_common::Fail(cmd, "the samples lack " + std::to_string(missing) +
-                                     " pixels the engine needs for this part; run `dcm plan` with the same "
-                                     "inputs, flags and samples, render what it asks for, and repeat");
+    return FailMissingSamples(provider, pending, " for this part");
   }
   if (!st.ok()) return aov_common::Fail(cmd, st.message());
 
@@ -274,11 +282,7 @@ int RunReconstruct(const ReconstructFlags& f) {
   st = aov_common::Run(*provider, options, f.engine, &r, &pending);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (st.pending()) {
-    int64_t missing = 0;
-    for (const auto& p : pending) missing += provider->HasSample(p) ? 0 : 1;
-    return aov_common::Fail(cmd, "the samples lack " + std::to_string(missing) +
-                                     " pixels the engine needs; run `dcm plan` with the same inputs, "
-                                     "flags and samples, render what it asks for, and repeat");
+    return FailMissingSamples(*provider, pending, "");
   }
   if (!st.ok()) return aov_common::Fail(cmd, st.message());
 
