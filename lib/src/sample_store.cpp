@@ -59,8 +59,33 @@ void SampleStore::SetGuides(GuideImage guides, ObjectTest test, float creaseAngl
     tauZero_.resize(tau_.size());
     for (size_t i = 0; i < tau_.size(); ++i) tauZero_[i] = TauZero(tau_[i]) ? 1 : 0;
   }
+  region_.clear();
+  if (!crease_.empty()) {
+    // Regions: union-find over 4-neighbours of one object (and one tau = 0
+    // class) that no crease separates.
+    const size_t n = crease_.size();
+    region_.resize(n);
+    for (size_t i = 0; i < n; ++i) region_[i] = uint32_t(i);
+    auto find = [&](uint32_t i) {
+      while (region_[i] != i) i = region_[i] = region_[region_[i]];
+      return i;
+    };
+    auto join = [&](size_t i, size_t j) {
+      if (obj && obj[i] != obj[j]) return;
+      if (!tauZero_.empty() && tauZero_[i] != tauZero_[j]) return;
+      const uint32_t a = find(uint32_t(i)), b = find(uint32_t(j));
+      if (a != b) region_[std::max(a, b)] = std::min(a, b);
+    };
+    for (int y = 0; y < height_; ++y)
+      for (int x = 0; x < width_; ++x) {
+        const size_t i = size_t(Index(x, y));
+        if (x + 1 < width_ && !(crease_[i] & 1)) join(i, i + 1);
+        if (y + 1 < height_ && !(crease_[i] & 2)) join(i, i + size_t(width_));
+      }
+    for (size_t i = 0; i < n; ++i) region_[i] = find(uint32_t(i));
+  }
   surfaces_ = SurfaceTest(obj, shader, crease_.empty() ? nullptr : crease_.data(), width_,
-                          tauZero_.empty() ? nullptr : tauZero_.data());
+                          tauZero_.empty() ? nullptr : tauZero_.data(), region_.empty() ? nullptr : region_.data());
 }
 
 bool SampleStore::TauZero(RGB tau) { return tau.r == 0.f && tau.g == 0.f && tau.b == 0.f; }

@@ -42,21 +42,23 @@ class SurfaceTest {
   /// `tauZero`: per pixel, 1 where tau is exactly zero (with the texture
   /// split); such pixels are another surface than those with tau != 0, since
   /// their L_i is unknown. May be null.
+  /// `region`: per pixel, the connected region of its object that no crease
+  /// crosses (from normal guides); pixels of one object in different regions
+  /// are different surfaces however close. May be null.
   SurfaceTest(const uint32_t* objectId, const uint32_t* shaderId, const uint8_t* crease = nullptr, int width = 0,
-              const uint8_t* tauZero = nullptr)
-      : objectId_(objectId), shaderId_(shaderId), crease_(crease), tauZero_(tauZero), width_(width) {}
+              const uint8_t* tauZero = nullptr, const uint32_t* region = nullptr)
+      : objectId_(objectId), shaderId_(shaderId), crease_(crease), tauZero_(tauZero), region_(region), width_(width) {}
   bool enabled() const { return objectId_ != nullptr || crease_ != nullptr || tauZero_ != nullptr; }
   /// Without IDs everything is one surface; with object IDs only, equal IDs;
   /// with object and shader IDs, a surface changes where both differ.
   bool Same(int64_t i, int64_t j) const {
     if (tauZero_ && tauZero_[i] != tauZero_[j]) return false;
-    if (!objectId_) return true;
-    if (objectId_[i] == objectId_[j]) return true;
+    if (!objectId_ || objectId_[i] == objectId_[j]) return !region_ || region_[i] == region_[j];
     return shaderId_ && shaderId_[i] == shaderId_[j];
   }
-  /// For 4-neighbours i and j: Same(), and no crease between them. Creases
-  /// are local: they mark where a block has a surface change and where its
-  /// border needs samples, not which distant pixels may interpolate which.
+  /// For 4-neighbours i and j: Same(), and no crease between them. A crease
+  /// that does not close a region (a fold that fades out) still marks where
+  /// a block has a surface change and where its border needs samples.
   bool SameAdjacent(int64_t i, int64_t j) const {
     if (!Same(i, j)) return false;
     if (!crease_) return true;
@@ -71,6 +73,7 @@ class SurfaceTest {
   const uint32_t* shaderId_ = nullptr;
   const uint8_t* crease_ = nullptr;
   const uint8_t* tauZero_ = nullptr;
+  const uint32_t* region_ = nullptr;
   int width_ = 0;
 };
 
@@ -157,6 +160,7 @@ class SampleStore {
   std::vector<std::array<float, 2>> var_;  // (varA, varB) with variance only
   std::vector<SampleReason> reason_;
   std::vector<uint8_t> finite_, filled_, crease_, tauZero_;
+  std::vector<uint32_t> region_;
   GuideImage guides_;
   SurfaceTest surfaces_;
   tbb::enumerable_thread_specific<std::vector<uint64_t>> requests_;

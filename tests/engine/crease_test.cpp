@@ -2,8 +2,11 @@
 // meeting its ceiling) is a surface change, though no ID marks it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 
+#include "../../lib/src/sample_store.h"
 #include "run_helpers.h"
 
 namespace dcm::testing {
@@ -71,6 +74,58 @@ TEST(Crease, SmoothlyCurvedSurfacesAreNotCreases) {
   ch.normals = true;
   AnalyticProvider withNormals(kSize, kSize, curved, ch), without(kSize, kSize, curved);
   EXPECT_EQ(ReconstructOrFail(withNormals, {}).stats.exactPixels, ReconstructOrFail(without, {}).stats.exactPixels);
+}
+
+/// Same() of a 16x8 store, one object, whose normals are `normal(x, y)`;
+/// objects and shaders from `id(x, y)` (both the same value).
+detail::SampleStore StoreWith(const std::function<Vec3f(int, int)>& normal,
+                              const std::function<uint32_t(int, int)>& id = [](int, int) { return 1u; }) {
+  constexpr int w = 16, h = 8;
+  detail::SampleStore store(w, h, false);
+  GuideImage g;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      g.objectId.push_back(id(x, y));
+      g.shaderId.push_back(id(x, y) == 3 ? 2u : id(x, y));
+      g.normal.push_back(normal(x, y));
+    }
+  store.SetGuides(std::move(g), ObjectTest::kObjectAndShader, 30.f);
+  return store;
+}
+
+TEST(Crease, ACreaseAcrossAnObjectSplitsItIntoTwoSurfaces) {
+  // A wall (x < 6) meeting its ceiling (x >= 6): a pixel of the wall and one
+  // of the ceiling are different surfaces even far from the crease, so no
+  // interior pixel takes the ceiling's samples for the wall's.
+  const detail::SampleStore s = StoreWith([](int x, int) { return x < 6 ? Vec3f{1, 0, 0} : Vec3f{0, 1, 0}; });
+  EXPECT_TRUE(s.surfaces().Same(s.Index(0, 0), s.Index(5, 7)));
+  EXPECT_TRUE(s.surfaces().Same(s.Index(6, 0), s.Index(15, 7)));
+  EXPECT_FALSE(s.surfaces().Same(s.Index(0, 0), s.Index(15, 7)));
+  EXPECT_FALSE(s.surfaces().Same(s.Index(5, 3), s.Index(6, 3)));
+}
+
+TEST(Crease, ACreaseThatEndsInsideTheObjectDoesNotSplitIt) {
+  // A fold in rows 0-3 only (the normal turns by 90 degrees between x = 5
+  // and 6); below it the normal turns by 15 degrees per pixel, no crease. The
+  // two sides join below the fold, so they are one surface (regions, not
+  // distances), though the neighbours across the fold still see a crease.
+  const detail::SampleStore s = StoreWith([](int x, int y) {
+    const float deg = y < 4 ? (x < 6 ? 0.f : 90.f) : std::clamp(15.f * float(x - 2), 0.f, 90.f);
+    const float a = deg * 3.14159265f / 180.f;
+    return Vec3f{std::cos(a), std::sin(a), 0.f};
+  });
+  EXPECT_TRUE(s.surfaces().Same(s.Index(0, 0), s.Index(15, 0)));
+  EXPECT_FALSE(s.surfaces().SameAdjacent(s.Index(5, 0), s.Index(6, 0)));
+}
+
+TEST(Crease, RegionsOnlyRefineOneObject) {
+  // Objects 1 (x < 8) and 3 (x >= 8, shader 2) are separated by their IDs as
+  // before; object 2 (shader 2) next to object 3 shares its shader, so it is
+  // the same surface under the paper's object+shader test, creases or not.
+  const detail::SampleStore s = StoreWith([](int x, int) { return x < 12 ? Vec3f{1, 0, 0} : Vec3f{0, 0, 1}; },
+                                          [](int x, int) { return x < 8 ? 1u : x < 12 ? 2u : 3u; });
+  EXPECT_FALSE(s.surfaces().Same(s.Index(0, 0), s.Index(8, 0)));
+  EXPECT_TRUE(s.surfaces().Same(s.Index(8, 0), s.Index(15, 0)));
 }
 
 }  // namespace

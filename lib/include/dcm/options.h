@@ -82,7 +82,10 @@ struct ReconstructionOptions {
   /// With normal guides: neighbouring pixels whose normals differ by more
   /// than this many degrees are a surface change, as an ID change is (a
   /// crease inside one object with one material, such as a room's walls and
-  /// ceiling, which no ID marks). 0: normals are not used.
+  /// ceiling, which no ID marks). Creases that enclose part of an object
+  /// make it a surface of its own (a region), so no pixel interpolates
+  /// samples from across them (docs/AOV.md: +0.5 to +2.2 dB on Cycles
+  /// renders). 0: normals are not used.
   float creaseAngle = 30.f;
 
   SmoothRefinement smoothRefinement = SmoothRefinement::kCentreProbe;
