@@ -179,6 +179,7 @@ constexpr BoolOption kBoolOptions[] = {
     {"first_order_test", &Options::firstOrderTest},
     {"lazy_evaluation", &Options::lazyEvaluation},
     {"fallback", &Options::fallback},
+    {"fallback_filled_borders", &Options::fallbackFilledBorders},
     {"finest_centre_probe", &Options::finestCentreProbe},
     {"full_evaluation", &Options::fullEvaluation},
     {"denoise_samples", &Options::denoiseSamples},

@@ -658,11 +658,17 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
       edges = std::move(nextEdges);
     }
 
-    // Fallback blocks: every interior pixel exactly.
-    // (with adaptive borders, the border pixels not evaluated yet too).
+    // Fallback blocks: every interior pixel exactly, and the border pixels
+    // not evaluated yet unless adaptive borders filled them (or the options
+    // ask for those too).
     ForEach(fallbackLeaves_, [&](Leaf& l, size_t) {
-      for (int y = l.block.y0; y <= l.block.y1; ++y)
-        for (int x = l.block.x0; x <= l.block.x1; ++x) store_.Request(x, y, SampleReason::kFallback);
+      const Block& b = l.block;
+      for (int y = b.y0; y <= b.y1; ++y)
+        for (int x = b.x0; x <= b.x1; ++x) {
+          const bool border = x == b.x0 || x == b.x1 || y == b.y0 || y == b.y1;
+          if (border && !opt_.fallbackFilledBorders && store_.IsFilled(store_.Index(x, y))) continue;
+          store_.Request(x, y, SampleReason::kFallback);
+        }
     });
     // Flushed before the thin-object pass: a fallback block's border is also
     // its neighbours' border, and what the pass decides depends on it.

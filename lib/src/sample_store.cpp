@@ -32,20 +32,20 @@ void SampleStore::SetGuides(GuideImage guides, ObjectTest test, float creaseAngl
   const uint32_t* shader = (obj && test == ObjectTest::kObjectAndShader && !guides_.shaderId.empty())
                                ? guides_.shaderId.data() : nullptr;
   crease_.clear();
-  const std::vector<Vec3f>& n = guides_.normal;
-  if (creaseAngle > 0.f && n.size() == size_t(width_) * size_t(height_)) {
+  const std::vector<Vec3f>& normal = guides_.normal;
+  if (creaseAngle > 0.f && normal.size() == size_t(width_) * size_t(height_)) {
     // A crease where the angle between unit normals exceeds creaseAngle;
     // a zero or non-finite normal (background, no data) marks none.
     const double cosMax = std::cos(double(creaseAngle) * 3.14159265358979323846 / 180.0);
     auto dot = [&](size_t i, size_t j, double* out) {
-      const Vec3f a = n[i], b = n[j];
+      const Vec3f a = normal[i], b = normal[j];
       const double la = std::sqrt(double(a.x) * a.x + double(a.y) * a.y + double(a.z) * a.z);
       const double lb = std::sqrt(double(b.x) * b.x + double(b.y) * b.y + double(b.z) * b.z);
       if (!(la > 1e-12 && lb > 1e-12 && std::isfinite(la) && std::isfinite(lb))) return false;
       *out = (double(a.x) * b.x + double(a.y) * b.y + double(a.z) * b.z) / (la * lb);
       return true;
     };
-    crease_.assign(n.size(), 0);
+    crease_.assign(normal.size(), 0);
     for (int y = 0; y < height_; ++y)
       for (int x = 0; x < width_; ++x) {
         const size_t i = size_t(Index(x, y));

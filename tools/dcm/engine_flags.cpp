@@ -22,6 +22,8 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
   app->add_option("--contrast", f->contrast, "mitchell | display");
   app->add_flag("--no-lazy", f->noLazy, "full border evaluation for children of simple edge blocks");
   app->add_flag("--no-fallback", f->noFallback, "never fall back to exact evaluation of a block interior");
+  app->add_flag("--fallback-filled-borders", f->fallbackFilledBorders,
+                "fallback blocks also evaluate the border pixels adaptive borders filled");
   app->add_flag("--no-surface-aware", f->noSurfaceAware, "interpolate across surfaces (Guo)");
   app->add_flag("--no-adaptive-borders", f->noAdaptiveBorders, "evaluate every border pixel of edge blocks (the paper)");
   app->add_flag("--no-centre-probe", f->noCentreProbe, "no centre probe of the finest edge blocks");
@@ -58,6 +60,7 @@ Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {
   if (!f.contrast.empty()) DCM_RETURN_IF_ERROR(Parse(f.contrast, &o->contrastMetric));
   if (f.noLazy) o->lazyEvaluation = false;
   if (f.noFallback) o->fallback = false;
+  if (f.fallbackFilledBorders) o->fallbackFilledBorders = true;
   if (f.noSurfaceAware) o->surfaceAware = false;
   if (f.noAdaptiveBorders) o->adaptiveBorders = false;
   if (f.noCentreProbe) o->finestCentreProbe = false;

@@ -18,7 +18,7 @@ struct EngineFlags {
   int block = 0, minBlock = 0, directions = 0, downsample = 1, threads = 0, tile = 0;
   bool noThin = false, noTextureSplit = false, noLazy = false, noFallback = false;
   bool noSurfaceAware = false, full = false;
-  bool noAdaptiveBorders = false, noCentreProbe = false, noDenoise = false;
+  bool noAdaptiveBorders = false, noCentreProbe = false, noDenoise = false, fallbackFilledBorders = false;
   std::string smoothRefinement;  ///< always | centre-probe | never
   std::string objectTest;      ///< none | id | id+shader
   std::string thinTest;        ///< off | none-matches | any-differs

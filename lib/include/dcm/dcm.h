@@ -161,8 +161,8 @@ DCM_API void dcmSetFloat(DCMReconstructor r, const char* name, float value);
 
 /** Sets a bool option: "surface_aware", "texture_split", "adaptive_borders",
  *  "zero_order_test", "gradient_blocks_simple", "first_order_test",
- *  "lazy_evaluation", "fallback", "finest_centre_probe", "full_evaluation",
- *  "denoise_samples". */
+ *  "lazy_evaluation", "fallback", "fallback_filled_borders",
+ *  "finest_centre_probe", "full_evaluation", "denoise_samples". */
 DCM_API void dcmSetBool(DCMReconstructor r, const char* name, int value);
 
 /** The value of an integer (or bool) option; 0 and an error for an unknown name. */
