@@ -26,3 +26,13 @@ render_room() {
     { tail -20 "$out/blender.log" >&2; exit 1; }
   echo "$(basename "$1"): $((SECONDS - t0)) s" >&2
 }
+
+# render_shadow_guide EXR VIEW RES: the sun's shadow guide (1 sample, view
+# layer ShadowGuide) unless EXR exists; dcm's blender preset reads it as a
+# second input.
+render_shadow_guide() {
+  [ -f "$1" ] && return 0
+  "$BLENDER" -b --factory-startup --python "$here/make_and_render.py" -- \
+    --out "$1" --view "$2" --res "$3" --threads "$THREADS" --shadow-guide > "$out/blender.log" 2>&1 ||
+    { tail -20 "$out/blender.log" >&2; exit 1; }
+}

@@ -37,6 +37,9 @@ def parse_args():
     ap.add_argument("--seed", type=int, default=1, help="Cycles seed")
     ap.add_argument("--threads", type=int, default=2, help="render threads (0: all)")
     ap.add_argument("--save-blend", default="", help="also save the scene as .blend")
+    ap.add_argument("--shadow-guide", action="store_true",
+                    help="render the sun's shadow guide instead of the AOVs: 1 sample, direct light of the "
+                         "sun only on white diffuse materials (view layer 'ShadowGuide', Combined only)")
     return ap.parse_args(argv)
 
 
@@ -390,6 +393,39 @@ def setup_render(args):
     sc.render.filepath = os.path.abspath(args.out)
 
 
+def setup_shadow_guide():
+    """The sun's direct light on white diffuse surfaces, one sample per pixel:
+    > 0 where the sun reaches the surface, 0 in its shadow. Every other light
+    is off (the ceiling light, the sky, the lamp shade's emission, which the
+    material override removes), and no light bounces: what is left is a
+    visibility guide, 1/samples of the cost of the render (docs/AOV.md)."""
+    sc = bpy.context.scene
+    sc.cycles.samples = 1
+    sc.cycles.max_bounces = 0
+    bpy.data.objects["CeilingLight"].hide_render = True
+    # a hard shadow: its edge is the middle of the render's 1.5-degree
+    # penumbra, the same in every pixel (one sample of a soft shadow would
+    # scatter lit and unlit pixels over the penumbra)
+    bpy.data.objects["Sun"].data.angle = 0.0
+    sc.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+    white = bpy.data.materials.new("GuideWhite")
+    white.use_nodes = True
+    white.node_tree.nodes.clear()
+    out = white.node_tree.nodes.new("ShaderNodeOutputMaterial")
+    bsdf = white.node_tree.nodes.new("ShaderNodeBsdfDiffuse")
+    bsdf.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    white.node_tree.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
+    vl = sc.view_layers[0]
+    vl.name = "ShadowGuide"   # dcm's blender preset takes its Combined as the shadow guide
+    vl.material_override = white
+    for attr in dir(vl):
+        if attr.startswith("use_pass_") and attr != "use_pass_combined":
+            try:
+                setattr(vl, attr, False)
+            except (AttributeError, TypeError):
+                pass
+
+
 def main():
     args = parse_args()
     outdir = os.path.dirname(os.path.abspath(args.out))
@@ -397,6 +433,8 @@ def main():
     build(outdir)
     camera(args.view)
     setup_render(args)
+    if args.shadow_guide:
+        setup_shadow_guide()
     if args.save_blend:
         bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(args.save_blend))
     bpy.ops.render.render(write_still=True)

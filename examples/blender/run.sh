@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Renders the example room with Blender Cycles (only the EXRs that are missing)
-# and runs `dcm reconstruct --preset blender` on each render.
+# and its shadow guide (1 sample of the sun's direct light) and runs
+# `dcm reconstruct --preset blender` on each render with its guide.
 #
 #   examples/blender/run.sh [VIEW ...]        views a, b, c (default: all three)
 #
@@ -12,8 +13,10 @@
 #                  final pixel) and reconstruct it with --downsample 2
 #   THREADS=2      Cycles render threads (0: all cores)
 #   DCM_ARGS="..." extra flags for dcm reconstruct (e.g. "--method paper")
+#   GUIDE=1        pass the shadow guide (0: the render alone)
 #
-# Outputs in examples/blender/out/: room_<view>_<res>.exr (the render) and
+# Outputs in examples/blender/out/: room_<view>_<res>.exr (the render),
+# shadow_guide_<view>_<res>.exr, and
 # room_<view>_<res>/ with dcm.exr, stats.json, sample_map.png, preview.png,
 # error_map.png.
 set -euo pipefail
@@ -24,6 +27,7 @@ here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 SAMPLES="${SAMPLES:-256}"
 SS="${SS:-0}"
 DCM_ARGS="${DCM_ARGS:-}"
+GUIDE="${GUIDE:-1}"
 views=("$@")
 [ ${#views[@]} -eq 0 ] && views=(a b c)
 
@@ -47,14 +51,22 @@ print("%-14s %4dx%-4d exact %6.2f %% (%6d of %7d)  PSNR %6.2f dB  relMSE %.6f  S
 EOF
 }
 
+guide() {  # view res: the shadow guide input, or nothing with GUIDE=0
+  [ "$GUIDE" = 1 ] || return 0
+  render_shadow_guide "$out/shadow_guide_${1}_$2.exr" "$1" "$2"
+  echo "$out/shadow_guide_${1}_$2.exr"
+}
+
 for v in "${views[@]}"; do
   exr="$out/room_${v}_256.exr"
   render_room "$exr" "$v" 256 "$SAMPLES" 1
-  reconstruct "$exr" "$out/room_${v}_256"
+  # shellcheck disable=SC2046
+  reconstruct "$exr" "$out/room_${v}_256" $(guide "$v" 256)
   if [ "$SS" = 1 ]; then
     exr="$out/room_${v}_512.exr"
     render_room "$exr" "$v" 512 $(( (SAMPLES + 3) / 4 )) 1
-    reconstruct "$exr" "$out/room_${v}_512" --downsample 2
+    # shellcheck disable=SC2046
+    reconstruct "$exr" "$out/room_${v}_512" --downsample 2 $(guide "$v" 512)
   fi
 done
 echo "(exact = pixels DCM asked Cycles for; PSNR on sRGB-encoded values clipped to [0,1], against the full render)"

@@ -10,6 +10,7 @@
 #include <limits>
 
 #include "dcm/aov/aov_provider.h"
+#include "dcm/reconstructor.h"
 #include "test_util.h"
 
 namespace dcm::aov::test {
@@ -139,6 +140,89 @@ TEST(AovProvider, NormalGuides) {
   WriteExr(dir / "p.exr", 16, 8, partial);
   const Status st = OpenError({dir / "p.exr"});
   EXPECT_NE(st.message().find("N.X found but not N.Y, N.Z"), std::string::npos) << st.message();
+}
+
+TEST(AovProvider, ShadowGuideSplitsLitAndUnlitSurfaces) {
+  // Generic "shadow" (> 0: lit) folds into both IDs: a lit and an unlit
+  // pixel of one object and shader get different object and shader IDs, two
+  // lit (or two unlit) ones keep equal IDs; without IDs the guide gives them.
+  ScratchDir dir;
+  const Scene sc{16, 8};
+  std::vector<TestChannel> ch = sc.GenericChannels(false);
+  const auto lit = [](int x, int) { return x == 9 ? 0.f : 0.5f + 0.01f * float(x); };
+  ch.push_back(Fill("shadow", 16, 8, lit));
+  WriteExr(dir / "s.exr", 16, 8, ch);
+  auto p = MustOpen({dir / "s.exr"});
+  ASSERT_TRUE(p);
+  GuideRequest req;
+  req.objectId = req.shaderId = true;
+  const GuideImage g = AllGuides(*p, req);
+  const auto at = [](int x, int y) { return size_t(y * 16 + x); };
+  ASSERT_EQ(sc.ObjectId(8, 7), sc.ObjectId(9, 7));
+  ASSERT_EQ(sc.ShaderId(8, 7), sc.ShaderId(9, 7));
+  EXPECT_NE(g.objectId[at(8, 7)], g.objectId[at(9, 7)]);
+  EXPECT_NE(g.shaderId[at(8, 7)], g.shaderId[at(9, 7)]);
+  for (int x = 0; x + 1 < 16; ++x)
+    if (x != 8 && x != 9 && sc.ObjectId(x, 7) == sc.ObjectId(x + 1, 7))
+      EXPECT_EQ(g.objectId[at(x, 7)], g.objectId[at(x + 1, 7)]) << x;
+  bool said = false;
+  for (const auto& n : p->Notes()) said |= n.find("shadow guide: shadow") != std::string::npos;
+  EXPECT_TRUE(said);
+
+  WriteExr(dir / "beauty.exr", 16, 8, {ch[2], ch[3], ch[4], ch.back()});
+  auto q = MustOpen({dir / "beauty.exr"});
+  ASSERT_TRUE(q);
+  EXPECT_TRUE(q->Capabilities().objectId);
+  req.shaderId = false;
+  const GuideImage h = AllGuides(*q, req);
+  EXPECT_NE(h.objectId[at(8, 2)], h.objectId[at(9, 2)]);
+  EXPECT_EQ(h.objectId[at(2, 2)], h.objectId[at(12, 2)]);
+
+  // Not finite: an error naming the channel and the pixel.
+  ch.back() = Fill("shadow", 16, 8, [](int x, int y) { return x == 3 && y == 5 ? std::nanf("") : 1.f; });
+  WriteExr(dir / "nan.exr", 16, 8, ch);
+  const Status st = OpenError({dir / "nan.exr"});
+  EXPECT_THAT(st.message(), HasSubstr("shadow guide 'shadow'"));
+  EXPECT_THAT(st.message(), HasSubstr("(3, 5)"));
+}
+
+TEST(AovProvider, ShadowGuideFindsShadowsThinnerThanTheLattice) {
+  // A lit floor (0.8, one object, one shader) crossed by three thin hard
+  // shadows (0.15) of legs, 1-2 pixels wide, as the sun casts on a Cycles
+  // floor. Without a guide most of their pixels lie between lattice samples
+  // and are interpolated over; with the shadow guide their edges are
+  // surface changes. Measured mean error on the shadow pixels: 0.27 without
+  // the guide, 0 with it (every such pixel exact or interpolated from its
+  // own shadow); 1/10 of the blind error is asked.
+  ScratchDir dir;
+  constexpr int n = 128;
+  const auto inShadow = [](int x, int y) {
+    for (int leg : {20, 55, 90})
+      if (std::abs(2 * x - y - 2 * leg) <= 2) return true;
+    return false;
+  };
+  std::vector<TestChannel> ch;
+  for (const char* c : {"R", "G", "B"})
+    ch.push_back(Fill(c, n, n, [&](int x, int y) { return inShadow(x, y) ? 0.15f : 0.8f; }));
+  ch.push_back(Fill("id", n, n, [](int, int) { return 1.f; }));
+  ch.push_back(Fill("shader", n, n, [](int, int) { return 1.f; }));
+  WriteExr(dir / "blind.exr", n, n, ch);
+  ch.push_back(Fill("shadow", n, n, [&](int x, int y) { return inShadow(x, y) ? 0.f : 1.f; }));
+  WriteExr(dir / "guided.exr", n, n, ch);
+  auto shadowError = [&](const std::string& file) {
+    auto p = MustOpen({file});
+    Reconstruction r;
+    const Status st = Reconstruct(*p, ReconstructionOptions{}, &r);
+    EXPECT_TRUE(st.ok()) << st.message();
+    double sum = 0;
+    int count = 0;
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x)
+        if (inShadow(x, y)) sum += std::fabs(r.image[size_t(y * n + x)].g - 0.15f), ++count;
+    return sum / count;
+  };
+  const double blind = shadowError(dir / "blind.exr"), guided = shadowError(dir / "guided.exr");
+  EXPECT_LT(guided * 10, blind) << "guided " << guided << ", blind " << blind;
 }
 
 TEST(AovProvider, SeveralInputFilesAndMissingOptionalRoles) {
@@ -300,6 +384,30 @@ TEST(AovProvider, BlenderViewLayers) {
   o.viewLayer = "Side";
   st = OpenError({dir / "two.exr"}, o);
   EXPECT_THAT(st.message(), HasSubstr("no Blender view layer 'Side'"));
+}
+
+TEST(AovProvider, BlenderShadowGuideLayer) {
+  // A ShadowGuide view layer (examples/blender/make_and_render.py
+  // --shadow-guide) is taken as the shadow guide, R + G + B, and is not a
+  // candidate for the layer of the passes.
+  ScratchDir dir;
+  auto ch = BlenderChannels("ViewLayer", 8, 8, true);
+  for (const char* c : {"R", "G", "B", "A"})
+    ch.push_back(Fill(std::string("ShadowGuide.Combined.") + c, 8, 8, [](int x, int) { return x < 4 ? 1.f : 0.f; }));
+  WriteExr(dir / "room.exr", 8, 8, ch);
+  AovOptions o;
+  o.preset = Preset::kBlender;
+  auto p = MustOpen({dir / "room.exr"}, o);
+  ASSERT_TRUE(p);
+  bool said = false;
+  for (const auto& n : p->Notes())
+    said |= n.find("shadow guide: ShadowGuide.Combined.R+ShadowGuide.Combined.G+ShadowGuide.Combined.B") !=
+            std::string::npos;
+  EXPECT_TRUE(said);
+  GuideRequest req;
+  req.objectId = true;
+  const GuideImage g = AllGuides(*p, req);
+  EXPECT_NE(g.objectId[3], g.objectId[4]);  // same IndexOB (x < 5), lit and unlit
 }
 
 TEST(AovProvider, MapOverrides) {

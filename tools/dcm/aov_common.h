@@ -44,7 +44,7 @@ inline void AddAovFlags(CLI::App* app, AovFlags* f, bool samplesHelpForPlan) {
   app->add_option("--preset", f->preset, "channel names: generic (default) or blender (Cycles passes)")
       ->check(CLI::IsMember({"generic", "blender"}));
   app->add_option("--map", f->maps,
-                  "ROLE=CHANNEL: override a role (id, shader, u, v, tau, Li, Lc, L, var, mask or one "
+                  "ROLE=CHANNEL: override a role (id, shader, u, v, tau, N, shadow, Li, Lc, L, var, mask or one "
                   "component like tau.R); CHANNEL may be A+B, A*B or cryptomatte:LAYER")
       ->allow_extra_args(false);
   app->add_option("--texture", f->textures,

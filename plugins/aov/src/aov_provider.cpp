@@ -24,7 +24,7 @@ using detail::Quote;
 namespace {
 
 constexpr std::array<std::string_view, kRoleCount> kRoleNames = {
-    "id",   "shader", "u",    "v",    "tau.R", "tau.G", "tau.B", "N.X",   "N.Y",   "N.Z", "Li.R",  "Li.G",  "Li.B",
+    "id",   "shader", "u",    "v",    "tau.R", "tau.G", "tau.B", "N.X",   "N.Y",   "N.Z", "shadow", "Li.R",  "Li.G",  "Li.B",
     "Lc.R", "Lc.G",   "Lc.B", "L.R",  "L.G",   "L.B",   "var.R", "var.G", "var.B", "mask"};
 
 constexpr const char* kComp[3] = {"R", "G", "B"};
@@ -106,6 +106,11 @@ Status CheckExpr(Role role, const Expr& e, const ChannelSet& set) {
   return Status::Ok();
 }
 
+/// Blender view layers whose name starts with this hold a light-visibility
+/// guide in their Combined pass (examples/blender/make_and_render.py
+/// --shadow-guide); they are never the layer of the passes.
+constexpr const char* kShadowGuideLayer = "ShadowGuide";
+
 /// The Blender view-layer prefix ("ViewLayer." or "") of the passes in `set`.
 Status DetectBlenderLayer(const ChannelSet& set, const std::string& wanted, std::string* prefix,
                           std::vector<std::string>* notes) {
@@ -117,7 +122,8 @@ Status DetectBlenderLayer(const ChannelSet& set, const std::string& wanted, std:
     for (const char* pass : kPasses) {
       const std::string p(pass);
       if (name == p) bare = true;
-      if (name.size() > p.size() + 1 && OIIO::Strutil::ends_with(name, "." + p))
+      if (name.size() > p.size() + 1 && OIIO::Strutil::ends_with(name, "." + p) &&
+          !OIIO::Strutil::starts_with(name, kShadowGuideLayer))
         layers.insert(name.substr(0, name.size() - p.size() - 1));
     }
   }
@@ -166,6 +172,7 @@ Status PresetExprs(Preset preset, const std::string& viewLayer, const ChannelSet
       set1(Role::kV, "v");
       setRgb(kTau, "tau.");
       for (int c = 0; c < 3; ++c) set1(Comp(kNormal, c), std::string("N.") + "XYZ"[c]);
+      set1(Role::kShadow, "shadow");
     }
     setRgb(kLi, "Li.");
     setRgb(kLc, "Lc.");
@@ -203,6 +210,17 @@ Status PresetExprs(Preset preset, const std::string& viewLayer, const ChannelSet
     set1(Role::kV, p + "UV.V");
     setRgb(kTau, p + "DiffCol.");
     for (int c = 0; c < 3; ++c) set1(Comp(kNormal, c), p + "Normal." + "XYZ"[c]);
+    // The shadow guide: the first ShadowGuide* layer's Combined, R + G + B.
+    for (const auto& name : set.Names()) {
+      if (!OIIO::Strutil::starts_with(name, kShadowGuideLayer) || !OIIO::Strutil::ends_with(name, ".Combined.R"))
+        continue;
+      const std::string base = name.substr(0, name.size() - 1);
+      if (!set.Has(base + "G") || !set.Has(base + "B")) continue;
+      Expr e;
+      e.terms = {{base + "R"}, {base + "G"}, {base + "B"}};
+      (*roles)[size_t(Role::kShadow)] = e;
+      break;
+    }
   }
   setRgb(kL, p + "Combined.");
   for (int c = 0; c < 3; ++c) {
@@ -461,6 +479,36 @@ std::string IdNote(const ChannelSet& set, const char* what, const Expr& e) {
   return std::string(what) + ": channel " + Quote(e.Text());
 }
 
+/// Folds a light-visibility guide into the IDs, as the tracer's shadow guide
+/// does: a lit pixel (guide > 0) and an unlit one of the same object and
+/// shader become different surfaces, so a hard shadow's edge is a surface
+/// change and a shadow thinner than the lattice is found like a thin object.
+/// Without IDs the guide alone gives them.
+Status FoldShadowGuide(const ChannelSet& set, Evaluator& eval, const Expr& e, Data* d) {
+  std::vector<float> g;
+  DCM_RETURN_IF_ERROR(eval.Eval(e, &g));
+  size_t lit = 0;
+  for (size_t i = 0; i < g.size(); ++i) {
+    if (!std::isfinite(g[i]))
+      return Status::Error("shadow guide " + Quote(e.Text()) + " in " + set.Paths() + ": not finite at pixel (" +
+                           std::to_string(i % size_t(d->width)) + ", " + std::to_string(i / size_t(d->width)) + ")");
+    lit += g[i] > 0.f;
+  }
+  // A constant far from small IDs and Cryptomatte's float bit patterns'
+  // common values; a collision would only merge two surfaces.
+  constexpr uint32_t kLit = 0x9E3779B9u;
+  if (d->objectId.empty()) d->objectId.assign(g.size(), 0u);
+  for (size_t i = 0; i < g.size(); ++i)
+    if (g[i] > 0.f) {
+      d->objectId[i] ^= kLit;
+      if (!d->shaderId.empty()) d->shaderId[i] ^= kLit;
+    }
+  d->notes.push_back("shadow guide: " + e.Text() + " (lit where > 0: " +
+                     std::to_string(int(std::lround(100.0 * double(lit) / double(std::max<size_t>(g.size(), 1))))) +
+                     " % of the pixels; lit and unlit parts of a surface are different surfaces)");
+  return Status::Ok();
+}
+
 /// tau(u, v) from texture files for the bound shaders.
 Status LookupTextures(const ChannelSet& set, const RoleExprs& roles,
                       const std::vector<TextureBinding>& bindings, const std::optional<Expr>& shaderExpr,
@@ -686,13 +734,15 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
     d->objectId = d->shaderId;
     d->shaderId.clear();
     d->notes.push_back("no object IDs: the shader IDs act as object IDs");
-  } else if (!idExpr) {
+  } else if (!idExpr && !roles[size_t(Role::kShadow)]) {
     d->notes.push_back("no object or shader IDs: the object and thin-object tests are off (contrast only)");
   } else if (!shaderExpr) {
     d->notes.push_back("no shader IDs: surfaces change where the object ID changes");
   }
 
   Evaluator guideEval(guides);
+  if (const auto& shadowExpr = roles[size_t(Role::kShadow)])
+    DCM_RETURN_IF_ERROR(FoldShadowGuide(guides, guideEval, *shadowExpr, d.get()));
   bool hasTau = false;
   DCM_RETURN_IF_ERROR(RgbPresent(roles, kTau, guides, &hasTau));
   if (hasTau) {

@@ -33,6 +33,7 @@ enum class Role : int {
   kV,         ///< "v": texture coordinate, with --texture
   kTauR, kTauG, kTauB,  ///< "tau.R/G/B": texture value
   kNX, kNY, kNZ,        ///< "N.X/Y/Z": surface normal (creases inside one object)
+  kShadow,    ///< "shadow": light-visibility guide, > 0 where the light reaches the surface
   kLiR, kLiG, kLiB,     ///< "Li.R/G/B": radiance before texturing
   kLcR, kLcG, kLcB,     ///< "Lc.R/G/B": radiance not modulated by the texture
   kLR, kLG, kLB,        ///< "L.R/G/B": beauty radiance
@@ -50,14 +51,15 @@ Status ParseRole(std::string_view name, Role* role);
 
 /// Where the channel names come from.
 enum class Preset {
-  /// Plain names: id, shader, u, v, tau.R/G/B, N.X/Y/Z, Li.R/G/B, Lc.R/G/B,
-  /// beauty R/G/B, var.R/G/B, mask.
+  /// Plain names: id, shader, u, v, tau.R/G/B, N.X/Y/Z, shadow, Li.R/G/B,
+  /// Lc.R/G/B, beauty R/G/B, var.R/G/B, mask.
   kGeneric,
   /// Blender Cycles multilayer EXR: <layer>.IndexOB.X, IndexMA.X (or the
   /// CryptoObject / CryptoMaterial layers), UV.U/V, Normal.X/Y/Z, tau = DiffCol,
   /// L_i = DiffDir + DiffInd, L = Combined, L_c = L - L_i*tau (so that
   /// L_i*tau + L_c = Combined; without Combined, L_c is the sum of the
-  /// Gloss, Trans, Volume, Emit and Env contributions).
+  /// Gloss, Trans, Volume, Emit and Env contributions). The Combined of a
+  /// view layer named ShadowGuide* is the shadow guide (R + G + B).
   kBlender,
 };
 Status ParsePreset(std::string_view name, Preset* preset);
