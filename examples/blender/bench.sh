@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# What accuracy costs on the Cycles room (docs/AOV.md, issue 3): `dcm bench`
+# on each view with its shadow guide, dcm against the paper, Guo and the two
+# rivals (uniform grid + bilinear, + joint bilateral) at every threshold,
+# block size and enhancement switch; CSV, summary and plots.
+#
+#   examples/blender/bench.sh OUTDIR [VIEW ...]     views a, b, c (default all)
+#
+# Environment: DCM, BLENDER, THREADS as for run.sh; SAMPLES=1024 (Cycles
+# samples per pixel, seed 3: the renders are also the references of
+# noise.sh); SS=1 also view a at 512x512 with SAMPLES per sub-pixel (4x the
+# cost, about 5 min on 2 cores), benched with --downsample 2 in OUTDIR/4x.
+# Renders only the EXRs that are missing (examples/blender/out/).
+set -euo pipefail
+
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+# shellcheck source=common.sh
+. "$here/common.sh"
+SAMPLES="${SAMPLES:-1024}"
+SS="${SS:-0}"
+[ $# -ge 1 ] || { echo "usage: bench.sh OUTDIR [VIEW ...]" >&2; exit 2; }
+dest="$1"
+shift
+views=("$@")
+[ ${#views[@]} -eq 0 ] && views=(a b c)
+require_tools bench.sh
+command -v oiiotool >/dev/null || { echo "bench.sh: no oiiotool (scripts/install-deps.sh)" >&2; exit 1; }
+
+# guided EXR VIEW RES: the render with its shadow guide appended (one file
+# per scene, as dcm bench takes them).
+guided() {
+  local render="$1" view="$2" res="$3" guide="$out/shadow_guide_${2}_${3}.exr" both="$out/guided_${2}_${3}_${SAMPLES}.exr"
+  render_room "$render" "$view" "$res" "$SAMPLES" 3
+  render_shadow_guide "$guide" "$view" "$res"
+  [ -f "$both" ] || oiiotool "$render" "$guide" --chappend -o "$both"
+  echo "$both"
+}
+
+inputs=()
+for v in "${views[@]}"; do inputs+=("$(guided "$out/noise_${v}_${SAMPLES}_s3.exr" "$v" 256)"); done
+"$DCM" bench "${inputs[@]}" --preset blender --out "$dest/1x"
+if [ "$SS" = 1 ]; then
+  "$DCM" bench "$(guided "$out/noise_a512_${SAMPLES}_s3.exr" a 512)" --preset blender --downsample 2 --out "$dest/4x"
+fi
