@@ -25,7 +25,7 @@ SampleStore::SampleStore(int width, int height, bool split, bool variance)
   if (variance) var_.assign(n, {0.f, 0.f});
 }
 
-void SampleStore::SetGuides(GuideImage guides, ObjectTest test, float creaseAngle) {
+void SampleStore::SetGuides(GuideImage guides, ObjectTest test, float creaseAngle, int regionCell) {
   guides_ = std::move(guides);
   if (split_) tau_ = std::move(guides_.texture);
   const uint32_t* obj = (test != ObjectTest::kNone && !guides_.objectId.empty()) ? guides_.objectId.data() : nullptr;
@@ -59,33 +59,45 @@ void SampleStore::SetGuides(GuideImage guides, ObjectTest test, float creaseAngl
     tauZero_.resize(tau_.size());
     for (size_t i = 0; i < tau_.size(); ++i) tauZero_[i] = TauZero(tau_[i]) ? 1 : 0;
   }
-  region_.clear();
+  regions_ = CellRegions{};
   if (!crease_.empty()) {
-    // Regions: union-find over 4-neighbours of one object (and one tau = 0
+    // Per cell: union-find over 4-neighbours of one object (and one tau = 0
     // class) that no crease separates.
-    const size_t n = crease_.size();
-    region_.resize(n);
-    for (size_t i = 0; i < n; ++i) region_[i] = uint32_t(i);
-    auto find = [&](uint32_t i) {
-      while (region_[i] != i) i = region_[i] = region_[region_[i]];
-      return i;
-    };
-    auto join = [&](size_t i, size_t j) {
-      if (obj && obj[i] != obj[j]) return;
-      if (!tauZero_.empty() && tauZero_[i] != tauZero_[j]) return;
-      const uint32_t a = find(uint32_t(i)), b = find(uint32_t(j));
-      if (a != b) region_[std::max(a, b)] = std::min(a, b);
-    };
-    for (int y = 0; y < height_; ++y)
-      for (int x = 0; x < width_; ++x) {
-        const size_t i = size_t(Index(x, y));
-        if (x + 1 < width_ && !(crease_[i] & 1)) join(i, i + 1);
-        if (y + 1 < height_ && !(crease_[i] & 2)) join(i, i + size_t(width_));
+    const int e = std::max(1, regionCell);
+    regions_.size = e;
+    regions_.cellsX = (width_ + e - 1) / e;
+    const int cellsY = (height_ + e - 1) / e;
+    const size_t perCell = size_t(e + 1) * size_t(e + 1);
+    regions_.labels.assign(size_t(regions_.cellsX) * size_t(cellsY) * perCell, 0u);
+    tbb::parallel_for(0, cellsY, [&](int cy) {
+      for (int cx = 0; cx < regions_.cellsX; ++cx) {
+        uint32_t* label = regions_.labels.data() + (size_t(cy) * size_t(regions_.cellsX) + size_t(cx)) * perCell;
+        for (size_t k = 0; k < perCell; ++k) label[k] = uint32_t(k);
+        auto find = [&](uint32_t k) {
+          while (label[k] != k) k = label[k] = label[label[k]];
+          return k;
+        };
+        const int x0 = cx * e, y0 = cy * e;
+        const int x1 = std::min(x0 + e, width_ - 1), y1 = std::min(y0 + e, height_ - 1);
+        auto join = [&](size_t i, size_t j, uint32_t a, uint32_t b) {
+          if (obj && obj[i] != obj[j]) return;
+          if (!tauZero_.empty() && tauZero_[i] != tauZero_[j]) return;
+          a = find(a), b = find(b);
+          if (a != b) label[std::max(a, b)] = std::min(a, b);
+        };
+        for (int y = y0; y <= y1; ++y)
+          for (int x = x0; x <= x1; ++x) {
+            const size_t i = size_t(Index(x, y));
+            const uint32_t k = uint32_t((y - y0) * (e + 1) + (x - x0));
+            if (x < x1 && !(crease_[i] & 1)) join(i, i + 1, k, k + 1);
+            if (y < y1 && !(crease_[i] & 2)) join(i, i + size_t(width_), k, k + uint32_t(e + 1));
+          }
+        for (size_t k = 0; k < perCell; ++k) label[k] = find(uint32_t(k));
       }
-    for (size_t i = 0; i < n; ++i) region_[i] = find(uint32_t(i));
+    });
   }
   surfaces_ = SurfaceTest(obj, shader, crease_.empty() ? nullptr : crease_.data(), width_,
-                          tauZero_.empty() ? nullptr : tauZero_.data(), region_.empty() ? nullptr : region_.data());
+                          tauZero_.empty() ? nullptr : tauZero_.data(), regions_.labels.empty() ? nullptr : &regions_);
 }
 
 bool SampleStore::TauZero(RGB tau) { return tau.r == 0.f && tau.g == 0.f && tau.b == 0.f; }

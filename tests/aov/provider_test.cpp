@@ -162,9 +162,11 @@ TEST(AovProvider, ShadowGuideSplitsLitAndUnlitSurfaces) {
   ASSERT_EQ(sc.ShaderId(8, 7), sc.ShaderId(9, 7));
   EXPECT_NE(g.objectId[at(8, 7)], g.objectId[at(9, 7)]);
   EXPECT_NE(g.shaderId[at(8, 7)], g.shaderId[at(9, 7)]);
-  for (int x = 0; x + 1 < 16; ++x)
-    if (x != 8 && x != 9 && sc.ObjectId(x, 7) == sc.ObjectId(x + 1, 7))
+  for (int x = 0; x + 1 < 16; ++x) {
+    if (x != 8 && x != 9 && sc.ObjectId(x, 7) == sc.ObjectId(x + 1, 7)) {
       EXPECT_EQ(g.objectId[at(x, 7)], g.objectId[at(x + 1, 7)]) << x;
+    }
+  }
   bool said = false;
   for (const auto& n : p->Notes()) said |= n.find("shadow guide: shadow") != std::string::npos;
   EXPECT_TRUE(said);

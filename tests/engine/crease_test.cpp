@@ -118,6 +118,47 @@ TEST(Crease, ACreaseThatEndsInsideTheObjectDoesNotSplitIt) {
   EXPECT_FALSE(s.surfaces().SameAdjacent(s.Index(5, 0), s.Index(6, 0)));
 }
 
+TEST(Crease, RegionsAreDecidedInsideOneCellOfTheLattice) {
+  // A comb of slots (normal turned by 90 degrees, 2 pixels wide, every 8
+  // pixels) from the top of a 48x48 frame down to row 40: the two sides of a
+  // slot join only below it. A window of the top 32 rows (a tile with its
+  // halo) must answer Same() as the frame does for every pair of pixels that
+  // share a 16-pixel cell inside the window, or tiles would differ from the
+  // frame (docs/TILES.md). Regions found over the whole image would join the
+  // sides in the frame and not in the window.
+  constexpr int n = 48, rows = 32, cell = 16;
+  auto slotted = [](int x, int y) {
+    return x % 8 >= 3 && x % 8 < 5 && y < 40 ? Vec3f{0.f, 1.f, 0.f} : Vec3f{0.f, 0.f, 1.f};
+  };
+  auto store = [&](int h) {
+    detail::SampleStore s(n, h, false);
+    GuideImage g;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < n; ++x) {
+        g.objectId.push_back(1);
+        g.shaderId.push_back(1);
+        g.normal.push_back(slotted(x, y));
+      }
+    s.SetGuides(std::move(g), ObjectTest::kObjectAndShader, 30.f, cell);
+    return s;
+  };
+  const detail::SampleStore frame = store(n), window = store(rows);
+  int pairs = 0, separated = 0;
+  for (int cy = 0; cy + cell < rows; cy += cell)
+    for (int cx = 0; cx + cell < n; cx += cell)
+      for (int a = 0; a < (cell + 1) * (cell + 1); ++a)
+        for (int b = a + 1; b < (cell + 1) * (cell + 1); ++b) {
+          const int xa = cx + a % (cell + 1), ya = cy + a / (cell + 1), xb = cx + b % (cell + 1), yb = cy + b / (cell + 1);
+          const bool f = frame.surfaces().Same(frame.Index(xa, ya), frame.Index(xb, yb));
+          ASSERT_EQ(f, window.surfaces().Same(window.Index(xa, ya), window.Index(xb, yb)))
+              << "(" << xa << ", " << ya << ") and (" << xb << ", " << yb << ")";
+          ++pairs, separated += !f;
+        }
+  // The slots do cut: across a slot, two pixels of one object are apart.
+  EXPECT_GT(separated, pairs / 4);
+  EXPECT_FALSE(frame.surfaces().Same(frame.Index(2, 5), frame.Index(6, 5)));
+}
+
 TEST(Crease, RegionsOnlyRefineOneObject) {
   // Objects 1 (x < 8) and 3 (x >= 8, shader 2) are separated by their IDs as
   // before; object 2 (shader 2) next to object 3 shares its shader, so it is

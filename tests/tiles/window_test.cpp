@@ -22,12 +22,28 @@ struct Case {
   int width, height, downsample;
   ReconstructionOptions options;
   bool noisy = false;  ///< Monte Carlo noise with its variance: significance tests and sample denoising
+  bool creases = false;  ///< normal guides whose creases cut the objects into regions
 };
+
+/// The furnished scene with a comb of creases: slots 3 pixels wide, every 20
+/// pixels, from the top to three quarters down, whose normal is turned by
+/// 90 degrees (regions: Crease.RegionsAreDecidedInsideOneCellOfTheLattice).
+SceneFunction Creased(int width, int height) {
+  const SceneFunction base = FurnishedScene(width, height);
+  return [base, height](int x, int y) {
+    PixelTruth t = base(x, y);
+    const bool slot = x % 20 >= 9 && x % 20 < 12 && y < height * 3 / 4;
+    t.normal = slot ? Vec3f{0.f, 1.f, 0.f} : Vec3f{0.f, 0.f, 1.f};
+    return t;
+  };
+}
 
 /// The case's provider: the furnished scene, with noise for noisy cases.
 struct CaseProvider {
   explicit CaseProvider(const Case& c)
-      : exact(c.width, c.height, FurnishedScene(c.width, c.height)), noisy(exact, NoiseModel{0.1f, 0.01f, 7}) {}
+      : exact(c.width, c.height, c.creases ? Creased(c.width, c.height) : FurnishedScene(c.width, c.height),
+              AnalyticChannels{.normals = c.creases}),
+        noisy(exact, NoiseModel{0.1f, 0.01f, 7}) {}
   SampleProvider& Get(const Case& c) { return c.noisy ? static_cast<SampleProvider&>(noisy) : exact; }
   AnalyticProvider exact;
   NoisyProvider noisy;
@@ -65,6 +81,8 @@ std::vector<Case> Cases() {
   ReconstructionOptions plain = dcm;
   plain.denoiseSamples = false;
   cases.push_back({"noisy samples, not denoised, 150x118", 150, 118, 1, plain, true});
+  cases.push_back({"normal guides with creases, 160x128", 160, 128, 1, dcm, false, true});
+  cases.push_back({"normal guides with creases, noisy, supersampled 2, 198x134", 198, 134, 2, ss, true, true});
   return cases;
 }
 
