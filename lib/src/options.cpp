@@ -33,6 +33,7 @@ ReconstructionOptions ReconstructionOptions::Paper() {
   o.thinObjects = ThinObjectTest::kNoneMatches;
   o.textureSplit = true;
   o.fallback = true;  // "switching back to a full sampling for these few critical cases"
+  o.fallbackMaxChanges = 4;  // more than two edges: more than two objects on the border
   return o;
 }
 

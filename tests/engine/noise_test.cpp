@@ -61,10 +61,9 @@ TEST(Noise, ZeroVarianceChangesNothing) {
 TEST(Noise, TheLiteralTestsChaseTheNoise) {
   // The problem the paper names: taken at face value, noise reads as detail.
   const double clean = ReconstructNoisy({0.f, 0.f}).r.stats.exactFraction();
-  // Measured: 2.55x the noise-free fraction at 10 % noise (3.2x while
-  // fallback blocks also evaluated their filled border pixels).
+  // Measured: 3.4x the noise-free fraction at 10 % noise.
   const double literal = ReconstructNoisy({0.1f, 0.01f}, Significance(0.f)).r.stats.exactFraction();
-  EXPECT_GT(literal, 2.2 * clean) << "clean " << clean << ", literal " << literal;
+  EXPECT_GT(literal, 2.5 * clean) << "clean " << clean << ", literal " << literal;
 }
 
 TEST(Noise, SignificanceSamplesAtTheNoiselessRate) {
@@ -80,8 +79,8 @@ TEST(Noise, SignificanceSamplesAtTheNoiselessRate) {
 
 TEST(Noise, DefaultSignificanceSamplesFarLessThanTheLiteralTests) {
   // The default (0.5 sd) errs towards refining, to keep faint features, yet
-  // spends at most 2/3 of the samples the literal tests spend on the same
-  // lattice at every noise level (measured: 62, 47 and 40 % at 5, 10 and
+  // spends at most 60 % of the samples the literal tests spend on the same
+  // lattice at every noise level (measured: 53, 43 and 41 % at 5, 10 and
   // 20 % noise).
   for (float rel : {0.05f, 0.1f, 0.2f}) {
     const NoiseModel m{rel, 0.01f};
@@ -89,7 +88,7 @@ TEST(Noise, DefaultSignificanceSamplesFarLessThanTheLiteralTests) {
     ReconstructionOptions literalOptions = Significance(0.f);
     literalOptions.elementaryBlock = literalOptions.noisyElementaryBlock;
     const double literal = ReconstructNoisy(m, literalOptions).r.stats.exactFraction();
-    EXPECT_LE(aware, 0.67 * literal) << "relative noise " << rel;
+    EXPECT_LE(aware, 0.6 * literal) << "relative noise " << rel;
   }
 }
 

@@ -14,7 +14,8 @@ import re
 import sys
 
 SCENES = ["room", "room-paper", "cactus", "parquet", "mirror"]
-THRESHOLDS = ["0.015", "0.03", "0.06", "0.1", "0.15", "0.25", "0.5"]
+THRESHOLDS = ["0.015", "0.03", "0.06", "0.1", "0.12", "0.15", "0.25", "0.5"]
+DEFAULT = "0.12"  # dcm's default contrast threshold (ReconstructionOptions)
 
 
 def rows(results, scene):
@@ -86,7 +87,7 @@ def methods_table(results):
     print("|---|---|---|---|---|---|---|---|---|---|")
     for scene in SCENES:
         rs = rows(results, scene)
-        for label in ("full", "dcm t=0.15", "paper t=0.06", "guo t=0.06"):
+        for label in ("full", "dcm t=" + DEFAULT, "paper t=0.06", "guo t=0.06"):
             r = by_label(rs, label)
             if r is None:
                 continue
@@ -96,7 +97,7 @@ def methods_table(results):
 
 
 def threshold_table(results):
-    print("| scene | " + " | ".join("t=%s%s" % (t, " (default)" if t == "0.15" else "") for t in THRESHOLDS) + " |")
+    print("| scene | " + " | ".join("t=%s%s" % (t, " (default)" if t == DEFAULT else "") for t in THRESHOLDS) + " |")
     print("|---|" + "---|" * len(THRESHOLDS))
     for scene in SCENES:
         rs = rows(results, scene)
@@ -118,8 +119,8 @@ def settings_table(results):
             if r["label"] not in labels:
                 labels.append(r["label"])
             table[(r["label"], scene)] = "%.2f / %.2f" % (pct(r), float(r["psnr_db"]))
-        table[("dcm default (t=0.15)", scene)] = "%.2f / %.2f" % (
-            pct(by_label(rows(results, scene), "dcm t=0.15")), float(by_label(rows(results, scene), "dcm t=0.15")["psnr_db"]))
+        default = by_label(rows(results, scene), "dcm t=" + DEFAULT)
+        table[("dcm default (t=%s)" % DEFAULT, scene)] = "%.2f / %.2f" % (pct(default), float(default["psnr_db"]))
         table[("guo default (t=0.06, block 8)", scene)] = "%.2f / %.2f" % (
             pct(by_label(rows(results, scene), "guo t=0.06")), float(by_label(rows(results, scene), "guo t=0.06")["psnr_db"]))
     # The supersampling rows together, in order (a scene's own rate is its
@@ -127,7 +128,7 @@ def settings_table(results):
     dcm = [l for l in labels if l.startswith("dcm") and not l.startswith("dcm ss=")]
     ss = sorted((l for l in labels if l.startswith("dcm ss=")), key=lambda l: int(l.split("=")[1]))
     at = next((i for i, l in enumerate(dcm) if not l.startswith(("dcm min_block", "dcm block"))), len(dcm))
-    order = ["dcm default (t=0.15)"] + dcm[:at] + ss + dcm[at:] + \
+    order = ["dcm default (t=%s)" % DEFAULT] + dcm[:at] + ss + dcm[at:] + \
             ["guo default (t=0.06, block 8)"] + [l for l in labels if l.startswith("guo")]
     print("| setting | " + " | ".join(SCENES) + " |")
     print("|---|" + "---|" * len(SCENES))

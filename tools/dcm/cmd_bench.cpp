@@ -244,8 +244,8 @@ std::string DefaultLabel(const std::string& method) {
 std::vector<Config> SweepConfigs(const BenchFlags& f, const Subject& s) {
   std::vector<float> thresholds = f.thresholds;
   if (thresholds.empty())
-    thresholds = f.quick ? std::vector<float>{0.03f, 0.06f, 0.15f, 0.3f}
-                         : std::vector<float>{0.015f, 0.03f, 0.06f, 0.1f, 0.15f, 0.25f, 0.5f};
+    thresholds = f.quick ? std::vector<float>{0.03f, 0.06f, 0.12f, 0.3f}
+                         : std::vector<float>{0.015f, 0.03f, 0.06f, 0.1f, 0.12f, 0.15f, 0.25f, 0.5f};
   const std::vector<int> minBlocks = f.quick ? std::vector<int>{2, 4, 8} : std::vector<int>{1, 2, 4, 8};
   const std::vector<int> blocks = f.quick ? std::vector<int>{8, 16, 32} : std::vector<int>{4, 8, 16, 32};
   std::vector<int> sss;

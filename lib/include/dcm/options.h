@@ -66,9 +66,10 @@ struct ReconstructionOptions {
   int LargestElementaryBlock() const {
     return ElementaryBlockFor(false) > ElementaryBlockFor(true) ? ElementaryBlockFor(false) : ElementaryBlockFor(true);
   }
-  /// Smooth/edge threshold of the contrast test (docs/ENGINE.md: 0.15 keeps
-  /// every bundled scene above 45 dB at 3-5 % exact pixels).
-  float contrastThreshold = 0.15f;
+  /// Smooth/edge threshold of the contrast test: 0.12 keeps every bundled
+  /// scene above 46 dB at 2.7-6 % exact pixels and every Cycles view of
+  /// docs/AOV.md at or above 40 dB (docs/RESULTS.md, docs/AOV.md).
+  float contrastThreshold = 0.12f;
   ContrastMetric contrastMetric = ContrastMetric::kMitchell;
   int directions = 8;        ///< candidate directions of the least-discrepancy search
 
@@ -106,7 +107,12 @@ struct ReconstructionOptions {
   /// discontinuities cross it: no single direction can serve it), or, with
   /// adaptive borders, whose border needed more than 3/4 of its pixels exactly.
   bool fallback = true;
-  int fallbackMaxChanges = 4;
+  /// More significant changes than this along a finest block's border make
+  /// it fall back: 6, three discontinuities. Two (a thin object across the
+  /// block) interpolate well; at 4, the third one's fallbacks cost 0.04-0.7
+  /// points of exact pixels for 0.01-0.5 dB (docs/AOV.md), less than the
+  /// same samples buy as a lower threshold.
+  int fallbackMaxChanges = 6;
   /// With adaptive borders, a fallback block also evaluates the border
   /// pixels that the bisection filled (its ends agreed). Off: the fills are
   /// trusted, as the neighbouring blocks that share the side trust them
