@@ -303,8 +303,7 @@ void Engine::WriteSmooth(const Leaf& leaf) {
     for (int ch = 0; ch < 3; ++ch) c[k][ch] = v.a[ch], c[k][3 + ch] = v.b[ch];
   }
   const double sx = b.x1 > b.x0 ? 1.0 / (b.x1 - b.x0) : 0.0, sy = b.y1 > b.y0 ? 1.0 / (b.y1 - b.y0) : 0.0;
-  const int channels = split_ ? 6 : 3;
-  const bool onlyL = !split_ && !store_.hasVariance();
+  const int channels = split_ ? 6 : 3;  // (L_i, L_c) or L
   for (int y = b.y0; y <= ye; ++y) {
     const double v = (y - b.y0) * sy;
     double left[6], right[6];
@@ -316,7 +315,7 @@ void Engine::WriteSmooth(const Leaf& leaf) {
       const int64_t i = store_.Index(x, y);
       if (store_.IsExact(i) || store_.IsFilled(i)) continue;
       const double u = (x - b.x0) * sx;
-      if (onlyL) {
+      if (!split_) {
         store_.SetInterpolatedL(i, RGB(float(u == 0 ? left[0] : (1 - u) * left[0] + u * right[0]),
                                        float(u == 0 ? left[1] : (1 - u) * left[1] + u * right[1]),
                                        float(u == 0 ? left[2] : (1 - u) * left[2] + u * right[2])));

@@ -124,9 +124,6 @@ std::array<float, 2> SampleStore::LuminanceVariances(RGB varL, RGB tau) {
   return {a * a, b * b};
 }
 
-void SampleStore::SetInterpolated(int64_t i, const Value& v) {
-  if (!IsExact(i)) Write(i, v);
-}
 
 void SampleStore::ReplaceExact(int64_t i, const Value& v) { Write(i, v); }
 

@@ -140,18 +140,22 @@ class SampleStore {
   bool hasVariance() const { return !var_.empty(); }
   RGB Tau(int64_t i) const { return tau_.empty() ? RGB::Gray(1.f) : tau_[i]; }
 
-  /// Writes an interpolated value (never over an exact pixel).
-  void SetInterpolated(int64_t i, const Value& v);
-  /// SetInterpolated() of L alone, for a store without the split and without
-  /// variances (the value's other fields would be zero).
+  /// Writes an interpolated pixel's radiance (never over an exact pixel).
+  /// Its (L_i, L_c) and variance are not kept: only exact and filled pixels
+  /// serve as interpolants, and the outputs read the radiance alone.
+  void SetInterpolated(int64_t i, const Value& v) {
+    if (!IsExact(i)) out_[i] = split_ ? v.a * tau_[size_t(i)] + v.b : v.a;
+  }
+  /// The same without the split: L itself.
   void SetInterpolatedL(int64_t i, RGB L) {
     if (!IsExact(i)) out_[i] = L;
   }
   /// Writes a value filled along an edge-block border; block interiors then
   /// interpolate it, and smooth blocks leave it in place.
   void SetFilled(int64_t i, const Value& v) {
-    SetInterpolated(i, v);
-    if (!IsExact(i)) filled_[i] = 1;
+    if (IsExact(i)) return;
+    Write(i, v);
+    filled_[i] = 1;
   }
   bool IsFilled(int64_t i) const { return filled_[i] != 0; }
   /// Replaces the value of exact pixel i (a denoised estimate); it stays exact.
