@@ -25,6 +25,9 @@ ref="$out/noise_${view}_${REF_SPP}_s3.exr"
 render_room "$a" "$view" 256 "$SPP" 1
 render_room "$b" "$view" 256 "$SPP" 2
 render_room "$ref" "$view" 256 "$REF_SPP" 3
+# The sun's shadow guide (1 sample), a second input of every dcm run.
+guide="$out/shadow_guide_${view}_256.exr"
+render_shadow_guide "$guide" "$view" 256
 # The reference's beauty as plain R, G, B for --reference.
 layer=$(oiiotool --info -v "$ref" | sed -n 's/.*channel list: \([^ ,]*\)\.Combined\.R.*/\1/p' | head -1)
 layer=${layer:-ViewLayer}
@@ -43,13 +46,13 @@ print("| %s | %.1f | %.2f | %.3g | %.4f |" % (sys.argv[2], 100 * s["exact_fracti
 PY
 }
 
-echo "Cycles, view $view, 256x256; noisy renders $SPP spp (seeds 1, 2), reference $REF_SPP spp (seed 3)."
+echo "Cycles, view $view, 256x256; noisy renders $SPP spp (seeds 1, 2), reference $REF_SPP spp (seed 3); dcm runs with the shadow guide."
 echo
 echo "| input and method | exact % | PSNR dB | relMSE | SSIM |"
 echo "|---|---|---|---|---|"
 run "one render: the render itself" "$a" --full
 run "one render: paper (noise taken at face value)" "$a" --method paper
-run "one render: dcm, noise ignored (no variance)" "$a"
-run "one render: dcm --estimate-variance" "$a" --estimate-variance
+run "one render: dcm, noise ignored (no variance)" "$a" "$guide"
+run "one render: dcm --estimate-variance" "$a" "$guide" --estimate-variance
 run "two renders: their mean" "$a" --second-render "$b" --full
-run "two renders: dcm --second-render" "$a" --second-render "$b"
+run "two renders: dcm --second-render" "$a" "$guide" --second-render "$b"
