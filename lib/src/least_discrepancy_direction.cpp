@@ -74,8 +74,7 @@ DirectionChoice Search(std::span<const Value> value, std::span<const uint8_t> fi
 }
 }  // namespace
 
-BorderPairs::BorderPairs(int width, int height, int directions)
-    : width_(width), height_(height), directions_(directions) {
+BorderPairs::BorderPairs(int width, int height, int directions) : directions_(directions) {
   const Block local{0, 0, width, height};
   std::vector<Point2i> loop;
   BorderLoop(local, &loop);

@@ -29,8 +29,6 @@ class BorderPairs {
   };
   /// `width`, `height` in pixel steps (Block::width()).
   BorderPairs(int width, int height, int directions);
-  int width() const { return width_; }
-  int height() const { return height_; }
   int directions() const { return directions_; }
   /// The pairs of direction k, in border order.
   std::span<const Pair> Of(int k) const {
@@ -38,7 +36,7 @@ class BorderPairs {
   }
 
  private:
-  int width_, height_, directions_;
+  int directions_;
   std::vector<Pair> pairs_;
   std::vector<size_t> start_;
 };

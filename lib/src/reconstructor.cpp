@@ -315,12 +315,6 @@ void Engine::WriteSmooth(const Leaf& leaf) {
       const int64_t i = store_.Index(x, y);
       if (store_.IsExact(i) || store_.IsFilled(i)) continue;
       const double u = (x - b.x0) * sx;
-      if (!split_) {
-        store_.SetInterpolatedL(i, RGB(float(u == 0 ? left[0] : (1 - u) * left[0] + u * right[0]),
-                                       float(u == 0 ? left[1] : (1 - u) * left[1] + u * right[1]),
-                                       float(u == 0 ? left[2] : (1 - u) * left[2] + u * right[2])));
-        continue;
-      }
       Value out;
       for (int ch = 0; ch < channels; ++ch) {
         const float f = float(u == 0 ? left[ch] : (1 - u) * left[ch] + u * right[ch]);

@@ -124,7 +124,6 @@ std::array<float, 2> SampleStore::LuminanceVariances(RGB varL, RGB tau) {
   return {a * a, b * b};
 }
 
-
 void SampleStore::ReplaceExact(int64_t i, const Value& v) { Write(i, v); }
 
 void SampleStore::Write(int64_t i, const Value& v) {

@@ -87,11 +87,11 @@ class SurfaceTest {
   }
 
  private:
+  bool SameRegion(int64_t i, int64_t j) const;
+
   const uint32_t* objectId_ = nullptr;
   const uint32_t* shaderId_ = nullptr;
   const uint8_t* crease_ = nullptr;
-  bool SameRegion(int64_t i, int64_t j) const;
-
   const uint8_t* tauZero_ = nullptr;
   const uint32_t* regionLabels_ = nullptr;  ///< CellRegions::labels (its buffer outlives moves)
   int regionSize_ = 0, regionCellsX_ = 0;
@@ -145,10 +145,6 @@ class SampleStore {
   /// serve as interpolants, and the outputs read the radiance alone.
   void SetInterpolated(int64_t i, const Value& v) {
     if (!IsExact(i)) out_[i] = split_ ? v.a * tau_[size_t(i)] + v.b : v.a;
-  }
-  /// The same without the split: L itself.
-  void SetInterpolatedL(int64_t i, RGB L) {
-    if (!IsExact(i)) out_[i] = L;
   }
   /// Writes a value filled along an edge-block border; block interiors then
   /// interpolate it, and smooth blocks leave it in place.
