@@ -443,8 +443,9 @@ Status ParseTextureBinding(std::string_view text, TextureBinding* out) {
 }
 
 struct AovProvider::Data {
-  int width = 0, height = 0;
-  detail::ImageWindows windows;
+  detail::ImageWindows windows;  ///< the engine's image is the data window
+  int width() const { return windows.data.width(); }
+  int height() const { return windows.data.height(); }
   ProviderCapabilities caps;
   bool dense = true;
   std::vector<uint32_t> objectId, shaderId;
@@ -490,8 +491,8 @@ Status FoldShadowGuide(const ChannelSet& set, Evaluator& eval, const Expr& e, Da
   size_t lit = 0;
   for (size_t i = 0; i < g.size(); ++i) {
     if (!std::isfinite(g[i]))
-      return Status::Error("shadow guide " + Quote(e.Text()) + " in " + set.Paths() + ": not finite at pixel (" +
-                           std::to_string(i % size_t(d->width)) + ", " + std::to_string(i / size_t(d->width)) + ")");
+      return Status::Error("shadow guide " + Quote(e.Text()) + " in " + set.Paths() + ": not finite at pixel " +
+                           d->windows.PixelText(i));
     lit += g[i] > 0.f;
   }
   // A constant far from small IDs and Cryptomatte's float bit patterns'
@@ -631,7 +632,7 @@ bool SameSurface(const Data& d, size_t i, size_t j) {
 /// Per pixel, the mean of `v` over the (2r+1)^2 window of pixels on the same
 /// surface (equal object and shader IDs where the inputs carry them).
 std::vector<RGB> SurfaceWindowMean(const std::vector<RGB>& v, const Data& d, int r) {
-  const int W = d.width, H = d.height;
+  const int W = d.width(), H = d.height();
   std::vector<RGB> out(v.size());
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x) {
@@ -652,7 +653,7 @@ std::vector<RGB> SurfaceWindowMean(const std::vector<RGB>& v, const Data& d, int
 
 /// The variance estimate of AovOptions::estimateVariance, in L units.
 std::vector<RGB> EstimateVarianceFromData(const Data& d) {
-  const int W = d.width, H = d.height;
+  const int W = d.width(), H = d.height();
   const bool split = !d.Li.empty() && !d.tau.empty();
   const std::vector<RGB>& v = split ? d.Li : d.L;
   constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
@@ -706,8 +707,6 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
   auto d = std::make_unique<Data>();
   ChannelSet guides;
   for (const auto& path : inputs) DCM_RETURN_IF_ERROR(guides.Add(path));
-  d->width = guides.width();
-  d->height = guides.height();
   d->windows = guides.windows();
   if (d->windows.cropped())
     d->notes.push_back("pixels: the " + d->windows.Text() + "; the outputs keep both");
@@ -926,8 +925,8 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
   if (!hasTau) d->notes.push_back("no tau: the texture split is off");
 
   ProviderCapabilities& c = d->caps;
-  c.width = d->width;
-  c.height = d->height;
+  c.width = d->width();
+  c.height = d->height();
   c.objectId = !d->objectId.empty();
   c.shaderId = !d->shaderId.empty();
   c.texture = split;
@@ -944,7 +943,7 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
 ProviderCapabilities AovProvider::Capabilities() const { return d_->caps; }
 
 Status AovProvider::Guides(const Bounds2i& region, const GuideRequest& what, GuideImage* out) {
-  const Bounds2i full{{0, 0}, {d_->width, d_->height}};
+  const Bounds2i full{{0, 0}, {d_->width(), d_->height()}};
   if (Intersect(region, full) != region)
     return Status::Error("guides requested outside the image");
   if ((what.objectId && d_->objectId.empty()) || (what.shaderId && d_->shaderId.empty()) ||
@@ -956,7 +955,7 @@ Status AovProvider::Guides(const Bounds2i& region, const GuideRequest& what, Gui
     dst->resize(count);
     size_t k = 0;
     for (int y = region.min.y; y < region.max.y; ++y) {
-      const size_t row = size_t(y) * size_t(d_->width);
+      const size_t row = size_t(y) * size_t(d_->width());
       for (int x = region.min.x; x < region.max.x; ++x) (*dst)[k++] = src[row + size_t(x)];
     }
   };
@@ -979,10 +978,10 @@ Status AovProvider::Evaluate(std::span<const Point2i> pixels, const SampleReques
   int64_t missing = 0;
   for (size_t k = 0; k < pixels.size(); ++k) {
     const Point2i p = pixels[k];
-    if (p.x < 0 || p.y < 0 || p.x >= d_->width || p.y >= d_->height)
+    if (p.x < 0 || p.y < 0 || p.x >= d_->width() || p.y >= d_->height())
       return Status::Error("Evaluate: pixel (" + std::to_string(p.x) + ", " + std::to_string(p.y) +
                            ") outside the image");
-    const size_t i = size_t(p.y) * size_t(d_->width) + size_t(p.x);
+    const size_t i = size_t(p.y) * size_t(d_->width()) + size_t(p.x);
     if (!d_->have.empty() && !d_->have[i]) {
       ++missing;
       continue;
@@ -1001,17 +1000,17 @@ Status AovProvider::Evaluate(std::span<const Point2i> pixels, const SampleReques
   return Status::Ok();
 }
 
-int AovProvider::width() const { return d_->width; }
-int AovProvider::height() const { return d_->height; }
+int AovProvider::width() const { return d_->width(); }
+int AovProvider::height() const { return d_->height(); }
 Bounds2i AovProvider::DataWindow() const { return d_->windows.data; }
 Bounds2i AovProvider::DisplayWindow() const { return d_->windows.display; }
 bool AovProvider::dense() const { return d_->dense; }
 bool AovProvider::HasSample(Point2i p) const {
-  if (p.x < 0 || p.y < 0 || p.x >= d_->width || p.y >= d_->height) return false;
-  return d_->have.empty() || d_->have[size_t(p.y) * size_t(d_->width) + size_t(p.x)] != 0;
+  if (p.x < 0 || p.y < 0 || p.x >= d_->width() || p.y >= d_->height()) return false;
+  return d_->have.empty() || d_->have[size_t(p.y) * size_t(d_->width()) + size_t(p.x)] != 0;
 }
 int64_t AovProvider::SampleCount() const {
-  return d_->have.empty() ? int64_t(d_->width) * d_->height : d_->haveCount;
+  return d_->have.empty() ? int64_t(d_->width()) * d_->height() : d_->haveCount;
 }
 const std::vector<RGB>& AovProvider::Beauty() const { return d_->L; }
 const std::vector<std::string>& AovProvider::Notes() const { return d_->notes; }

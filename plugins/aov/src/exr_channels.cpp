@@ -97,6 +97,11 @@ std::string ImageWindows::Text() const {
                    : std::to_string(data.width()) + "x" + std::to_string(data.height());
 }
 
+std::string ImageWindows::PixelText(size_t i) const {
+  const size_t w = size_t(std::max(1, data.width()));
+  return "(" + std::to_string(int(i % w) + data.min.x) + ", " + std::to_string(int(i / w) + data.min.y) + ")";
+}
+
 void ChannelSet::ScanCrypto(int file) {
   const File& f = files_[size_t(file)];
   for (const ImageSpec& sp : f.specs) {
@@ -215,11 +220,8 @@ Status ChannelSet::ReadId(const std::string& name, std::vector<uint32_t>* plane)
     // Integers exactly representable in float32 span +-2^24; larger integral
     // values are accepted as stored (they are still integers).
     if (!std::isfinite(v) || v != std::floor(v) || v < -2147483648.f || v >= 4294967296.f) {
-      const int x = int(i % size_t(width())) + windows_.data.min.x, y = int(i / size_t(width())) + windows_.data.min.y;
-      return Status::Error(Quote(Path(ref->file)) + ": channel " + Quote(name) +
-                           " holds a non-integer ID " + std::to_string(v) + " at pixel (" +
-                           std::to_string(x) + ", " + std::to_string(y) +
-                           "); IDs must be integers");
+      return Status::Error(Quote(Path(ref->file)) + ": channel " + Quote(name) + " holds a non-integer ID " +
+                           std::to_string(v) + " at pixel " + windows_.PixelText(i) + "; IDs must be integers");
     }
     (*plane)[i] = v < 0 ? uint32_t(int32_t(v)) : uint32_t(v);
   }

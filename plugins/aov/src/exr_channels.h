@@ -51,6 +51,9 @@ struct ImageWindows {
   bool cropped() const { return !(data == display); }
   /// "200x150 at 30,40 of 256x256 at 0,0", for messages.
   std::string Text() const;
+  /// "(x, y)": pixel i of the data window (row-major) in frame coordinates,
+  /// for messages.
+  std::string PixelText(size_t i) const;
   friend bool operator==(const ImageWindows&, const ImageWindows&) = default;
 };
 
