@@ -73,6 +73,17 @@ Status WriteAtomically(const std::string& path,
   return Status::Ok();
 }
 
+ImageSpec WindowedSpec(const Bounds2i& display, const Bounds2i& data, int channels) {
+  ImageSpec spec(data.width(), data.height(), channels, TypeDesc::FLOAT);
+  spec.x = data.min.x;
+  spec.y = data.min.y;
+  spec.full_x = display.min.x;
+  spec.full_y = display.min.y;
+  spec.full_width = display.width();
+  spec.full_height = display.height();
+  return spec;
+}
+
 Status WriteImage(const std::string& path, const ImageSpec& spec, const void* pixels, TypeDesc format) {
   return WriteAtomically(path, [&](const std::string& tmp) -> Status {
     auto out = ImageOutput::create(tmp);
@@ -105,13 +116,7 @@ Status WriteRgbExr(const std::string& path, const Bounds2i& display, const Bound
   DCM_RETURN_IF_ERROR(CheckSize(path, data.width(), data.height(), pixels.size()));
   if (display.empty()) return Status::Error("cannot write '" + path + "': empty display window");
   const int nch = alpha ? 4 : 3;
-  ImageSpec spec(data.width(), data.height(), nch, TypeDesc::FLOAT);
-  spec.x = data.min.x;
-  spec.y = data.min.y;
-  spec.full_x = display.min.x;
-  spec.full_y = display.min.y;
-  spec.full_width = display.width();
-  spec.full_height = display.height();
+  ImageSpec spec = WindowedSpec(display, data, nch);
   spec.channelnames = alpha ? std::vector<std::string>{"R", "G", "B", "A"}
                             : std::vector<std::string>{"R", "G", "B"};
   spec.alpha_channel = alpha ? 3 : -1;

@@ -40,6 +40,10 @@ Status WriteRgbExr(const std::string& path, int width, int height, std::span<con
 Status WriteRgbExr(const std::string& path, const Bounds2i& display, const Bounds2i& data,
                    std::span<const RGB> pixels, const Metadata& metadata, bool alpha);
 
+/// A float image spec of `channels` channels for the `data` window of a
+/// frame whose display window is `display` (EXR data and display windows).
+OIIO::ImageSpec WindowedSpec(const Bounds2i& display, const Bounds2i& data, int channels);
+
 /// Writes `pixels` (interleaved, `format`, covering spec's data window) with
 /// `spec` atomically; the format comes from the extension. The one place
 /// that drives OpenImageIO's writer: every image output goes through it.

@@ -13,6 +13,7 @@
 //
 // stdout is one word for scripts: "pending N" or "done".
 #include <OpenImageIO/imageio.h>
+#include <OpenImageIO/strutil.h>
 
 #include <algorithm>
 #include <fstream>
@@ -39,15 +40,10 @@ Status WriteMask(const std::string& path, const Bounds2i& display, const Bounds2
   const int width = data.width();
   std::vector<float> mask(size_t(data.area()), 0.f);
   for (const auto& p : pixels) mask[size_t(p.y) * size_t(width) + size_t(p.x)] = 1.f;
-  OIIO::ImageSpec spec(width, data.height(), 1, OIIO::TypeDesc::FLOAT);
-  spec.x = data.min.x, spec.y = data.min.y;
-  spec.full_x = display.min.x, spec.full_y = display.min.y;
-  spec.full_width = display.width(), spec.full_height = display.height();
+  OIIO::ImageSpec spec = toolkit::WindowedSpec(display, data, 1);
   spec.channelnames = {"mask"};
   spec.attribute("compression", "zip");
-  std::string names;
-  for (const auto& c : channels) names += (names.empty() ? "" : ",") + c;
-  spec.attribute("dcm:channels", names);
+  spec.attribute("dcm:channels", OIIO::Strutil::join(channels, ","));
   spec.attribute("dcm:pending", int(pixels.size()));
   return toolkit::WriteImage(path, spec, mask.data(), OIIO::TypeDesc::FLOAT);
 }
@@ -59,13 +55,11 @@ Status WriteList(const std::string& path, const Bounds2i& display, const Bounds2
   return toolkit::WriteAtomically(path, [&](const std::string& tmp) -> Status {
     std::ofstream out(tmp, std::ios::trunc);
     if (!out) return Status::Error("cannot write '" + path + "': cannot create a file in its folder");
-    std::string names;
-    for (const auto& c : channels) names += (names.empty() ? "" : ",") + c;
     out << "# dcm plan: " << pixels.size() << " pixels of " << data.width() << "x" << data.height();
     if (!(data == display))
       out << " at " << data.min.x << "," << data.min.y << " (data window) of the " << display.width() << "x"
           << display.height() << " frame";
-    out << " to render; samples EXR channels: " << names << "\n";
+    out << " to render; samples EXR channels: " << OIIO::Strutil::join(channels, ",") << "\n";
     for (const auto& p : pixels) out << p.x + data.min.x << ' ' << p.y + data.min.y << '\n';
     out.close();
     if (!out) return Status::Error("cannot write '" + path + "': write failed");
