@@ -166,8 +166,15 @@ class Engine {
   std::vector<Point2i>* pending_ = nullptr;
   std::vector<Leaf> smoothLeaves_, orientedLeaves_, fallbackLeaves_;
   /// The direction search's geometry per block shape (width, height), built
-  /// before each search; read-only while the blocks run in parallel.
+  /// by PrepareBorderPairs before each search; read-only while the blocks run
+  /// in parallel.
   std::map<std::pair<int, int>, BorderPairs> borderPairs_;
+  void PrepareBorderPairs(const std::vector<EdgeBlock>& blocks) {
+    for (const EdgeBlock& e : blocks) {
+      const auto shape = std::pair(e.block.width(), e.block.height());
+      if (!borderPairs_.contains(shape)) borderPairs_.try_emplace(shape, shape.first, shape.second, opt_.directions);
+    }
+  }
   /// The interpolants of interior pixels per (width, height, direction) of
   /// the oriented leaves, built by PrepareElements before the passes that
   /// read them in parallel.
@@ -531,11 +538,7 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
       });
       if (opt_.adaptiveBorders) DCM_RETURN_IF_ERROR(EvaluateBordersAdaptively(edges));
       DCM_RETURN_IF_ERROR(Flush());
-      for (const EdgeBlock& e : eb) {
-        const auto shape = std::pair(e.block.width(), e.block.height());
-        if (!borderPairs_.contains(shape))
-          borderPairs_.try_emplace(shape, e.block.width(), e.block.height(), opt_.directions);
-      }
+      PrepareBorderPairs(eb);
       ForEach(eb, [&](EdgeBlock& e, size_t) {
         e.direction = LeastDiscrepancyDirection(store_, e.border,
                                                 borderPairs_.at(std::pair(e.block.width(), e.block.height())));
