@@ -16,14 +16,22 @@ require_tools() {
   mkdir -p "$out"
 }
 
+# make_and_render EXR VIEW RES [ARGS...]: one run of make_and_render.py;
+# on failure, the end of its log and exit.
+make_and_render() {
+  local exr="$1" view="$2" res="$3"
+  shift 3
+  "$BLENDER" -b --factory-startup --python "$here/make_and_render.py" -- \
+    --out "$exr" --view "$view" --res "$res" --threads "$THREADS" "$@" > "$out/blender.log" 2>&1 ||
+    { tail -20 "$out/blender.log" >&2; exit 1; }
+}
+
 # render_room EXR VIEW RES SAMPLES SEED: renders EXR unless it exists.
 render_room() {
   [ -f "$1" ] && return 0
   echo "rendering $(basename "$1") (${3}x${3}, $4 spp, seed $5)" >&2
   local t0=$SECONDS
-  "$BLENDER" -b --factory-startup --python "$here/make_and_render.py" -- \
-    --out "$1" --view "$2" --res "$3" --samples "$4" --seed "$5" --threads "$THREADS" > "$out/blender.log" 2>&1 ||
-    { tail -20 "$out/blender.log" >&2; exit 1; }
+  make_and_render "$1" "$2" "$3" --samples "$4" --seed "$5"
   echo "$(basename "$1"): $((SECONDS - t0)) s" >&2
 }
 
@@ -32,7 +40,5 @@ render_room() {
 # second input.
 render_shadow_guide() {
   [ -f "$1" ] && return 0
-  "$BLENDER" -b --factory-startup --python "$here/make_and_render.py" -- \
-    --out "$1" --view "$2" --res "$3" --threads "$THREADS" --shadow-guide > "$out/blender.log" 2>&1 ||
-    { tail -20 "$out/blender.log" >&2; exit 1; }
+  make_and_render "$1" "$2" "$3" --shadow-guide
 }

@@ -112,17 +112,17 @@ def threshold_table(results):
 def settings_table(results):
     labels = []
     table = {}
+    cell = lambda r: "%.2f / %.2f" % (pct(r), float(r["psnr_db"]))
     for scene in SCENES:
-        for r in rows(results, scene):
+        rs = rows(results, scene)
+        for r in rs:
             if r["method"] not in ("dcm", "guo") or r["label"].startswith(("dcm t=", "guo t=")):
                 continue
             if r["label"] not in labels:
                 labels.append(r["label"])
-            table[(r["label"], scene)] = "%.2f / %.2f" % (pct(r), float(r["psnr_db"]))
-        default = by_label(rows(results, scene), "dcm t=" + DEFAULT)
-        table[("dcm default (t=%s)" % DEFAULT, scene)] = "%.2f / %.2f" % (pct(default), float(default["psnr_db"]))
-        table[("guo default (t=0.06, block 8)", scene)] = "%.2f / %.2f" % (
-            pct(by_label(rows(results, scene), "guo t=0.06")), float(by_label(rows(results, scene), "guo t=0.06")["psnr_db"]))
+            table[(r["label"], scene)] = cell(r)
+        table[("dcm default (t=%s)" % DEFAULT, scene)] = cell(by_label(rs, "dcm t=" + DEFAULT))
+        table[("guo default (t=0.06, block 8)", scene)] = cell(by_label(rs, "guo t=0.06"))
     # The supersampling rows together, in order (a scene's own rate is its
     # default and has no row).
     dcm = [l for l in labels if l.startswith("dcm") and not l.startswith("dcm ss=")]
