@@ -76,11 +76,12 @@ TEST(Crease, SmoothlyCurvedSurfacesAreNotCreases) {
   EXPECT_EQ(ReconstructOrFail(withNormals, {}).stats.exactPixels, ReconstructOrFail(without, {}).stats.exactPixels);
 }
 
-/// Same() of a 16x8 store, one object, whose normals are `normal(x, y)`;
-/// objects and shaders from `id(x, y)` (both the same value).
+/// A w x h store (16x8 by default, one 16-pixel region cell) whose normals
+/// are `normal(x, y)`; objects and shaders from `id(x, y)` (the same value,
+/// but shader 2 for object 3).
 detail::SampleStore StoreWith(const std::function<Vec3f(int, int)>& normal,
-                              const std::function<uint32_t(int, int)>& id = [](int, int) { return 1u; }) {
-  constexpr int w = 16, h = 8;
+                              const std::function<uint32_t(int, int)>& id = [](int, int) { return 1u; }, int w = 16,
+                              int h = 8) {
   detail::SampleStore store(w, h, false);
   GuideImage g;
   for (int y = 0; y < h; ++y)
@@ -89,7 +90,7 @@ detail::SampleStore StoreWith(const std::function<Vec3f(int, int)>& normal,
       g.shaderId.push_back(id(x, y) == 3 ? 2u : id(x, y));
       g.normal.push_back(normal(x, y));
     }
-  store.SetGuides(std::move(g), ObjectTest::kObjectAndShader, 30.f);
+  store.SetGuides(std::move(g), ObjectTest::kObjectAndShader, 30.f, 16);
   return store;
 }
 
@@ -126,23 +127,12 @@ TEST(Crease, RegionsAreDecidedInsideOneCellOfTheLattice) {
   // share a 16-pixel cell inside the window, or tiles would differ from the
   // frame (docs/TILES.md). Regions found over the whole image would join the
   // sides in the frame and not in the window.
-  constexpr int n = 48, rows = 32, cell = 16;
+  constexpr int n = 48, rows = 32, cell = 16;  // StoreWith's cell
   auto slotted = [](int x, int y) {
     return x % 8 >= 3 && x % 8 < 5 && y < 40 ? Vec3f{0.f, 1.f, 0.f} : Vec3f{0.f, 0.f, 1.f};
   };
-  auto store = [&](int h) {
-    detail::SampleStore s(n, h, false);
-    GuideImage g;
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < n; ++x) {
-        g.objectId.push_back(1);
-        g.shaderId.push_back(1);
-        g.normal.push_back(slotted(x, y));
-      }
-    s.SetGuides(std::move(g), ObjectTest::kObjectAndShader, 30.f, cell);
-    return s;
-  };
-  const detail::SampleStore frame = store(n), window = store(rows);
+  const auto one = [](int, int) { return 1u; };
+  const detail::SampleStore frame = StoreWith(slotted, one, n, n), window = StoreWith(slotted, one, n, rows);
   int pairs = 0, separated = 0;
   for (int cy = 0; cy + cell < rows; cy += cell)
     for (int cx = 0; cx + cell < n; cx += cell)
