@@ -63,9 +63,9 @@ std::string_view NameOf(E value, const std::array<std::pair<std::string_view, E>
 
 constexpr std::array<std::pair<std::string_view, ObjectTest>, 3> kObjectTests{{
     {"none", ObjectTest::kNone}, {"id", ObjectTest::kObjectId}, {"id+shader", ObjectTest::kObjectAndShader}}};
-constexpr std::array<std::pair<std::string_view, ThinObjectTest>, 3> kThinTests{{
+constexpr std::array<std::pair<std::string_view, ThinObjectTest>, 4> kThinTests{{
     {"off", ThinObjectTest::kOff}, {"none-matches", ThinObjectTest::kNoneMatches},
-    {"any-differs", ThinObjectTest::kAnyDiffers}}};
+    {"any-differs", ThinObjectTest::kAnyDiffers}, {"end-differs", ThinObjectTest::kEndDiffers}}};
 constexpr std::array<std::pair<std::string_view, ContrastMetric>, 2> kMetrics{{
     {"mitchell", ContrastMetric::kMitchell}, {"display", ContrastMetric::kDisplay}}};
 constexpr std::array<std::pair<std::string_view, SmoothRefinement>, 3> kRefinements{{

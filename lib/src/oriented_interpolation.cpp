@@ -73,16 +73,17 @@ OrientedElements::Element LocalElement(int width, int height, int x, int y, Dire
   const double total = fwd.t + back.t;
   const double wf = back.t / total, wb = fwd.t / total;
   e.count = 0;
-  auto add = [&](Point2i p, double w) {
+  auto add = [&](Point2i p, double w, uint8_t end) {
     if (w <= 0) return;
     e.p[size_t(e.count)] = p;
     e.weight[size_t(e.count)] = w;
+    e.end[size_t(e.count)] = end;
     ++e.count;
   };
-  add(fwd.p0, wf * (1 - fwd.w1));
-  add(fwd.p1, wf * fwd.w1);
-  add(back.p0, wb * (1 - back.w1));
-  add(back.p1, wb * back.w1);
+  add(fwd.p0, wf * (1 - fwd.w1), 0);
+  add(fwd.p1, wf * fwd.w1, 0);
+  add(back.p0, wb * (1 - back.w1), 1);
+  add(back.p1, wb * back.w1, 1);
   return e;
 }
 
@@ -93,6 +94,7 @@ bool ToInterpolant(const SampleStore& store, const Block& b, const OrientedEleme
   for (int k = 0; k < e.count; ++k) {
     out->index[size_t(k)] = store.Index(b.x0 + e.p[size_t(k)].x, b.y0 + e.p[size_t(k)].y);
     out->weight[size_t(k)] = e.weight[size_t(k)];
+    out->end[size_t(k)] = e.end[size_t(k)];
   }
   return true;
 }

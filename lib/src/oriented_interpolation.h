@@ -36,6 +36,7 @@ bool ExitPoint(const Block& b, double px, double py, Direction d, BorderPoint* o
 struct Interpolant {
   std::array<int64_t, 4> index{};
   std::array<double, 4> weight{};
+  std::array<uint8_t, 4> end{};  ///< which border point (0, 1) each pixel serves
   int count = 0;
 };
 
@@ -59,6 +60,7 @@ class OrientedElements {
     int count = -1;  ///< -1: the line through the pixel does not cross the block
     std::array<Point2i, 4> p{};
     std::array<double, 4> weight{};
+    std::array<uint8_t, 4> end{};
   };
 
  private:

@@ -266,26 +266,47 @@ SampleReason Engine::Resolve(Point2i q, Interpolant* in) const {
     return SampleReason::kInterpolated;
   }
   bool anyOther = false, anySame = false;
+  double sameAt[2] = {0, 0}, otherAt[2] = {0, 0};  ///< finite weight per border point
   Interpolant kept;
   Interpolant finite;
   for (int k = 0; k < in->count; ++k) {
     const int64_t i = in->index[k];
+    const int end = in->end[k];
     if (!store_.IsFinite(i)) continue;  // non-finite samples never spread
     if (!store_.LiKnownFor(i, iq)) {  // tau = 0 there: its L_i is unknown here
       anyOther = true;                 // (and it is another surface)
+      otherAt[end] += in->weight[k];
       continue;
     }
-    finite.index[finite.count] = i, finite.weight[finite.count++] = in->weight[k];
+    finite.index[finite.count] = i, finite.end[finite.count] = in->end[k], finite.weight[finite.count++] = in->weight[k];
     if (s.Same(iq, i)) {
       anySame = true;
-      kept.index[kept.count] = i, kept.weight[kept.count++] = in->weight[k];
+      sameAt[end] += in->weight[k];
+      kept.index[kept.count] = i, kept.end[kept.count] = in->end[k], kept.weight[kept.count++] = in->weight[k];
     } else {
       anyOther = true;
+      otherAt[end] += in->weight[k];
     }
   }
-  if (opt_.thinObjects == ThinObjectTest::kAnyDiffers && anyOther) return SampleReason::kThinObject;
-  if (opt_.thinObjects == ThinObjectTest::kNoneMatches && !anySame && s.enabled())
-    return SampleReason::kThinObject;
+  switch (opt_.thinObjects) {
+    case ThinObjectTest::kOff: break;
+    case ThinObjectTest::kNoneMatches:
+      if (!anySame && s.enabled()) return SampleReason::kThinObject;
+      break;
+    case ThinObjectTest::kAnyDiffers:
+      if (anyOther) return SampleReason::kThinObject;
+      break;
+    case ThinObjectTest::kEndDiffers:
+      for (int end = 0; end < 2; ++end)
+        if (otherAt[end] > 0 && sameAt[end] == 0) return SampleReason::kThinObject;
+      // A border point between a pixel on q's surface and one on another
+      // snaps to the one on q's: the edge passes between them.
+      for (int k = 0; k < kept.count; ++k) {
+        const int end = kept.end[k];
+        kept.weight[k] *= (sameAt[end] + otherAt[end]) / sameAt[end];
+      }
+      break;
+  }
   Interpolant& use = (opt_.surfaceAware && kept.count > 0) ? kept : finite;
   if (use.count == 0) return SampleReason::kFallback;
   double sum = 0;

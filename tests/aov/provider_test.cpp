@@ -499,17 +499,23 @@ float FromBits(uint32_t u) {
   return f;
 }
 
+/// The rank-1 ID of AddCrypto's layers.
+constexpr uint32_t kOtherHash = 0x3d0a11f3u;
+
 /// A Cryptomatte layer like Blender writes it: rank-0 ID in 00.R, coverage in
-/// 00.G, manifest in the metadata.
+/// 00.G, rank 1 in 00.B and 00.A, manifest in the metadata.
 void AddCrypto(std::vector<TestChannel>* ch, Attributes* attrs, const std::string& name,
                const std::string& key, int w, int h, const std::function<uint32_t(int, int)>& hashAt,
-               const std::vector<std::pair<std::string, uint32_t>>& manifest, bool half = false) {
+               const std::vector<std::pair<std::string, uint32_t>>& manifest, bool half = false,
+               const std::function<std::pair<float, float>(int, int)>& coverageAt = {}) {
   TestChannel r = Fill(name + "00.R", w, h, [&](int x, int y) { return FromBits(hashAt(x, y)); });
   r.half = half;
   ch->push_back(r);
-  ch->push_back(Fill(name + "00.G", w, h, [](int, int) { return 1.f; }));
-  ch->push_back(Fill(name + "00.B", w, h, [](int, int) { return 0.f; }));
-  ch->push_back(Fill(name + "00.A", w, h, [](int, int) { return 0.f; }));
+  // Rank 0 covers the whole pixel unless `coverageAt` says (rank 0, rank 1).
+  auto cover = [&](int x, int y) { return coverageAt ? coverageAt(x, y) : std::pair(1.f, 0.f); };
+  ch->push_back(Fill(name + "00.G", w, h, [&](int x, int y) { return cover(x, y).first; }));
+  ch->push_back(Fill(name + "00.B", w, h, [](int, int) { return FromBits(kOtherHash); }));
+  ch->push_back(Fill(name + "00.A", w, h, [&](int x, int y) { return cover(x, y).second; }));
   std::string json = "{";
   for (size_t i = 0; i < manifest.size(); ++i) {
     char hex[16];
@@ -574,6 +580,34 @@ TEST(AovProvider, CryptomatteIds) {
   Status st = OpenError({dir / "crypto.exr"}, g3);
   EXPECT_THAT(st.message(), HasSubstr("no Cryptomatte layer 'CryptoAsset'"));
   EXPECT_THAT(st.message(), HasSubstr("ViewLayer.CryptoObject"));
+}
+
+// The sky through a window, where one of the pixel's samples hit the frame:
+// Cryptomatte's rank 0 is then the frame with a tiny coverage, and the rest
+// of the footprint saw nothing. Such pixels are background (ID 0), not the
+// frame; a pixel shared by two objects keeps its rank 0.
+TEST(AovProvider, CryptomattePixelsThatMostlySawNothingAreBackground) {
+  ScratchDir dir;
+  const int w = 12, h = 4;
+  auto ch = BlenderChannels("ViewLayer", w, h, true);
+  Attributes attrs;
+  // x < 4: the chair alone; 4 <= x < 8: chair 0.4 and another object 0.3, so
+  // 0.3 saw nothing; x >= 8: the chair with 1/1024 of the pixel, as Blender
+  // writes the sky beside a frame.
+  auto coverage = [](int x, int) {
+    return x < 4 ? std::pair(1.f, 0.f) : x < 8 ? std::pair(0.4f, 0.3f) : std::pair(1.f / 1024, 0.f);
+  };
+  AddCrypto(&ch, &attrs, "ViewLayer.CryptoObject", "a1b2c3d", w, h, [](int, int) { return kChair; },
+            {{"Chair", kChair}}, false, coverage);
+  WriteExr(dir / "sky.exr", w, h, ch, attrs);
+  AovOptions o;
+  o.preset = Preset::kBlender;
+  auto p = MustOpen({dir / "sky.exr"}, o);
+  ASSERT_TRUE(p);
+  const GuideImage g = AllGuides(*p, {true, false, false});
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      EXPECT_EQ(g.objectId[size_t(y * w + x)], x < 8 ? kChair : 0u) << "pixel " << x << "," << y;
 }
 
 TEST(AovProvider, CryptomatteInHalfIsAnError) {

@@ -25,7 +25,8 @@ TEST(ThinObjects, ThinLineSurvivesOnlyWithTheTest) {
   ReconstructionOptions paper = ReconstructionOptions::Paper();
   ReconstructionOptions guo = paper;
   guo.thinObjects = ThinObjectTest::kOff;
-  // dcm's reading: exact where any border sample used lies on another surface.
+  // dcm's reading: exact where a border point used has no sample on the
+  // pixel's surface.
   ReconstructionOptions dcm;
   const Reconstruction a = ReconstructOrFail(provider, paper);
   const Reconstruction b = ReconstructOrFail(provider, guo);
@@ -40,6 +41,47 @@ TEST(ThinObjects, ThinLineSurvivesOnlyWithTheTest) {
   EXPECT_LT(errDcm, 0.01);
   // And it costs little: the paper measured about 1 % more samples.
   EXPECT_LT(a.stats.exactFraction() - b.stats.exactFraction(), 0.03);
+}
+
+// A straight edge between two smoothly shaded surfaces is no thin object:
+// where an interior pixel's border point falls between a sample on its
+// surface and one across the edge, the end-differs test snaps the point to
+// the sample on its surface, while any-differs evaluates the pixel. The
+// edge runs at 16.7 degrees, between the 8 directions of the search, so its
+// border points fall between surfaces all along it.
+TEST(ThinObjects, AStraightEdgeIsNoThinObject) {
+  const int N = 256;
+  constexpr double kSlope = 0.3, kGradient = 0.002;  ///< the edge's slope; the shading's, per pixel
+  auto above = [&](int x, int y) { return double(y) < 40 + kSlope * x; };
+  AnalyticProvider provider(N, N, [&](int x, int y) {
+    PixelTruth t;
+    const bool a = above(x, y);
+    t.objectId = t.shaderId = a ? 1 : 2;
+    const double l = a ? 0.2 + kGradient * x + 0.5 * kGradient * y : 0.6 - 0.5 * kGradient * x + kGradient * y;
+    t.Li = RGB::Gray(float(l));
+    return t;
+  });
+  const auto full = provider.FullRender();
+  ReconstructionOptions any;
+  any.thinObjects = ThinObjectTest::kAnyDiffers;
+  const ReconstructionOptions end;  // the default
+  ASSERT_EQ(end.thinObjects, ThinObjectTest::kEndDiffers);
+  const Reconstruction a = ReconstructOrFail(provider, any), e = ReconstructOrFail(provider, end);
+  const auto thin = [](const Reconstruction& r) { return r.stats.byReason[size_t(SampleReason::kThinObject)]; };
+  auto nearEdge = [&](int x, int y) { return std::fabs(double(y) - (40 + kSlope * x)) < 3; };
+  const double errAny = MeanLuminanceError(a, full, nearEdge), errEnd = MeanLuminanceError(e, full, nearEdge);
+  std::printf("edge: %lld thin-object samples, error %.5f (any-differs); %lld, %.5f (end-differs)\n",
+              (long long)thin(a), errAny, (long long)thin(e), errEnd);
+  // Each surface is linear, so interpolating between samples on it is exact
+  // up to where the snapped point lies: less than a pixel from the exit
+  // point, so at most one pixel's step of the shading, on average far less.
+  EXPECT_LT(errEnd, kGradient);
+  // The edge is about 270 pixels long; any-differs evaluates a pixel or two
+  // beside it on most of its rows, end-differs only where a border point
+  // lies wholly across it (the corners of blocks the edge cuts).
+  EXPECT_GT(thin(a), 150);
+  EXPECT_LT(thin(e), thin(a) / 3);
+  EXPECT_LT(e.stats.exactPixels, a.stats.exactPixels);
 }
 
 // 3.3: with the texture split a textured floor needs several times fewer

@@ -16,7 +16,7 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
   app->add_option("--min-block", f->minBlock, "finest block size (power of two, default 4)");
   app->add_option("--directions", f->directions, "candidate directions of the least-discrepancy search (default 8)");
   app->add_flag("--no-thin", f->noThin, "switch off the thin-object test (paper 3.1)");
-  app->add_option("--thin-test", f->thinTest, "off | none-matches | any-differs");
+  app->add_option("--thin-test", f->thinTest, "off | none-matches | any-differs | end-differs (default)");
   app->add_flag("--no-texture-split", f->noTextureSplit, "interpolate L instead of (L_i, L_c) (paper 3.3)");
   app->add_option("--object-test", f->objectTest, "none | id | id+shader (paper 3.2)");
   app->add_option("--contrast", f->contrast, "mitchell | display");

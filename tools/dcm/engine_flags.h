@@ -21,7 +21,7 @@ struct EngineFlags {
   bool noAdaptiveBorders = false, noCentreProbe = false, noDenoise = false, fallbackFilledBorders = false;
   std::string smoothRefinement;  ///< always | centre-probe | never
   std::string objectTest;      ///< none | id | id+shader
-  std::string thinTest;        ///< off | none-matches | any-differs
+  std::string thinTest;        ///< off | none-matches | any-differs | end-differs (default)
   std::string contrast;        ///< mitchell | display
   std::string progressive;     ///< folder for an image after each refinement level
   bool verbose = false, quiet = false;

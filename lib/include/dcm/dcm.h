@@ -140,7 +140,7 @@ DCM_API DCMError dcmGetError(DCMReconstructor r, const char** message);
  *                        (Guo 1998): resets EVERY option to that preset, so set
  *                        it first;
  *   "object_test"        "none" | "id" | "id+shader";
- *   "thin_objects"       "off" | "none-matches" | "any-differs";
+ *   "thin_objects"       "off" | "none-matches" | "any-differs" | "end-differs";
  *   "contrast_metric"    "mitchell" | "display";
  *   "smooth_refinement"  "always" | "centre-probe" | "never".
  *  An unknown name or value records DCM_ERROR_INVALID_ARGUMENT. */

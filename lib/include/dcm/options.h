@@ -24,6 +24,10 @@ enum class ThinObjectTest {
   kOff,          ///< Guo: interpolate every interior pixel
   kNoneMatches,  ///< paper as written: exact when no border sample used is on the pixel's surface
   kAnyDiffers,   ///< exact when any border sample used lies on another surface
+  /// exact when one of the two border points the pixel interpolates has no
+  /// sample on the pixel's surface; a point between a sample on the surface
+  /// and one off it snaps to the one on it (the edge passes between them)
+  kEndDiffers,
 };
 
 /// What happens to a smooth block above the finest level.
@@ -74,7 +78,7 @@ struct ReconstructionOptions {
   int directions = 8;        ///< candidate directions of the least-discrepancy search
 
   ObjectTest objectTest = ObjectTest::kObjectAndShader;
-  ThinObjectTest thinObjects = ThinObjectTest::kAnyDiffers;
+  ThinObjectTest thinObjects = ThinObjectTest::kEndDiffers;
   /// An interior pixel interpolates only border samples on its own surface.
   bool surfaceAware = true;
   /// Interpolate (L_i, L_c) and re-apply tau per pixel (paper 3.3).

@@ -125,6 +125,18 @@ void ChannelSet::ScanCrypto(int file) {
         }
       }
       if (layer.channel.empty()) continue;  // metadata without channels: not usable
+      for (int rank = 0; rank < 100; ++rank) {
+        const std::string prefix = layer.name + (rank < 10 ? "0" : "") + std::to_string(rank) + ".";
+        bool found = false;
+        for (const auto& [even, odd] : {std::pair("G", "A"), std::pair("g", "a"), std::pair("green", "alpha")})
+          if (Has(prefix + even) && Has(prefix + odd)) {
+            layer.coverage.push_back(prefix + even);
+            layer.coverage.push_back(prefix + odd);
+            found = true;
+            break;
+          }
+        if (!found) break;
+      }
       const std::string manifest = sp.get_string_attribute(prefix + "manifest");
       if (!manifest.empty()) {
         auto j = nlohmann::json::parse(manifest, nullptr, /*allow_exceptions=*/false);
@@ -238,6 +250,18 @@ Status ChannelSet::ReadCrypto(const CryptoLayer& layer, std::vector<uint32_t>* p
   plane->resize(pixels());
   static_assert(sizeof(float) == sizeof(uint32_t));
   std::memcpy(plane->data(), f.data(), f.size() * sizeof(float));
+  if (layer.coverage.empty()) return Status::Ok();
+  // Rank 0 holds the largest coverage; the rest of the footprint, 1 - sum,
+  // saw nothing. Where that is more than rank 0's share, the pixel is
+  // background.
+  std::vector<float> rank0, sum(pixels(), 0.f), c;
+  for (size_t k = 0; k < layer.coverage.size(); ++k) {
+    DCM_RETURN_IF_ERROR(ReadFloat(layer.coverage[k], &c));
+    for (size_t i = 0; i < c.size(); ++i) sum[i] += std::isfinite(c[i]) ? c[i] : 0.f;
+    if (k == 0) rank0 = c;
+  }
+  for (size_t i = 0; i < sum.size(); ++i)
+    if (1.f - sum[i] > rank0[i]) (*plane)[i] = 0u;
   return Status::Ok();
 }
 

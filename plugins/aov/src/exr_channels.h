@@ -35,11 +35,13 @@ struct ChannelRef {
 };
 
 /// A Cryptomatte layer: rank-0 IDs in `<name>00.R` (float bits of a uint32
-/// hash), names in the manifest of the EXR metadata.
+/// hash), the coverage of rank 2k in `<name>0k.G` and of rank 2k+1 in
+/// `<name>0k.A`, names in the manifest of the EXR metadata.
 struct CryptoLayer {
   std::string name;     ///< as in "cryptomatte/<key>/name"
   std::string channel;  ///< the rank-0 ID channel
   ChannelRef ref;
+  std::vector<std::string> coverage;  ///< the coverage channels of every rank stored
   std::map<std::string, uint32_t> manifest;  ///< object/material name -> ID
 };
 
@@ -91,7 +93,11 @@ class ChannelSet {
   /// Reads an ID channel: uint channels as UINT32, float/half channels as
   /// float checked to hold integers (negative integers wrap to uint32).
   Status ReadId(const std::string& name, std::vector<uint32_t>* plane) const;
-  /// Reads a Cryptomatte rank-0 channel: the float bits as uint32.
+  /// Reads a Cryptomatte layer's rank-0 IDs: the float bits as uint32. A
+  /// pixel whose footprint mostly saw no object (the share no rank covers
+  /// exceeds rank 0's: the sky through a window, where one sample of the
+  /// pixel hit the frame) gets ID 0, the background, which no Cryptomatte
+  /// hash takes.
   Status ReadCrypto(const CryptoLayer& layer, std::vector<uint32_t>* plane) const;
 
   /// The Cryptomatte layers found in the metadata.
