@@ -50,7 +50,7 @@ float ContrastTest::Contrast(std::span<const Value> values) const {
     const float lb = split_ ? Luminance(v.b) : 0.f;
     A.Add(la, v.varA);
     B.Add(lb, split_ ? v.varB : 0.f);
-    T.Add(la + lb, v.varA + (split_ ? v.varB : 0.f));
+    T.Add(la * v.tau + lb, v.varA * v.tau * v.tau + (split_ ? v.varB : 0.f));
   }
   if (values.empty()) return 0.f;
   A.Discount(k_), B.Discount(k_), T.Discount(k_);

@@ -21,8 +21,10 @@ class ContrastTest {
   /// Contrast of a set of values; +infinity when any is not finite.
   /// Mitchell: (max-min)/(max+min) of luminance (0 for a black set). With the
   /// texture split, L_i is measured by its own Mitchell contrast and the
-  /// change of L_c against the total L_i + L_c of the set, since L_c is near
-  /// zero on diffuse surfaces and its own contrast would be noise.
+  /// change of L_c against the radiance L = L_i tau + L_c of the set
+  /// (Value::tau), since L_c is near zero on diffuse surfaces and its own
+  /// contrast would be noise: a highlight on a dark glossy surface is a large
+  /// change of L though L_i, the light arriving, is bright.
   /// Display: the range of sRGB-encoded luminance clipped to [0,1].
   /// With noise, each range [lo, hi] shrinks to [lo + d/2, hi - d/2] with
   /// d = k sqrt(var(lo) + var(hi)) (no contrast when it closes).

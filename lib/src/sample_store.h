@@ -26,6 +26,9 @@ struct Value {
   RGB b;
   float varA = 0.f;
   float varB = 0.f;
+  /// With the split, the luminance of tau at the pixel the value belongs
+  /// to: the contrast test weighs a change of L_c against L = L_i tau + L_c.
+  float tau = 1.f;
 };
 
 /// (1-t) p + t q, with the variance of independent p and q.
@@ -134,6 +137,7 @@ class SampleStore {
   /// Without the split the interpolated quantity is L itself, stored once.
   Value ValueAt(int64_t i) const {
     Value v = split_ ? Value{a_[i], b_[i]} : Value{out_[i], RGB{}};
+    if (split_) v.tau = Luminance(tau_[size_t(i)]);
     if (!var_.empty()) v.varA = var_[i][0], v.varB = var_[i][1];
     return v;
   }
