@@ -14,6 +14,7 @@ ReconstructionOptions ReconstructionOptions::Guo() {
   o.contrastThreshold = 0.06f;
   o.objectTest = ObjectTest::kObjectId;
   o.thinObjects = ThinObjectTest::kOff;
+  o.neighbourDirections = 0;
   o.surfaceAware = false;
   o.textureSplit = false;
   o.smoothRefinement = SmoothRefinement::kAlways;
@@ -101,6 +102,9 @@ Status ReconstructionOptions::Validate() const {
   if (!(noiseSignificance >= 0) || !std::isfinite(noiseSignificance))
     return bad("noiseSignificance", "must be a finite number >= 0");
   if (fallbackMaxChanges < 0) return bad("fallbackMaxChanges", "must be >= 0");
+  if (neighbourDirections < 0 || 2 * neighbourDirections >= directions)
+    return bad("neighbourDirections", "must be from 0 to (directions - 1) / 2 = " + std::to_string((directions - 1) / 2) +
+                                          ", got " + std::to_string(neighbourDirections));
   if (downsample < 1 || downsample > 64) return bad("downsample", "must be from 1 to 64, got " + std::to_string(downsample));
   if (threads < 0) return bad("threads", "must be >= 0");
   if (tileSize < 1) return bad("tileSize", "must be >= 1");

@@ -141,6 +141,11 @@ class Engine {
   /// Resolves the interpolant of interior pixel q against the surfaces and the
   /// finite samples. Returns the reason q must be exact, or kInterpolated.
   SampleReason Resolve(Point2i q, Interpolant* in) const;
+  /// For interior pixel q of an oriented leaf that the thin-object test
+  /// rejects along the leaf's direction: the interpolant along the nearest
+  /// neighbouring direction that passes it (neighbourDirections each side),
+  /// or kThinObject.
+  SampleReason ResolveAlongNeighbours(const Leaf& leaf, Point2i q, Interpolant* in) const;
   void WriteSmooth(const Leaf& leaf);
   /// The image as this level knows it, for progressive output: settled leaves,
   /// blocks split further interpolated bilinearly, edge blocks along their
@@ -182,15 +187,17 @@ class Engine {
     }
   }
   /// The interpolants of interior pixels per (width, height, direction) of
-  /// the oriented leaves, built by PrepareElements before the passes that
-  /// read them in parallel.
+  /// the oriented leaves and their neighbouring directions, built by
+  /// PrepareElements before the passes that read them in parallel.
   std::map<std::tuple<int, int, int>, OrientedElements> elements_;
   void PrepareElements(const std::vector<Leaf>& leaves) {
-    for (const Leaf& l : leaves) {
-      const auto key = std::tuple(l.block.width(), l.block.height(), int(l.direction));
-      if (!elements_.contains(key))
-        elements_.try_emplace(key, l.block.width(), l.block.height(), Direction::Of(l.direction, opt_.directions));
-    }
+    const int K = opt_.directions;
+    for (const Leaf& l : leaves)
+      for (int step = -opt_.neighbourDirections; step <= opt_.neighbourDirections; ++step) {
+        const int k = ((int(l.direction) + step) % K + K) % K;
+        const auto key = std::tuple(l.block.width(), l.block.height(), k);
+        if (!elements_.contains(key)) elements_.try_emplace(key, l.block.width(), l.block.height(), Direction::Of(k, K));
+      }
   }
 };
 
@@ -322,6 +329,24 @@ SampleReason Engine::Resolve(Point2i q, Interpolant* in) const {
   return SampleReason::kInterpolated;
 }
 
+SampleReason Engine::ResolveAlongNeighbours(const Leaf& leaf, Point2i q, Interpolant* in) const {
+  const int K = opt_.directions;
+  const Block& b = leaf.block;
+  for (int step = 1; step <= opt_.neighbourDirections; ++step)
+    for (int sign : {1, -1}) {
+      const int k = ((leaf.direction + sign * step) % K + K) % K;
+      const auto table = elements_.find(std::tuple(b.width(), b.height(), k));
+      Interpolant alt;
+      const bool found = table != elements_.end() ? table->second.At(store_, b, q, &alt)
+                                                  : OrientedInterpolant(store_, b, q, Direction::Of(k, K), &alt);
+      if (found && Resolve(q, &alt) == SampleReason::kInterpolated) {
+        *in = alt;
+        return SampleReason::kInterpolated;
+      }
+    }
+  return SampleReason::kThinObject;
+}
+
 void Engine::WriteSmooth(const Leaf& leaf) {
   const Block& b = leaf.block;
   // A smooth leaf owns [x0, x1) x [y0, y1), and its last column and row at the
@@ -373,7 +398,8 @@ void Engine::InterpolateOriented(const Leaf& leaf, OrientedPass pass) {
       if (store_.IsExact(i)) continue;
       Interpolant in;
       const bool found = elements ? elements->At(store_, b, {x, y}, &in) : OrientedInterpolant(store_, b, {x, y}, d, &in);
-      const SampleReason r = found ? Resolve({x, y}, &in) : SampleReason::kFallback;
+      SampleReason r = found ? Resolve({x, y}, &in) : SampleReason::kFallback;
+      if (r == SampleReason::kThinObject) r = ResolveAlongNeighbours(leaf, {x, y}, &in);
       if (r != SampleReason::kInterpolated) {
         if (pass != OrientedPass::kPreview) store_.Request(x, y, r);
         continue;

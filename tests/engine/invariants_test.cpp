@@ -137,6 +137,16 @@ TEST(Invariants, InvalidOptionsNameTheField) {
   const Status s = Reconstruct(p, o, &r);
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("minBlock"), std::string::npos) << s.message();
+  // Four neighbours each side of 8 directions would come round to the
+  // block's own direction from the other side.
+  ReconstructionOptions turns;
+  turns.neighbourDirections = 4;
+  const Status t = Reconstruct(p, turns, &r);
+  ASSERT_FALSE(t.ok());
+  EXPECT_NE(t.message().find("neighbourDirections"), std::string::npos) << t.message();
+  EXPECT_NE(t.message().find("got 4"), std::string::npos) << t.message();
+  turns.neighbourDirections = 3;
+  EXPECT_TRUE(Reconstruct(p, turns, &r).ok());
 }
 
 }  // namespace

@@ -205,6 +205,8 @@ struct Enhancement {
 const Enhancement kEnhancements[] = {
     {"thinObjects", [](ReconstructionOptions* o) { o->thinObjects = ThinObjectTest::kOff; },
      [](ReconstructionOptions* o) { o->thinObjects = ThinObjectTest::kNoneMatches; }},
+    {"neighbourDirections", [](ReconstructionOptions* o) { o->neighbourDirections = 0; },
+     [](ReconstructionOptions* o) { o->neighbourDirections = 1; }},
     {"objectTest", [](ReconstructionOptions* o) { o->objectTest = ObjectTest::kObjectId; },
      [](ReconstructionOptions* o) { o->objectTest = ObjectTest::kObjectAndShader; }},
     {"textureSplit", [](ReconstructionOptions* o) { o->textureSplit = false; },

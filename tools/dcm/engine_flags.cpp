@@ -17,6 +17,9 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
   app->add_option("--directions", f->directions, "candidate directions of the least-discrepancy search (default 8)");
   app->add_flag("--no-thin", f->noThin, "switch off the thin-object test (paper 3.1)");
   app->add_option("--thin-test", f->thinTest, "off | none-matches | any-differs | end-differs (default)");
+  app->add_option("--neighbour-directions", f->neighbourDirections,
+                  "directions each side of its block's that an interior pixel tries before the thin-object test "
+                  "makes it exact (default 1; paper|guo: 0)");
   app->add_flag("--no-texture-split", f->noTextureSplit, "interpolate L instead of (L_i, L_c) (paper 3.3)");
   app->add_option("--object-test", f->objectTest, "none | id | id+shader (paper 3.2)");
   app->add_option("--contrast", f->contrast, "mitchell | display");
@@ -55,6 +58,7 @@ Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {
   if (f.directions) o->directions = f.directions;
   if (f.noThin) o->thinObjects = ThinObjectTest::kOff;
   if (!f.thinTest.empty()) DCM_RETURN_IF_ERROR(Parse(f.thinTest, &o->thinObjects));
+  if (f.neighbourDirections >= 0) o->neighbourDirections = f.neighbourDirections;
   if (f.noTextureSplit) o->textureSplit = false;
   if (!f.objectTest.empty()) DCM_RETURN_IF_ERROR(Parse(f.objectTest, &o->objectTest));
   if (!f.contrast.empty()) DCM_RETURN_IF_ERROR(Parse(f.contrast, &o->contrastMetric));

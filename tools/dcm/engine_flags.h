@@ -16,6 +16,7 @@ struct EngineFlags {
   float noiseSignificance = -1;  ///< <0: the method's default
   float creaseAngle = -1;        ///< <0: the method's default
   int block = 0, minBlock = 0, directions = 0, downsample = 1, threads = 0, tile = 0;
+  int neighbourDirections = -1;  ///< <0: the method's default
   bool noThin = false, noTextureSplit = false, noLazy = false, noFallback = false;
   bool noSurfaceAware = false, full = false;
   bool noAdaptiveBorders = false, noCentreProbe = false, noDenoise = false, fallbackFilledBorders = false;
@@ -28,7 +29,7 @@ struct EngineFlags {
 };
 
 /// Adds --method, --threshold, --block, --min-block, --directions, --no-thin,
-/// --thin-test, --no-texture-split, --object-test, --contrast, --no-lazy,
+/// --thin-test, --neighbour-directions, --no-texture-split, --object-test, --contrast, --no-lazy,
 /// --no-fallback, --no-surface-aware, --downsample, --threads, --tile-size,
 /// --noise-significance, --no-denoise-samples, --crease-angle,
 /// --progressive, -v, --quiet.

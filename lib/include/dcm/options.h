@@ -79,6 +79,14 @@ struct ReconstructionOptions {
 
   ObjectTest objectTest = ObjectTest::kObjectAndShader;
   ThinObjectTest thinObjects = ThinObjectTest::kEndDiffers;
+  /// An interior pixel that the thin-object test would make exact first
+  /// tries this many neighbouring directions on each side of its block's
+  /// (the nearer first, +pi/K before -pi/K) and is interpolated along the
+  /// first one whose border points pass the test. The K directions are
+  /// quantised: an edge between two of them leaves a pixel beside it whose
+  /// line along the block's direction crosses the edge, while the next
+  /// direction stays on its surface. 0: the block's direction only.
+  int neighbourDirections = 1;
   /// An interior pixel interpolates only border samples on its own surface.
   bool surfaceAware = true;
   /// Interpolate (L_i, L_c) and re-apply tau per pixel (paper 3.3).
