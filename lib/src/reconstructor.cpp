@@ -669,15 +669,11 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
           }
         }
       } else {
-        // More discontinuities than one direction can serve, a border that
-        // needed nearly every pixel exactly (adaptive borders), or an
+        // More discontinuities than one direction can serve, or an
         // interpolation that misses the block's centre: evaluate it all.
         std::vector<uint8_t> fallback(eb.size(), 0);
         ForEach(eb, [&](EdgeBlock& e, size_t i) {
-          size_t exactBorder = 0;
-          for (Point2i p : e.border) exactBorder += store_.IsExact(store_.Index(p.x, p.y));
-          const bool busy = opt_.adaptiveBorders && 4 * exactBorder > 3 * e.border.size();
-          fallback[i] = opt_.fallback && (busy || int(e.crossings.size()) > opt_.fallbackMaxChanges);
+          fallback[i] = opt_.fallback && int(e.crossings.size()) > opt_.fallbackMaxChanges;
           if (!fallback[i] && opt_.fallback && opt_.finestCentreProbe && e.block.HasInterior())
             store_.Request(e.block.Centre().x, e.block.Centre().y, SampleReason::kCentreProbe);
         });

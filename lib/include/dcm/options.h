@@ -116,8 +116,8 @@ struct ReconstructionOptions {
   bool lazyEvaluation = true;  ///< children of simple edge blocks: centre pixel only
   /// At the finest level, evaluate the interior of an edge block whose border
   /// shows more than `fallbackMaxChanges` significant changes (more than two
-  /// discontinuities cross it: no single direction can serve it), or, with
-  /// adaptive borders, whose border needed more than 3/4 of its pixels exactly.
+  /// discontinuities cross it: no single direction can serve it), or whose
+  /// centre probe (finestCentreProbe) the interpolation misses.
   bool fallback = true;
   /// More significant changes than this along a finest block's border make
   /// it fall back: 6, three discontinuities. Two (a thin object across the
