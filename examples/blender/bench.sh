@@ -8,8 +8,9 @@
 #
 # Environment: DCM, BLENDER, THREADS as for run.sh; SAMPLES=1024 (Cycles
 # samples per pixel, seed 3: the renders are also the references of
-# noise.sh); SS=1 also view a at 512x512 with SAMPLES per sub-pixel (4x the
-# cost, about 5 min on 2 cores), benched with --downsample 2 in OUTDIR/4x.
+# noise.sh); SS=1 also each view at 512x512 with SAMPLES per sub-pixel (4x
+# the cost, 5-8 min per view on 2 cores), benched with --downsample 2 in
+# OUTDIR/4x.
 # Renders only the EXRs that are missing (examples/blender/out/).
 set -euo pipefail
 
@@ -40,5 +41,7 @@ inputs=()
 for v in "${views[@]}"; do inputs+=("$(guided "$out/noise_${v}_${SAMPLES}_s3.exr" "$v" 256)"); done
 "$DCM" bench "${inputs[@]}" --preset blender --out "$dest/1x"
 if [ "$SS" = 1 ]; then
-  "$DCM" bench "$(guided "$out/noise_a512_${SAMPLES}_s3.exr" a 512)" --preset blender --downsample 2 --out "$dest/4x"
+  inputs=()
+  for v in "${views[@]}"; do inputs+=("$(guided "$out/noise_${v}512_${SAMPLES}_s3.exr" "$v" 512)"); done
+  "$DCM" bench "${inputs[@]}" --preset blender --downsample 2 --out "$dest/4x"
 fi
