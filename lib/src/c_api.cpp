@@ -169,6 +169,7 @@ constexpr IntOption kIntOptions[] = {
 constexpr FloatOption kFloatOptions[] = {
     {"contrast_threshold", &Options::contrastThreshold},
     {"noise_significance", &Options::noiseSignificance},
+    {"probe_lc_share", &Options::probeLcShare},
     {"crease_angle", &Options::creaseAngle},
 };
 constexpr BoolOption kBoolOptions[] = {

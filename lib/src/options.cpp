@@ -102,6 +102,7 @@ Status ReconstructionOptions::Validate() const {
   if (!(noiseSignificance >= 0) || !std::isfinite(noiseSignificance))
     return bad("noiseSignificance", "must be a finite number >= 0");
   if (fallbackMaxChanges < 0) return bad("fallbackMaxChanges", "must be >= 0");
+  if (!(probeLcShare >= 0 && probeLcShare <= 1)) return bad("probeLcShare", "must be from 0 to 1");
   if (neighbourDirections < 0 || 2 * neighbourDirections >= directions)
     return bad("neighbourDirections", "must be from 0 to (directions - 1) / 2 = " + std::to_string((directions - 1) / 2) +
                                           ", got " + std::to_string(neighbourDirections));

@@ -85,6 +85,7 @@ struct EdgeBlock {
   DirectionChoice direction;
   std::vector<int> crossings;
   bool simple = false;
+  bool probe = false;  ///< the finest level probes its centre
 };
 
 class Engine {
@@ -141,6 +142,18 @@ class Engine {
   /// Resolves the interpolant of interior pixel q against the surfaces and the
   /// finite samples. Returns the reason q must be exact, or kInterpolated.
   SampleReason Resolve(Point2i q, Interpolant* in) const;
+  /// With the split: L_c is below probeLcShare of L at every finite pixel of
+  /// the border, which the centre probe then need not search for a highlight.
+  bool LooksDiffuse(std::span<const Point2i> border) const {
+    if (!split_ || !(opt_.probeLcShare > 0)) return false;
+    for (Point2i p : border) {
+      if (!store_.IsFinite(store_.Index(p.x, p.y))) continue;
+      const Value v = At(p);
+      const double lc = Luminance(v.b), l = Luminance(v.a) * v.tau + lc;
+      if (!(lc <= opt_.probeLcShare * l)) return false;
+    }
+    return true;
+  }
   /// For interior pixel q of an oriented leaf that the thin-object test
   /// rejects along the leaf's direction: the interpolant along the nearest
   /// neighbouring direction that passes it (neighbourDirections each side),
@@ -674,13 +687,14 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
         std::vector<uint8_t> fallback(eb.size(), 0);
         ForEach(eb, [&](EdgeBlock& e, size_t i) {
           fallback[i] = opt_.fallback && int(e.crossings.size()) > opt_.fallbackMaxChanges;
-          if (!fallback[i] && opt_.fallback && opt_.finestCentreProbe && e.block.HasInterior())
-            store_.Request(e.block.Centre().x, e.block.Centre().y, SampleReason::kCentreProbe);
+          e.probe = !fallback[i] && opt_.fallback && opt_.finestCentreProbe && e.block.HasInterior() &&
+                    (!e.crossings.empty() || !LooksDiffuse(e.border));
+          if (e.probe) store_.Request(e.block.Centre().x, e.block.Centre().y, SampleReason::kCentreProbe);
         });
         if (opt_.fallback && opt_.finestCentreProbe) {
           DCM_RETURN_IF_ERROR(Flush());
           ForEach(eb, [&](EdgeBlock& e, size_t i) {
-            if (fallback[i] || !e.block.HasInterior()) return;
+            if (!e.probe) return;
             const Point2i c = e.block.Centre();
             Interpolant in;
             if (!OrientedInterpolant(store_, e.block, c, Direction::Of(e.direction.index, opt_.directions), &in))

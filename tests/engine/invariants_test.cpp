@@ -147,6 +147,11 @@ TEST(Invariants, InvalidOptionsNameTheField) {
   EXPECT_NE(t.message().find("got 4"), std::string::npos) << t.message();
   turns.neighbourDirections = 3;
   EXPECT_TRUE(Reconstruct(p, turns, &r).ok());
+  ReconstructionOptions share;
+  share.probeLcShare = -0.5f;
+  const Status u = Reconstruct(p, share, &r);
+  ASSERT_FALSE(u.ok());
+  EXPECT_NE(u.message().find("probeLcShare"), std::string::npos) << u.message();
 }
 
 }  // namespace

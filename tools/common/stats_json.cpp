@@ -48,6 +48,7 @@ nlohmann::json OptionsToJson(const ReconstructionOptions& o) {
   j["fallback_filled_borders"] = o.fallbackFilledBorders;
   j["finest_centre_probe"] = o.finestCentreProbe;
   j["noise_significance"] = o.noiseSignificance;
+  j["probe_lc_share"] = o.probeLcShare;
   j["crease_angle"] = o.creaseAngle;
   j["denoise_samples"] = o.denoiseSamples;
   j["downsample"] = o.downsample;

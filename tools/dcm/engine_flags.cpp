@@ -30,6 +30,9 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
   app->add_flag("--no-surface-aware", f->noSurfaceAware, "interpolate across surfaces (Guo)");
   app->add_flag("--no-adaptive-borders", f->noAdaptiveBorders, "evaluate every border pixel of edge blocks (the paper)");
   app->add_flag("--no-centre-probe", f->noCentreProbe, "no centre probe of the finest edge blocks");
+  app->add_option("--probe-lc-share", f->probeLcShare,
+                  "with the texture split: no centre probe where the border is unchanging and L_c is below this "
+                  "share of L on all of it (default 0.02; 0: probe every finest edge block)");
   app->add_option("--smooth-refinement", f->smoothRefinement, "always (the paper) | centre-probe | never");
   app->add_flag("--full", f->full, "evaluate every pixel exactly (the baseline)");
   app->add_option("--downsample", f->downsample, "the input is supersampled N times per axis; box-filter the result down");
@@ -76,6 +79,7 @@ Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {
   if (f.noDenoise) o->denoiseSamples = false;
   if (f.creaseAngle >= 0) o->creaseAngle = f.creaseAngle;
   if (f.noiseSignificance >= 0) o->noiseSignificance = f.noiseSignificance;
+  if (f.probeLcShare >= 0) o->probeLcShare = f.probeLcShare;
   if (!f.progressive.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(f.progressive, ec);

@@ -15,6 +15,7 @@ struct EngineFlags {
   float threshold = -1;        ///< <0: the method's default
   float noiseSignificance = -1;  ///< <0: the method's default
   float creaseAngle = -1;        ///< <0: the method's default
+  float probeLcShare = -1;       ///< <0: the method's default
   int block = 0, minBlock = 0, directions = 0, downsample = 1, threads = 0, tile = 0;
   int neighbourDirections = -1;  ///< <0: the method's default
   bool noThin = false, noTextureSplit = false, noLazy = false, noFallback = false;
