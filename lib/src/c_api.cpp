@@ -179,6 +179,7 @@ constexpr BoolOption kBoolOptions[] = {
     {"zero_order_test", &Options::zeroOrderTest},
     {"gradient_blocks_simple", &Options::gradientBlocksSimple},
     {"first_order_test", &Options::firstOrderTest},
+    {"first_order_from_guides", &Options::firstOrderFromGuides},
     {"lazy_evaluation", &Options::lazyEvaluation},
     {"fallback", &Options::fallback},
     {"fallback_filled_borders", &Options::fallbackFilledBorders},

@@ -36,6 +36,12 @@ struct Crossing {
   Point2i inward;    // inward normal of the side
 };
 
+/// The crossing is a surface change the guides mark, and `fromGuides` asks
+/// to read it from them.
+bool FromGuides(const SampleStore& store, const Crossing& c, bool fromGuides) {
+  return fromGuides && !store.surfaces().SameAdjacent(store.Index(c.p.x, c.p.y), store.Index(c.q.x, c.q.y));
+}
+
 Crossing CrossingAt(std::span<const Point2i> loop, int k) {
   const int n = int(loop.size());
   Crossing c;
@@ -50,11 +56,12 @@ Crossing CrossingAt(std::span<const Point2i> loop, int k) {
 bool Inside(const Block& b, Point2i p) { return p.x > b.x0 && p.x < b.x1 && p.y > b.y0 && p.y < b.y1; }
 }  // namespace
 
-std::vector<Point2i> FirstOrderProbes(const Block& b, std::span<const Point2i> loop,
-                                      std::span<const int> crossings) {
+std::vector<Point2i> FirstOrderProbes(const SampleStore& store, const Block& b, std::span<const Point2i> loop,
+                                      std::span<const int> crossings, bool fromGuides) {
   std::vector<Point2i> probes;
   for (int k : crossings) {
     const Crossing c = CrossingAt(loop, k);
+    if (FromGuides(store, c, fromGuides)) continue;
     for (Point2i p : {c.p, c.q}) {
       const Point2i in{p.x + c.inward.x, p.y + c.inward.y};
       if (Inside(b, in)) probes.push_back(in);
@@ -64,7 +71,7 @@ std::vector<Point2i> FirstOrderProbes(const Block& b, std::span<const Point2i> l
 }
 
 bool FirstOrderConsistent(const SampleStore& store, const ContrastTest& contrast, const Block& b,
-                          std::span<const Point2i> loop, std::span<const int> crossings) {
+                          std::span<const Point2i> loop, std::span<const int> crossings, bool fromGuides) {
   if (crossings.size() != 2) return false;
   double ex[2], ey[2], cx[2], cy[2];
   for (int i = 0; i < 2; ++i) {
@@ -72,14 +79,17 @@ bool FirstOrderConsistent(const SampleStore& store, const ContrastTest& contrast
     const Point2i pin{c.p.x + c.inward.x, c.p.y + c.inward.y};
     const Point2i qin{c.q.x + c.inward.x, c.q.y + c.inward.y};
     if (!Inside(b, pin) || !Inside(b, qin)) return false;
-    const Value vp = store.ValueAt(store.Index(c.p.x, c.p.y));
-    const Value vq = store.ValueAt(store.Index(c.q.x, c.q.y));
-    const Value vpin = store.ValueAt(store.Index(pin.x, pin.y));
-    const Value vqin = store.ValueAt(store.Index(qin.x, qin.y));
+    // Is an inner pixel like p or like q: on its surface, or of its value?
+    const int64_t ip = store.Index(c.p.x, c.p.y), iq = store.Index(c.q.x, c.q.y);
+    const int64_t ipin = store.Index(pin.x, pin.y), iqin = store.Index(qin.x, qin.y);
+    const bool guides = FromGuides(store, c, fromGuides);
+    auto like = [&](int64_t inner, int64_t border) {
+      return guides ? store.surfaces().Same(inner, border) : !contrast.Differ(store.ValueAt(inner), store.ValueAt(border));
+    };
     // Where does the change lie on the inner row: between the same two
     // positions (0), one step back (-1) or one step ahead (+1)?
-    const bool pinLikeP = !contrast.Differ(vpin, vp), pinLikeQ = !contrast.Differ(vpin, vq);
-    const bool qinLikeP = !contrast.Differ(vqin, vp), qinLikeQ = !contrast.Differ(vqin, vq);
+    const bool pinLikeP = like(ipin, ip), pinLikeQ = like(ipin, iq);
+    const bool qinLikeP = like(iqin, ip), qinLikeQ = like(iqin, iq);
     int offset;
     if (pinLikeP && qinLikeQ) offset = 0;
     else if (pinLikeQ && !pinLikeP) offset = -1;

@@ -21,6 +21,7 @@ ReconstructionOptions ReconstructionOptions::Guo() {
   o.adaptiveBorders = false;
   o.finestCentreProbe = false;
   o.gradientBlocksSimple = false;
+  o.firstOrderFromGuides = false;
   o.fallback = false;
   o.noiseSignificance = 0.f;
   o.creaseAngle = 0.f;

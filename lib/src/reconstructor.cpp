@@ -618,14 +618,14 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
           const bool zeroOrder = !opt_.zeroOrderTest || n == 2 || (n == 0 && opt_.gradientBlocksSimple);
           e.simple = e.block.HasInterior() && zeroOrder && SurfaceChanges(store_, e.border) <= 2;
           if (e.simple && opt_.firstOrderTest && n == 2)
-            for (Point2i p : FirstOrderProbes(e.block, e.border, e.crossings))
+            for (Point2i p : FirstOrderProbes(store_, e.block, e.border, e.crossings, opt_.firstOrderFromGuides))
               store_.Request(p.x, p.y, SampleReason::kFirstOrderProbe);
         });
         if (opt_.firstOrderTest) {
           DCM_RETURN_IF_ERROR(Flush());
           ForEach(eb, [&](EdgeBlock& e, size_t) {
             if (e.simple && e.crossings.size() == 2)
-              e.simple = FirstOrderConsistent(store_, contrast_, e.block, e.border, e.crossings);
+              e.simple = FirstOrderConsistent(store_, contrast_, e.block, e.border, e.crossings, opt_.firstOrderFromGuides);
           });
         }
         // Lazy evaluation of simple blocks: the parent's centre only.

@@ -142,6 +142,43 @@ TEST(TextureSplit, TexturedFloorNeedsSeveralTimesFewerSamples) {
 }
 
 // Without texture the engine does not ask for the split at all.
+// The first-order test asks where a discontinuity runs one row inside the
+// block at each of its two crossings. Where the crossing is a surface change,
+// the guides answer without samples; the answer, and so the image, is the
+// same as from the evaluated pixels when the radiance changes with the
+// surface. An edge between two shaded objects at 16.7 degrees.
+TEST(FirstOrder, SurfaceChangesNeedNoProbes) {
+  const int N = 128;
+  AnalyticProvider provider(N, N, [](int x, int y) {
+    PixelTruth t;
+    const bool a = double(y) < 30 + 0.3 * x;
+    t.objectId = t.shaderId = a ? 1 : 2;
+    t.Li = RGB::Gray(float(a ? 0.2 + 0.002 * x : 0.7 - 0.001 * y));
+    return t;
+  });
+  ReconstructionOptions values;
+  values.firstOrderFromGuides = false;
+  const Reconstruction v = ReconstructOrFail(provider, values);
+  const Reconstruction g = ReconstructOrFail(provider, ReconstructionOptions{});
+  const auto probes = [](const Reconstruction& r) {
+    return r.stats.byReason[size_t(SampleReason::kFirstOrderProbe)];
+  };
+  std::printf("first-order probes: %lld from values, %lld with the guides; exact %lld, %lld\n",
+              (long long)probes(v), (long long)probes(g), (long long)v.stats.exactPixels,
+              (long long)g.stats.exactPixels);
+  ASSERT_GT(probes(v), 10);
+  EXPECT_EQ(probes(g), 0);
+  EXPECT_LT(g.stats.exactPixels, v.stats.exactPixels);
+  // The radiance changes exactly where the surface does, so both read the
+  // same crossings and the same blocks are simple; the probes' pixels are
+  // interpolated instead, on linear shading: the mean error moves by less
+  // than 1e-4.
+  EXPECT_EQ(g.stats.simpleEdgeBlocks, v.stats.simpleEdgeBlocks);
+  const auto full = provider.FullRender();
+  auto all = [](int, int) { return true; };
+  EXPECT_NEAR(MeanLuminanceError(g, full, all), MeanLuminanceError(v, full, all), 1e-4);
+}
+
 // With the split, a change of L_c counts against L = L_i tau + L_c, the
 // radiance seen: on a dark glossy surface (tau 0.05) under bright light
 // (L_i 2), a highlight that raises L_c from 0.03 to 0.5 raises L from 0.13 to

@@ -41,6 +41,7 @@ nlohmann::json OptionsToJson(const ReconstructionOptions& o) {
   j["zero_order_test"] = o.zeroOrderTest;
   j["gradient_blocks_simple"] = o.gradientBlocksSimple;
   j["first_order_test"] = o.firstOrderTest;
+  j["first_order_from_guides"] = o.firstOrderFromGuides;
   j["lazy_evaluation"] = o.lazyEvaluation;
   j["fallback"] = o.fallback;
   j["fallback_max_changes"] = o.fallbackMaxChanges;

@@ -217,6 +217,10 @@ const Enhancement kEnhancements[] = {
      [](ReconstructionOptions* o) { o->smoothRefinement = SmoothRefinement::kCentreProbe; }},
     {"finestCentreProbe", [](ReconstructionOptions* o) { o->finestCentreProbe = false; },
      [](ReconstructionOptions* o) { o->finestCentreProbe = true; }},
+    {"firstOrderFromGuides", [](ReconstructionOptions* o) { o->firstOrderFromGuides = false; },
+     [](ReconstructionOptions* o) { o->firstOrderFromGuides = true; }},
+    {"probeLcShare", [](ReconstructionOptions* o) { o->probeLcShare = 0.f; },
+     [](ReconstructionOptions* o) { o->probeLcShare = 0.02f; }},
     {"lazyEvaluation", [](ReconstructionOptions* o) { o->lazyEvaluation = false; },
      [](ReconstructionOptions* o) { o->lazyEvaluation = true; }},
 };

@@ -30,6 +30,9 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
   app->add_flag("--no-surface-aware", f->noSurfaceAware, "interpolate across surfaces (Guo)");
   app->add_flag("--no-adaptive-borders", f->noAdaptiveBorders, "evaluate every border pixel of edge blocks (the paper)");
   app->add_flag("--no-centre-probe", f->noCentreProbe, "no centre probe of the finest edge blocks");
+  app->add_flag("--no-guide-first-order", f->noGuideFirstOrder,
+                "first-order test: evaluate the inner pixels at every crossing, also where the guides show the "
+                "surfaces meeting");
   app->add_option("--probe-lc-share", f->probeLcShare,
                   "with the texture split: no centre probe where the border is unchanging and L_c is below this "
                   "share of L on all of it (default 0.02; 0: probe every finest edge block)");
@@ -71,6 +74,7 @@ Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {
   if (f.noSurfaceAware) o->surfaceAware = false;
   if (f.noAdaptiveBorders) o->adaptiveBorders = false;
   if (f.noCentreProbe) o->finestCentreProbe = false;
+  if (f.noGuideFirstOrder) o->firstOrderFromGuides = false;
   if (!f.smoothRefinement.empty()) DCM_RETURN_IF_ERROR(Parse(f.smoothRefinement, &o->smoothRefinement));
   if (f.full) o->fullEvaluation = true;
   o->downsample = f.downsample;

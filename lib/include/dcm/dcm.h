@@ -165,6 +165,7 @@ DCM_API void dcmSetFloat(DCMReconstructor r, const char* name, float value);
 
 /** Sets a bool option: "surface_aware", "texture_split", "adaptive_borders",
  *  "zero_order_test", "gradient_blocks_simple", "first_order_test",
+ *  "first_order_from_guides",
  *  "lazy_evaluation", "fallback", "fallback_filled_borders",
  *  "finest_centre_probe", "full_evaluation", "denoise_samples". */
 DCM_API void dcmSetBool(DCMReconstructor r, const char* name, int value);
