@@ -204,13 +204,29 @@ class Engine {
   /// PrepareElements before the passes that read them in parallel.
   std::map<std::tuple<int, int, int>, OrientedElements> elements_;
   void PrepareElements(const std::vector<Leaf>& leaves) {
-    const int K = opt_.directions;
     for (const Leaf& l : leaves)
       for (int step = -opt_.neighbourDirections; step <= opt_.neighbourDirections; ++step) {
-        const int k = ((int(l.direction) + step) % K + K) % K;
+        const int k = Turned(l.direction, step);
         const auto key = std::tuple(l.block.width(), l.block.height(), k);
-        if (!elements_.contains(key)) elements_.try_emplace(key, l.block.width(), l.block.height(), Direction::Of(k, K));
+        if (!elements_.contains(key))
+          elements_.try_emplace(key, l.block.width(), l.block.height(), Direction::Of(k, opt_.directions));
       }
+  }
+  /// Direction k turned by `step` directions (modulo the K directions).
+  int Turned(int k, int step) const {
+    const int K = opt_.directions;
+    return ((k + step) % K + K) % K;
+  }
+  /// The prepared oriented elements of b's shape along direction k, or null.
+  const OrientedElements* ElementsOf(const Block& b, int k) const {
+    const auto table = elements_.find(std::tuple(b.width(), b.height(), k));
+    return table == elements_.end() ? nullptr : &table->second;
+  }
+  /// The interpolant of q in b along direction k: from `elements`
+  /// (ElementsOf(b, k), looked up once per leaf) when prepared.
+  bool InterpolantAlong(const OrientedElements* elements, const Block& b, Point2i q, int k, Interpolant* in) const {
+    return elements ? elements->At(store_, b, q, in)
+                    : OrientedInterpolant(store_, b, q, Direction::Of(k, opt_.directions), in);
   }
 };
 
@@ -291,29 +307,28 @@ SampleReason Engine::Resolve(Point2i q, Interpolant* in) const {
     for (int k = 0; k < in->count; ++k) in->weight[k] /= sum;
     return SampleReason::kInterpolated;
   }
-  bool anyOther = false, anySame = false;
-  double sameAt[2] = {0, 0}, otherAt[2] = {0, 0};  ///< finite weight per border point
+  // The finite weight per border point on q's surface and off it (weights
+  // are > 0: an interpolant leaves zero weights out).
+  double sameAt[2] = {0, 0}, otherAt[2] = {0, 0};
   Interpolant kept;
   Interpolant finite;
   for (int k = 0; k < in->count; ++k) {
     const int64_t i = in->index[k];
-    const int end = in->end[k];
+    const uint8_t end = in->end[k];
     if (!store_.IsFinite(i)) continue;  // non-finite samples never spread
     if (!store_.LiKnownFor(i, iq)) {  // tau = 0 there: its L_i is unknown here
-      anyOther = true;                 // (and it is another surface)
-      otherAt[end] += in->weight[k];
+      otherAt[end] += in->weight[k];   // (and it is another surface)
       continue;
     }
-    finite.index[finite.count] = i, finite.end[finite.count] = in->end[k], finite.weight[finite.count++] = in->weight[k];
+    finite.index[finite.count] = i, finite.end[finite.count] = end, finite.weight[finite.count++] = in->weight[k];
     if (s.Same(iq, i)) {
-      anySame = true;
       sameAt[end] += in->weight[k];
-      kept.index[kept.count] = i, kept.end[kept.count] = in->end[k], kept.weight[kept.count++] = in->weight[k];
+      kept.index[kept.count] = i, kept.end[kept.count] = end, kept.weight[kept.count++] = in->weight[k];
     } else {
-      anyOther = true;
       otherAt[end] += in->weight[k];
     }
   }
+  const bool anySame = sameAt[0] + sameAt[1] > 0, anyOther = otherAt[0] + otherAt[1] > 0;
   switch (opt_.thinObjects) {
     case ThinObjectTest::kOff: break;
     case ThinObjectTest::kNoneMatches:
@@ -343,16 +358,12 @@ SampleReason Engine::Resolve(Point2i q, Interpolant* in) const {
 }
 
 SampleReason Engine::ResolveAlongNeighbours(const Leaf& leaf, Point2i q, Interpolant* in) const {
-  const int K = opt_.directions;
   const Block& b = leaf.block;
   for (int step = 1; step <= opt_.neighbourDirections; ++step)
     for (int sign : {1, -1}) {
-      const int k = ((leaf.direction + sign * step) % K + K) % K;
-      const auto table = elements_.find(std::tuple(b.width(), b.height(), k));
+      const int k = Turned(leaf.direction, sign * step);
       Interpolant alt;
-      const bool found = table != elements_.end() ? table->second.At(store_, b, q, &alt)
-                                                  : OrientedInterpolant(store_, b, q, Direction::Of(k, K), &alt);
-      if (found && Resolve(q, &alt) == SampleReason::kInterpolated) {
+      if (InterpolantAlong(ElementsOf(b, k), b, q, k, &alt) && Resolve(q, &alt) == SampleReason::kInterpolated) {
         *in = alt;
         return SampleReason::kInterpolated;
       }
@@ -400,9 +411,7 @@ void Engine::WriteSmooth(const Leaf& leaf) {
 
 void Engine::InterpolateOriented(const Leaf& leaf, OrientedPass pass) {
   const Block& b = leaf.block;
-  const Direction d = Direction::Of(leaf.direction, opt_.directions);
-  const auto table = elements_.find(std::tuple(b.width(), b.height(), int(leaf.direction)));
-  const OrientedElements* elements = table == elements_.end() ? nullptr : &table->second;
+  const OrientedElements* elements = ElementsOf(b, leaf.direction);
   const bool lazy = leaf.type == BlockType::kLazy;
   const double hx = 0.5 * (b.x1 - b.x0), hy = 0.5 * (b.y1 - b.y0);
   for (int y = b.y0 + 1; y < b.y1; ++y)
@@ -410,7 +419,7 @@ void Engine::InterpolateOriented(const Leaf& leaf, OrientedPass pass) {
       const int64_t i = store_.Index(x, y);
       if (store_.IsExact(i)) continue;
       Interpolant in;
-      const bool found = elements ? elements->At(store_, b, {x, y}, &in) : OrientedInterpolant(store_, b, {x, y}, d, &in);
+      const bool found = InterpolantAlong(elements, b, {x, y}, leaf.direction, &in);
       SampleReason r = found ? Resolve({x, y}, &in) : SampleReason::kFallback;
       if (r == SampleReason::kThinObject) r = ResolveAlongNeighbours(leaf, {x, y}, &in);
       if (r != SampleReason::kInterpolated) {
