@@ -206,7 +206,7 @@ const Enhancement kEnhancements[] = {
     {"thinObjects", [](ReconstructionOptions* o) { o->thinObjects = ThinObjectTest::kOff; },
      [](ReconstructionOptions* o) { o->thinObjects = ThinObjectTest::kNoneMatches; }},
     {"neighbourDirections", [](ReconstructionOptions* o) { o->neighbourDirections = 0; },
-     [](ReconstructionOptions* o) { o->neighbourDirections = 1; }},
+     [](ReconstructionOptions* o) { o->neighbourDirections = ReconstructionOptions{}.neighbourDirections; }},
     {"objectTest", [](ReconstructionOptions* o) { o->objectTest = ObjectTest::kObjectId; },
      [](ReconstructionOptions* o) { o->objectTest = ObjectTest::kObjectAndShader; }},
     {"textureSplit", [](ReconstructionOptions* o) { o->textureSplit = false; },
@@ -220,7 +220,7 @@ const Enhancement kEnhancements[] = {
     {"firstOrderFromGuides", [](ReconstructionOptions* o) { o->firstOrderFromGuides = false; },
      [](ReconstructionOptions* o) { o->firstOrderFromGuides = true; }},
     {"probeLcShare", [](ReconstructionOptions* o) { o->probeLcShare = 0.f; },
-     [](ReconstructionOptions* o) { o->probeLcShare = 0.02f; }},
+     [](ReconstructionOptions* o) { o->probeLcShare = ReconstructionOptions{}.probeLcShare; }},
     {"lazyEvaluation", [](ReconstructionOptions* o) { o->lazyEvaluation = false; },
      [](ReconstructionOptions* o) { o->lazyEvaluation = true; }},
 };
