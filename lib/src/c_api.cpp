@@ -184,6 +184,7 @@ constexpr BoolOption kBoolOptions[] = {
     {"fallback", &Options::fallback},
     {"fallback_filled_borders", &Options::fallbackFilledBorders},
     {"finest_centre_probe", &Options::finestCentreProbe},
+    {"checkerboard", &Options::checkerboard},
     {"full_evaluation", &Options::fullEvaluation},
     {"denoise_samples", &Options::denoiseSamples},
 };

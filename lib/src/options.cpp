@@ -22,6 +22,7 @@ ReconstructionOptions ReconstructionOptions::Guo() {
   o.finestCentreProbe = false;
   o.gradientBlocksSimple = false;
   o.firstOrderFromGuides = false;
+  o.checkerboard = false;
   o.fallback = false;
   o.noiseSignificance = 0.f;
   o.creaseAngle = 0.f;

@@ -17,6 +17,7 @@
 #include <tuple>
 
 #include "block.h"
+#include "checkerboard_fill.h"
 #include "contrast_test.h"
 #include "dcm/downsample.h"
 #include "edge_classification.h"
@@ -189,6 +190,24 @@ class Engine {
   ReconstructionStats stats_;
   std::vector<Point2i>* pending_ = nullptr;
   std::vector<Leaf> smoothLeaves_, orientedLeaves_, fallbackLeaves_;
+  /// Checkerboard refinement: per pixel, the reason a pixel of the colour
+  /// evaluated second is wanted exact (kInterpolated: none), until
+  /// ResolveDeferred decides; `filledDeferred_` then lists those filled.
+  std::vector<SampleReason> deferred_;
+  std::vector<int64_t> filledDeferred_;
+  /// Asks for (x, y) exactly, or defers it to ResolveDeferred when the
+  /// checkerboard refinement holds it back.
+  void RequestOrDefer(int x, int y, SampleReason reason) {
+    if (opt_.checkerboard && !EvaluatedFirst(x, y)) deferred_[size_t(store_.Index(x, y))] = reason;
+    else store_.Request(x, y, reason);
+  }
+  bool IsDeferred(int64_t i) const { return !deferred_.empty() && deferred_[size_t(i)] != SampleReason::kInterpolated; }
+  /// Each deferred pixel is filled from its exact neighbours when they agree
+  /// (written now when `write`), or evaluated.
+  Status ResolveDeferred(bool write);
+  /// Writes the deferred pixels ResolveDeferred filled, from the exact
+  /// neighbours as they are now (denoised).
+  void WriteFilledDeferred();
   /// The direction search's geometry per block shape (width, height), built
   /// by PrepareBorderPairs before each search; read-only while the blocks run
   /// in parallel.
@@ -417,13 +436,13 @@ void Engine::InterpolateOriented(const Leaf& leaf, OrientedPass pass) {
   for (int y = b.y0 + 1; y < b.y1; ++y)
     for (int x = b.x0 + 1; x < b.x1; ++x) {
       const int64_t i = store_.Index(x, y);
-      if (store_.IsExact(i)) continue;
+      if (store_.IsExact(i) || IsDeferred(i)) continue;
       Interpolant in;
       const bool found = InterpolantAlong(elements, b, {x, y}, leaf.direction, &in);
       SampleReason r = found ? Resolve({x, y}, &in) : SampleReason::kFallback;
       if (r == SampleReason::kThinObject) r = ResolveAlongNeighbours(leaf, {x, y}, &in);
       if (r != SampleReason::kInterpolated) {
-        if (pass != OrientedPass::kPreview) store_.Request(x, y, r);
+        if (pass != OrientedPass::kPreview) RequestOrDefer(x, y, r);
         continue;
       }
       if (pass == OrientedPass::kThinObjects) continue;
@@ -542,6 +561,7 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
   const int W = caps_.width, H = caps_.height;
   // The baseline needs no guides: it evaluates every pixel.
   if (!opt_.fullEvaluation) DCM_RETURN_IF_ERROR(LoadGuides());
+  if (opt_.checkerboard && !opt_.fullEvaluation) deferred_.assign(size_t(W) * size_t(H), SampleReason::kInterpolated);
 
   if (opt_.fullEvaluation) {
     for (int y = 0; y < H; ++y)
@@ -735,7 +755,8 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
         for (int x = b.x0; x <= b.x1; ++x) {
           const bool border = x == b.x0 || x == b.x1 || y == b.y0 || y == b.y1;
           if (border && !opt_.fallbackFilledBorders && store_.IsFilled(store_.Index(x, y))) continue;
-          store_.Request(x, y, SampleReason::kFallback);
+          if (border) store_.Request(x, y, SampleReason::kFallback);
+          else RequestOrDefer(x, y, SampleReason::kFallback);
         }
     });
     // Flushed before the thin-object pass: a fallback block's border is also
@@ -753,6 +774,7 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
       InterpolateOriented(l, denoise ? OrientedPass::kThinObjects : OrientedPass::kFinal);
     });
     DCM_RETURN_IF_ERROR(Flush());
+    if (opt_.checkerboard) DCM_RETURN_IF_ERROR(ResolveDeferred(!denoise));
     if (denoise) {
       Progress(0.93f, "denoising samples");
       // Averaging what the noise explains: the gate is wider than the
@@ -764,6 +786,7 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
       ForEach(orientedLeaves_, [&](Leaf& l, size_t) { InterpolateOriented(l, OrientedPass::kFinal); });
       // Nothing to evaluate unless the thin-object pass missed a pixel.
       DCM_RETURN_IF_ERROR(Flush());
+      WriteFilledDeferred();
     }
     if (opt_.onLevel) opt_.onLevel(levels - 1, W, H, store_.radiance());
     stats_.smoothBlocks = int64_t(smoothLeaves_.size());
@@ -788,6 +811,38 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
   out->stats = stats_;
   Progress(1.f, "done");
   return Status::Ok();
+}
+
+Status Engine::ResolveDeferred(bool write) {
+  std::vector<int64_t> deferred;
+  for (size_t i = 0; i < deferred_.size(); ++i)
+    if (deferred_[i] != SampleReason::kInterpolated) deferred.push_back(int64_t(i));
+  std::vector<uint8_t> filled(deferred.size(), 0);
+  // The decisions read the exact samples of the first colour only (requests
+  // take effect at the flush), so they do not depend on the order.
+  ForEach(deferred, [&](int64_t& i, size_t k) {
+    const int x = int(i % store_.width()), y = int(i / store_.width());
+    Value v;
+    if (NeighbourEstimate(store_, contrast_, {x, y}, true, &v)) {
+      filled[k] = 1;
+      if (write) store_.SetInterpolated(i, v);
+    } else {
+      store_.Request(x, y, deferred_[size_t(i)]);
+    }
+  });
+  filledDeferred_.clear();
+  for (size_t k = 0; k < deferred.size(); ++k)
+    if (filled[k]) filledDeferred_.push_back(deferred[k]);
+  stats_.checkerboardFilled = int64_t(filledDeferred_.size());
+  return Flush();
+}
+
+void Engine::WriteFilledDeferred() {
+  ForEach(filledDeferred_, [&](int64_t& i, size_t) {
+    Value v;
+    if (NeighbourEstimate(store_, contrast_, {int(i % store_.width()), int(i / store_.width())}, false, &v))
+      store_.SetInterpolated(i, v);
+  });
 }
 
 void Engine::RecordLeaves(Reconstruction* out) {

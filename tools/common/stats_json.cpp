@@ -42,6 +42,7 @@ nlohmann::json OptionsToJson(const ReconstructionOptions& o) {
   j["gradient_blocks_simple"] = o.gradientBlocksSimple;
   j["first_order_test"] = o.firstOrderTest;
   j["first_order_from_guides"] = o.firstOrderFromGuides;
+  j["checkerboard"] = o.checkerboard;
   j["lazy_evaluation"] = o.lazyEvaluation;
   j["fallback"] = o.fallback;
   j["fallback_max_changes"] = o.fallbackMaxChanges;
@@ -80,6 +81,7 @@ nlohmann::json StatsToJson(const ReconstructionStats& s) {
                  {"fallback", s.fallbackBlocks}};
   j["non_finite_samples"] = s.nonFiniteSamples;
   j["denoised_samples"] = s.denoisedSamples;
+  j["checkerboard_filled"] = s.checkerboardFilled;
   j["provider_calls"] = s.providerCalls;
   j["used"] = {{"split", s.usedSplit}, {"object_id", s.usedObjectId}, {"shader_id", s.usedShaderId},
                {"normals", s.usedNormals}};

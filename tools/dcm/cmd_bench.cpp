@@ -221,6 +221,8 @@ const Enhancement kEnhancements[] = {
      [](ReconstructionOptions* o) { o->firstOrderFromGuides = true; }},
     {"probeLcShare", [](ReconstructionOptions* o) { o->probeLcShare = 0.f; },
      [](ReconstructionOptions* o) { o->probeLcShare = ReconstructionOptions{}.probeLcShare; }},
+    {"checkerboard", [](ReconstructionOptions* o) { o->checkerboard = false; },
+     [](ReconstructionOptions* o) { o->checkerboard = true; }},
     {"lazyEvaluation", [](ReconstructionOptions* o) { o->lazyEvaluation = false; },
      [](ReconstructionOptions* o) { o->lazyEvaluation = true; }},
 };

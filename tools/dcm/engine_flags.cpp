@@ -36,6 +36,9 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
   app->add_option("--probe-lc-share", f->probeLcShare,
                   "with the texture split: no centre probe where the border is unchanging and L_c is below this "
                   "share of L on all of it (default 0.02; 0: probe every finest edge block)");
+  app->add_flag("--no-checkerboard", f->noCheckerboard,
+                "evaluate every pixel the thin-object test or a fallback wants exact, instead of one colour of a "
+                "checkerboard first and the other only where its exact neighbours disagree");
   app->add_option("--smooth-refinement", f->smoothRefinement, "always (the paper) | centre-probe | never");
   app->add_flag("--full", f->full, "evaluate every pixel exactly (the baseline)");
   app->add_option("--downsample", f->downsample, "the input is supersampled N times per axis; box-filter the result down");
@@ -75,6 +78,7 @@ Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {
   if (f.noAdaptiveBorders) o->adaptiveBorders = false;
   if (f.noCentreProbe) o->finestCentreProbe = false;
   if (f.noGuideFirstOrder) o->firstOrderFromGuides = false;
+  if (f.noCheckerboard) o->checkerboard = false;
   if (!f.smoothRefinement.empty()) DCM_RETURN_IF_ERROR(Parse(f.smoothRefinement, &o->smoothRefinement));
   if (f.full) o->fullEvaluation = true;
   o->downsample = f.downsample;

@@ -21,7 +21,7 @@ struct EngineFlags {
   bool noThin = false, noTextureSplit = false, noLazy = false, noFallback = false;
   bool noSurfaceAware = false, full = false;
   bool noAdaptiveBorders = false, noCentreProbe = false, noDenoise = false, fallbackFilledBorders = false;
-  bool noGuideFirstOrder = false;
+  bool noGuideFirstOrder = false, noCheckerboard = false;
   std::string smoothRefinement;  ///< always | centre-probe | never
   std::string objectTest;      ///< none | id | id+shader
   std::string thinTest;        ///< off | none-matches | any-differs | end-differs (default)

@@ -167,7 +167,9 @@ DCM_API void dcmSetFloat(DCMReconstructor r, const char* name, float value);
  *  "zero_order_test", "gradient_blocks_simple", "first_order_test",
  *  "first_order_from_guides",
  *  "lazy_evaluation", "fallback", "fallback_filled_borders",
- *  "finest_centre_probe", "full_evaluation", "denoise_samples". */
+ *  "finest_centre_probe", "checkerboard" (of the pixels the thin-object test
+ *  or a fallback wants exact, one checkerboard colour first, the other filled
+ *  where its exact neighbours agree), "full_evaluation", "denoise_samples". */
 DCM_API void dcmSetBool(DCMReconstructor r, const char* name, int value);
 
 /** The value of an integer (or bool) option; 0 and an error for an unknown name. */

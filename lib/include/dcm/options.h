@@ -148,6 +148,13 @@ struct ReconstructionOptions {
   /// to 0.28 points fewer exact pixels on the Cycles views at <= 0.01 dB).
   /// 0: probe every finest edge block.
   float probeLcShare = 0.02f;
+  /// Checkerboard refinement: of the pixels that the thin-object test or a
+  /// fallback wants exact, those with x + y odd wait until the others are
+  /// evaluated, and are filled from their exact 8-neighbours on their surface
+  /// when an opposite pair brackets them and none of them differs
+  /// significantly from the estimate; otherwise they are evaluated too
+  /// (docs/AOV.md). Off: every such pixel exactly.
+  bool checkerboard = true;
 
   /// Noisy samples (a provider that reports variance): a difference between
   /// samples counts only when it exceeds `noiseSignificance` standard

@@ -55,6 +55,7 @@ struct ReconstructionStats {
   int64_t denoisedSamples = 0;   ///< exact samples replaced by their local fit (noisy samples)
   int64_t smoothBlocks = 0, simpleEdgeBlocks = 0, complexEdgeBlocks = 0;
   int64_t lazyAccepted = 0, lazyRejected = 0, fallbackBlocks = 0;
+  int64_t checkerboardFilled = 0;  ///< pixels the tests wanted exact, filled from their exact neighbours
   int64_t providerCalls = 0;
   double timeGuidesS = 0;    ///< in the provider's Guides()
   double timeProviderS = 0;  ///< in the provider's Evaluate() (the illumination)
