@@ -142,6 +142,16 @@ Status ReconstructRegion(SampleProvider& provider, const ReconstructionOptions& 
   const Bounds2i window =
       RegionWindow(outputRegion, caps.width, caps.height, s, detail::ElementaryBlock(options, caps), haloBlocks);
 
+  if (info) {
+    info->output = outputRegion;
+    info->haloBlocks = haloBlocks;
+    info->work = work;
+    info->window = window;
+    info->frameWidth = frame.x;
+    info->frameHeight = frame.y;
+    info->frameWorkWidth = caps.width;
+    info->frameWorkHeight = caps.height;
+  }
   WindowProvider windowed(provider, window);
   DCM_RETURN_IF_ERROR(windowed.Validate());
   Reconstruction r;
@@ -186,17 +196,7 @@ Status ReconstructRegion(SampleProvider& provider, const ReconstructionOptions& 
   out->stats.exactPixels =
       out->stats.totalPixels - out->stats.byReason[size_t(SampleReason::kInterpolated)];
 
-  if (info) {
-    info->output = outputRegion;
-    info->haloBlocks = haloBlocks;
-    info->work = work;
-    info->window = window;
-    info->frameWidth = frame.x;
-    info->frameHeight = frame.y;
-    info->frameWorkWidth = caps.width;
-    info->frameWorkHeight = caps.height;
-    info->windowStats = r.stats;
-  }
+  if (info) info->windowStats = r.stats;
   return Status::Ok();
 }
 

@@ -283,6 +283,98 @@ TEST_P(PlanRoundTrip, SameImageAsDenseBitForBit) {
 INSTANTIATE_TEST_SUITE_P(BeautyAndSplit, PlanRoundTrip, ::testing::Values(false, true),
                          [](const auto& p) { return p.param ? "Split" : "Beauty"; });
 
+// A farm's round trip: each tile plans and renders its own part (its window,
+// halo included) until its plan is done; the tiles reconstructed from all the
+// samples and merged are the dense frame, bit for bit.
+TEST(PlanTiles, MergeToTheDenseImageBitForBit) {
+  ScratchDir dir;
+  Scene sc{96, 80};
+  const bool split = true;
+  WriteExr(dir / "dense.exr", sc.width, sc.height, sc.GenericChannels(split));
+  WriteExr(dir / "guides.exr", sc.width, sc.height, sc.GenericChannels(split, /*guidesOnly=*/true));
+  const std::vector<std::string> engine = {"--threads", "2", "--quiet"};
+  auto with = [&](std::vector<std::string> args, const std::vector<std::string>& samples) {
+    for (const auto& s : samples) args.insert(args.end(), {"--samples", s});
+    args.insert(args.end(), engine.begin(), engine.end());
+    return args;
+  };
+  auto r = RunDcm(with({"reconstruct", dir / "dense.exr", "-o", dir / "dense_out.exr", "--stats", dir / "dense.json"}, {}), dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+
+  const int n = 4;
+  std::vector<std::string> samples;
+  std::set<std::pair<int, int>> rendered;  // RenderList fails on a pixel asked for twice
+  for (int t = 0; t < n; ++t) {
+    const std::string tile = std::to_string(t) + "/" + std::to_string(n);
+    bool done = false;
+    for (int round = 0; round < 64 && !done; ++round) {
+      const std::string stats = dir / "plan.json";
+      r = RunDcm(with({"plan", dir / "guides.exr", "--tile", tile, "--list", dir / "next.txt", "--stats", stats}, samples),
+                 dir);
+      ASSERT_EQ(r.exitCode, 0) << r.err;
+      const auto j = ReadJson(stats);
+      EXPECT_EQ(j["part"]["tile"], tile);
+      if (r.out == "done\n") {
+        done = true;
+        EXPECT_TRUE(j["part"].contains("window_stats"));
+        break;
+      }
+      // Every pixel asked for lies in the tile's window.
+      const auto& w = j["part"]["window"];  // x, y, width, height
+      std::istringstream in(ReadText(dir / "next.txt"));
+      std::string line;
+      while (std::getline(in, line)) {
+        if (line.empty() || line[0] == '#') continue;
+        int x = -1, y = -1;
+        std::istringstream(line) >> x >> y;
+        EXPECT_TRUE(x >= int(w[0]) && x < int(w[0]) + int(w[2]) && y >= int(w[1]) && y < int(w[1]) + int(w[3]))
+            << "tile " << tile << ": pixel " << line << " outside its window";
+      }
+      const std::string s = dir / ("samples_" + std::to_string(t) + "_" + std::to_string(round) + ".exr");
+      RenderList(sc, split, dir / "next.txt", s, &rendered);
+      samples.push_back(s);
+    }
+    ASSERT_TRUE(done) << "tile " << tile << ": plan did not finish in 64 rounds";
+  }
+  std::vector<std::string> merge = {"merge", "-o", dir / "merged.exr", "--quiet"};
+  for (int t = 0; t < n; ++t) {
+    const std::string part = dir / ("part_" + std::to_string(t) + ".exr");
+    r = RunDcm(with({"reconstruct", dir / "guides.exr", "--tile", std::to_string(t) + "/" + std::to_string(n), "-o", part},
+                    samples),
+               dir);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    merge.push_back(part);
+  }
+  r = RunDcm(merge, dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const auto a = ReadRgbExr(dir / "dense_out.exr"), b = ReadRgbExr(dir / "merged.exr");
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(RGB)), 0) << "not bit-identical";
+  // Windows overlap by their halo: the tiles render at least the frame's
+  // exact pixels, and the halos add some.
+  EXPECT_GE(int64_t(rendered.size()), int64_t(ReadJson(dir / "dense.json")["exact_pixels"]));
+}
+
+TEST(PlanTiles, FramesExpandEveryName) {
+  ScratchDir dir;
+  Scene sc{32, 32};
+  for (int frame : {3, 4})
+    WriteExr(dir / ("guides." + std::to_string(frame) + ".exr"), 32, 32, sc.GenericChannels(false, true));
+  auto r = RunDcm({"plan", dir / "guides.#.exr", "--frames", "3-4", "--list", dir / "next.#.txt", "--quiet"}, dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const std::string first = r.out.substr(0, r.out.find('\n') + 1);
+  EXPECT_THAT(first, HasSubstr("pending "));
+  EXPECT_EQ(r.out, first + first) << "one line per frame, the same plan for the same guides";
+  EXPECT_TRUE(fs::exists(dir / "next.3.txt"));
+  EXPECT_TRUE(fs::exists(dir / "next.4.txt"));
+  EXPECT_EQ(ReadText(dir / "next.3.txt"), ReadText(dir / "next.4.txt"));
+  // Without a pattern, --frames is a usage error (exit 2) that says so.
+  r = RunDcm({"plan", dir / "guides.3.exr", "--frames", "3-4", "--list", dir / "x.txt"}, dir);
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_THAT(r.err, HasSubstr("frame pattern"));
+  EXPECT_FALSE(fs::exists(dir / "x.txt"));
+}
+
 TEST(DcmReconstruct, IncompleteSamplesAskForPlan) {
   ScratchDir dir;
   Scene sc{32, 32};

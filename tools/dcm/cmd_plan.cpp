@@ -11,7 +11,13 @@
 // samples files until plan prints "done"; then `dcm reconstruct GUIDES.exr
 // --samples ...` gives the same image as dense mode.
 //
-// stdout is one word for scripts: "pending N" or "done".
+// With --tile I/N or --region, the round covers one part of the frame (the
+// window ReconstructRegion reconstructs for it, halo included): each node of a
+// farm plans and renders its own part, and `dcm reconstruct --tile I/N` then
+// `dcm merge` assemble the frame. With --frames, '#' in the file names is the
+// frame number.
+//
+// stdout is one word for scripts: "pending N" or "done" (per frame).
 #include <OpenImageIO/imageio.h>
 #include <OpenImageIO/strutil.h>
 
@@ -23,6 +29,9 @@
 #include "aov_common.h"
 #include "common/image_io.h"
 #include "common/stats_json.h"
+#include "common/tiles.h"
+#include "dcm/window_provider.h"
+#include "tile_flags.h"
 
 namespace dcm::cli {
 namespace {
@@ -30,6 +39,7 @@ namespace {
 struct PlanFlags {
   aov_common::AovFlags aov;
   EngineFlags engine;
+  TileFlags tiles;
   std::string mask, list, stats;
 };
 
@@ -84,7 +94,26 @@ int RunPlan(const PlanFlags& f) {
 
   Reconstruction r;
   std::vector<Point2i> pending;
-  st = aov_common::Run(*provider, options, f.engine, &r, &pending);
+  std::string tile;
+  RegionInfo info;
+  if (IsPartial(f.tiles)) {
+    // As `dcm reconstruct --tile`: parts are cut from the whole frame.
+    if (!(provider->DataWindow() == provider->DisplayWindow()))
+      return aov_common::Fail(cmd, "--tile and --region need guides whose data window is their display window (the "
+                                   "whole frame); these are " + toolkit::RegionText(provider->DataWindow()) + " of " +
+                                   toolkit::RegionText(provider->DisplayWindow()), kExitUsage);
+    const ProviderCapabilities caps = provider->Capabilities();
+    const Point2i frame = OutputSize(caps.width, caps.height, options.downsample);
+    Bounds2i region;
+    st = ResolveRegion(f.tiles, frame.x, frame.y, TileAlignment(options), &region, &tile);
+    if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
+    toolkit::Progress progress(!f.engine.quiet);
+    options.progress = [&progress](float v, std::string_view stage) { progress.Update(v, stage); };
+    st = ReconstructRegion(*provider, options, region, &r, &info, &pending);
+    progress.Done();
+  } else {
+    st = aov_common::Run(*provider, options, f.engine, &r, &pending);
+  }
   if (!st.ok() && !st.pending()) return aov_common::Fail(cmd, st.message());
   const bool done = st.ok();
   std::vector<Point2i> next;
@@ -116,10 +145,18 @@ int RunPlan(const PlanFlags& f) {
     j["total_pixels"] = data.area();
     j["channels"] = channels;
     j["options"] = toolkit::OptionsToJson(options);
-    if (done) j["result"] = toolkit::StatsToJson(r.stats);
+    if (IsPartial(f.tiles)) {
+      j["part"] = PartJson(tile, info);
+      if (!done) j["part"].erase("window_stats");  // the engine did not finish the window
+    }
+    else if (done) j["result"] = toolkit::StatsToJson(r.stats);
     if ((rc = check(f.stats, toolkit::WriteJson(f.stats, j)))) return rc;
   }
   if (!f.engine.quiet) {
+    if (IsPartial(f.tiles))
+      std::cerr << "dcm plan: " << (tile.empty() ? "region " : "tile " + tile + ", ")
+                << toolkit::RegionText(info.output) << " of the frame, window " << toolkit::RegionText(info.window)
+                << "\n";
     std::string names;
     for (const auto& c : channels) names += (names.empty() ? "" : ",") + c;
     if (done)
@@ -136,6 +173,30 @@ int RunPlan(const PlanFlags& f) {
   return kExitOk;
 }
 
+/// --frames: one round per frame, '#' in the file names replaced by the
+/// frame number.
+int RunPlanFrames(const PlanFlags& f) {
+  std::vector<int> frames;
+  if (Status st = FrameList(f.tiles, &frames); !st.ok()) return aov_common::Fail("plan", st.message(), kExitUsage);
+  if (frames.empty()) return RunPlan(f);
+  auto names = [](PlanFlags* g, const std::function<void(std::string*)>& each) {
+    for (auto* list : {&g->aov.inputs, &g->aov.samples})
+      for (auto& name : *list) each(&name);
+    for (auto* name : {&g->mask, &g->list, &g->stats}) each(name);
+  };
+  bool any = false;
+  PlanFlags probe = f;
+  names(&probe, [&](std::string* name) { any = any || HasFramePattern(*name); });
+  if (!any)
+    return aov_common::Fail("plan", "--frames " + f.tiles.frames + ": no '#' frame pattern in the input or output names",
+                            kExitUsage);
+  return RunFrames("plan", frames, [&](int frame) {
+    PlanFlags g = f;
+    names(&g, [frame](std::string* name) { *name = ExpandFrame(*name, frame); });
+    return RunPlan(g);
+  });
+}
+
 Registration reg("plan", "Plan the next round of a file-based round trip (pixels to render)",
                  [](CLI::App* app) -> std::function<int()> {
                    auto f = std::make_shared<PlanFlags>();
@@ -144,7 +205,8 @@ Registration reg("plan", "Plan the next round of a file-based round trip (pixels
                    app->add_option("--list", f->list, "output text list of the pixels to render ('x y' lines)");
                    app->add_option("--stats", f->stats, "round summary as JSON");
                    AddEngineFlags(app, &f->engine);
-                   return [f] { return RunPlan(*f); };
+                   AddTileFlags(app, &f->tiles);
+                   return [f] { return RunPlanFrames(*f); };
                  });
 
 }  // namespace

@@ -103,7 +103,9 @@ struct RegionInfo {
 /// that touch them, in full-frame coordinates; `stats` counts (total, exact,
 /// by reason) over the region's working pixels, times and block counts over
 /// the window. Pending pixels (sparse providers) are in full-frame
-/// coordinates. The region must be a non-empty part of the output frame.
+/// coordinates; `info` then describes the region and window already (its
+/// windowStats only on success). The region must be a non-empty part of the
+/// output frame.
 /// `haloBlocks` < 0 takes RegionHaloBlocks(); other values are for tests.
 Status ReconstructRegion(SampleProvider& provider, const ReconstructionOptions& options,
                          const Bounds2i& outputRegion, Reconstruction* out, RegionInfo* info = nullptr,
