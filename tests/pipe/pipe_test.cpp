@@ -395,6 +395,62 @@ TEST(DcmPipe, FullEvaluationAsksForEveryPixel) {
   EXPECT_TRUE(Contains(log, "100.00 %")) << log;
 }
 
+// A renderer in a child process on a farm: each tile's dcm asks its child for
+// the tile's window only; the merged parts are the whole frame, bit for bit.
+TEST(DcmPipe, TilesMergeToTheWholeFrame) {
+  TempDir dir;
+  const int n = 3;
+  std::string log;
+  // Every tile runs the same command (merge checks it), one after another
+  // here, so that each count can be read before the next tile writes it.
+  const std::string provider = Quoted(Analytic("--width 96 --height 80 --count-file " + (dir / "count.txt")));
+  auto count = [&] {
+    std::ifstream cf(dir / "count.txt");
+    int64_t e = -1;
+    cf >> e;
+    return e;
+  };
+  ASSERT_EQ(RunShell(std::string(DCM_BINARY) + " pipe --quiet --provider-cmd " + provider + " -o " +
+                         (dir / "whole.exr") + " --stats " + (dir / "whole.json"),
+                     &log),
+            0)
+      << log;
+  const int64_t wholeEvaluated = count();
+  std::string merge = std::string(DCM_BINARY) + " merge --quiet -o " + (dir / "merged.exr");
+  int64_t evaluated = 0;
+  for (int i = 0; i < n; ++i) {
+    const std::string part = dir / ("part_" + std::to_string(i) + ".exr");
+    // `dcm reconstruct --provider-cmd` for one of them: the same computation.
+    const std::string command = i == 1 ? " reconstruct" : " pipe";
+    ASSERT_EQ(RunShell(std::string(DCM_BINARY) + command + " --quiet --provider-cmd " + provider + " --tile " +
+                           std::to_string(i) + "/" + std::to_string(n) + " -o " + part + " --stats " + part + ".json",
+                       &log),
+              0)
+        << log;
+    evaluated += count();
+    std::ifstream js(part + ".json");
+    EXPECT_EQ(nlohmann::json::parse(js).at("part").at("tile"), std::to_string(i) + "/" + std::to_string(n));
+    merge += " " + part;
+  }
+  ASSERT_EQ(RunShell(merge, &log), 0) << log;
+  std::vector<dcm::RGB> a, b;
+  int w = 0, h = 0;
+  ASSERT_TRUE(dcm::toolkit::ReadRgb(dir / "whole.exr", &w, &h, &a).ok());
+  ASSERT_TRUE(dcm::toolkit::ReadRgb(dir / "merged.exr", &w, &h, &b).ok());
+  ASSERT_EQ(a.size(), size_t(96 * 80));
+  EXPECT_EQ(a, b) << "the merged tiles differ from the whole frame";
+  // Each child was asked for its tile's window only: the windows overlap by
+  // their halo, so together at least the frame's exact pixels, and less than
+  // the whole frame's pixels.
+  EXPECT_GE(evaluated, wholeEvaluated);
+  EXPECT_LT(evaluated, 96 * 80);
+  EXPECT_NE(RunShell(std::string(DCM_BINARY) + " pipe --quiet --provider-cmd " + provider + " --frames 1-2 -o " +
+                         (dir / "f#.exr"),
+                     &log),
+            0);
+  EXPECT_TRUE(Contains(log, "--frames is not for a provider command")) << log;
+}
+
 class DcmPipeFault : public ::testing::TestWithParam<FaultCase> {};
 
 TEST_P(DcmPipeFault, ExitsWithAMessageAndNoOutput) {

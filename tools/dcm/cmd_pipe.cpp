@@ -18,8 +18,10 @@
 #include "common/progress.h"
 #include "common/sample_map.h"
 #include "common/stats_json.h"
+#include "common/tiles.h"
 #include "dcm/pipe/pipe_provider.h"
 #include "dcm/reconstructor.h"
+#include "dcm/window_provider.h"
 #include "engine_flags.h"
 #include "pipe_run.h"
 
@@ -41,6 +43,11 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
   };
   ReconstructionOptions options;
   if (Status st = ToOptions(f.engine, &options); !st.ok()) return Fail(st.message(), kExitUsage);
+  if (!f.tiles.frames.empty())
+    return Fail("--frames is not for a provider command (run one dcm pipe per frame)", kExitUsage);
+  const bool partial = IsPartial(f.tiles);
+  if (partial && !f.engine.progressive.empty())
+    return Fail("--progressive needs the whole frame; not with --tile or --region", kExitUsage);
 
   const auto t0 = std::chrono::steady_clock::now();
   std::unique_ptr<pipe::PipeProvider> provider;
@@ -62,10 +69,19 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
                 kExitUsage);
   }
 
+  // --tile / --region: the part of the frame, its window asked of the child.
+  const Point2i frame = OutputSize(caps.width, caps.height, options.downsample);
+  Bounds2i region;
+  std::string tile;
+  if (partial) {
+    if (Status st = ResolveRegion(f.tiles, frame.x, frame.y, TileAlignment(options), &region, &tile); !st.ok())
+      return Fail(st.message(), kExitUsage);
+  }
   toolkit::Progress progress(!f.engine.quiet);
   options.progress = [&](float v, std::string_view stage) { progress.Update(v, stage); };
   Reconstruction rec;
-  Status st = Reconstruct(*provider, options, &rec);
+  RegionInfo info;
+  Status st = partial ? ReconstructRegion(*provider, options, region, &rec, &info) : Reconstruct(*provider, options, &rec);
   progress.Done();
   if (!st.ok()) return Fail(st.message());
   // The child must end cleanly before anything is written.
@@ -82,8 +98,22 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
   meta.floats.push_back({"dcm:exact_fraction", float(stats.exactFraction())});
   meta.floats.push_back({"dcm:time_illum_s", float(stats.timeProviderS)});
   meta.floats.push_back({"dcm:time_dcm_s", float(stats.timeEngineS)});
-  if (Status w = toolkit::WriteRgbExr(f.output, rec.width, rec.height, rec.image, meta); !w.ok())
+  if (partial) {
+    // What decides the pixels besides the options: the provider command (so
+    // every tile must run the same one) and what the provider announced. The
+    // same for `dcm pipe` and `dcm reconstruct --provider-cmd`, which are one
+    // computation.
+    const nlohmann::json settings = toolkit::PartSettings(
+        "pipe", DCM_VERSION, options,
+        {{"provider_cmd", f.command}, {"provider_name", caps.name}, {"width", caps.width}, {"height", caps.height},
+         {"object_id", caps.objectId}, {"shader_id", caps.shaderId}, {"texture", caps.texture},
+         {"split", caps.splitRadiance}, {"variance", caps.variance}});
+    AddPartMetadata(tile, region, settings, rec, info, &meta);
+    if (Status w = toolkit::WritePartExr(f.output, frame.x, frame.y, region, rec.image, meta); !w.ok())
+      return Fail(w.message());
+  } else if (Status w = toolkit::WriteRgbExr(f.output, rec.width, rec.height, rec.image, meta); !w.ok()) {
     return Fail(w.message());
+  }
   if (!f.sampleMap.empty()) {
     if (Status w = toolkit::WriteSampleMap(f.sampleMap, rec); !w.ok()) return Fail(w.message());
   }
@@ -92,11 +122,17 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
     j["provider"] = "pipe";
     j["provider_name"] = caps.name;
     j["provider_cmd"] = f.command;
+    if (partial) j["part"] = PartJson(tile, info);
     if (Status w = toolkit::WriteJson(f.stats, j); !w.ok()) return Fail(w.message());
   }
 
-  std::printf("%s: %dx%d (working %dx%d), %s, provider '%s'\n", f.output.c_str(), rec.width, rec.height,
-              rec.workWidth, rec.workHeight, method.c_str(), caps.name.c_str());
+  if (partial)
+    std::printf("%s: %s %s of %dx%d (window %dx%d working pixels), %s, provider '%s'\n", f.output.c_str(),
+                tile.empty() ? "region" : "tile", tile.empty() ? toolkit::RegionText(region).c_str() : tile.c_str(),
+                frame.x, frame.y, info.window.width(), info.window.height(), method.c_str(), caps.name.c_str());
+  else
+    std::printf("%s: %dx%d (working %dx%d), %s, provider '%s'\n", f.output.c_str(), rec.width, rec.height,
+                rec.workWidth, rec.workHeight, method.c_str(), caps.name.c_str());
   std::printf("  exact pixels   %.2f %% (%lld of %lld)\n", 100.0 * stats.exactFraction(),
               static_cast<long long>(stats.exactPixels), static_cast<long long>(stats.totalPixels));
   std::printf("  time           provider %.2f s, DCM %.2f s, guides %.2f s, total %.2f s\n", stats.timeProviderS,
@@ -118,6 +154,7 @@ Registration reg("pipe", "Reconstruct with an external renderer as a child proce
                    app->add_option("--sample-map", f->sampleMap, "write the sample map (PNG): which pixels were exact, why");
                    AddProviderTimeoutFlags(app, f.get());
                    AddEngineFlags(app, &f->engine);
+                   AddTileFlags(app, &f->tiles);
                    return [f] { return RunPipe("pipe", *f); };
                  });
 

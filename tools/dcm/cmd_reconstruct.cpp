@@ -233,16 +233,18 @@ int RunReconstruct(const ReconstructFlags& f) {
     if (!f.aov.inputs.empty())
       return aov_common::Fail(cmd, "--provider-cmd replaces the input files; give one or the other", kExitUsage);
     if (!f.aov.samples.empty() || !f.aov.secondRender.empty() || f.aov.estimateVariance || !f.reference.empty() ||
-        !f.errorMap.empty() || !f.preview.empty() || f.alpha || !f.tiles.tile.empty() || !f.tiles.region.empty())
+        !f.errorMap.empty() || !f.preview.empty() || f.alpha)
       return aov_common::Fail(cmd,
-                              "with --provider-cmd only -o, --stats, --sample-map, the provider timeouts and the "
-                              "engine flags apply (the provider reports its own variance and guides)",
+                              "with --provider-cmd only -o, --stats, --sample-map, --tile/--region, the provider "
+                              "timeouts and the engine flags apply (the provider reports its own variance and guides)",
                               kExitUsage);
     PipeFlags p = f.pipe;
     p.output = f.output;
     p.stats = f.stats;
     p.sampleMap = f.sampleMap;
     p.engine = f.engine;
+    p.tiles = f.tiles;
+    p.tiles.frames.clear();  // RunReconstructFrames ran the frames
     return RunPipe(cmd, p);
 #else
     return aov_common::Fail(cmd, "--provider-cmd needs plugins/pipe, which this build does not have", kExitUsage);

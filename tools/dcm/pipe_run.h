@@ -8,6 +8,7 @@
 #include <string>
 
 #include "engine_flags.h"
+#include "tile_flags.h"
 
 namespace dcm::cli {
 
@@ -20,6 +21,7 @@ struct PipeFlags {
   double timeout = 600.0;         ///< --provider-timeout, per answer
   double startupTimeout = 600.0;  ///< --provider-startup-timeout, for the handshake
   EngineFlags engine;
+  TileFlags tiles;  ///< --tile / --region: a part of the frame for `dcm merge` (no --frames)
 };
 
 /// Adds --provider-timeout and --provider-startup-timeout.
