@@ -23,6 +23,7 @@ ReconstructionOptions ReconstructionOptions::Guo() {
   o.gradientBlocksSimple = false;
   o.firstOrderFromGuides = false;
   o.checkerboard = false;
+  o.simpleSurfaceChanges = 2;
   o.fallback = false;
   o.noiseSignificance = 0.f;
   o.creaseAngle = 0.f;
@@ -104,6 +105,8 @@ Status ReconstructionOptions::Validate() const {
   if (!(noiseSignificance >= 0) || !std::isfinite(noiseSignificance))
     return bad("noiseSignificance", "must be a finite number >= 0");
   if (fallbackMaxChanges < 0) return bad("fallbackMaxChanges", "must be >= 0");
+  if (simpleSurfaceChanges < 2 || simpleSurfaceChanges > 64)
+    return bad("simpleSurfaceChanges", "must be from 2 to 64, got " + std::to_string(simpleSurfaceChanges));
   if (!(probeLcShare >= 0 && probeLcShare <= 1)) return bad("probeLcShare", "must be from 0 to 1");
   if (neighbourDirections < 0 || 2 * neighbourDirections >= directions)
     return bad("neighbourDirections", "must be from 0 to (directions - 1) / 2 = " + std::to_string((directions - 1) / 2) +

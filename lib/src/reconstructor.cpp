@@ -645,7 +645,13 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
         ForEach(eb, [&](EdgeBlock& e, size_t) {
           const size_t n = e.crossings.size();
           const bool zeroOrder = !opt_.zeroOrderTest || n == 2 || (n == 0 && opt_.gradientBlocksSimple);
-          e.simple = e.block.HasInterior() && zeroOrder && SurfaceChanges(store_, e.border) <= 2;
+          const int surfaceChanges = SurfaceChanges(store_, e.border);
+          // Every significant change a surface change (crossings include them all).
+          const bool onlySurfaces = int(n) == surfaceChanges;
+          const bool small = std::max(e.block.width(), e.block.height()) <= 2 * opt_.minBlock;
+          e.simple = e.block.HasInterior() &&
+                     ((zeroOrder && surfaceChanges <= 2) ||
+                      (small && onlySurfaces && n > 2 && int(n) <= opt_.simpleSurfaceChanges));
           if (e.simple && opt_.firstOrderTest && n == 2)
             for (Point2i p : FirstOrderProbes(store_, e.block, e.border, e.crossings, opt_.firstOrderFromGuides))
               store_.Request(p.x, p.y, SampleReason::kFirstOrderProbe);

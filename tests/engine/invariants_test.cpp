@@ -152,6 +152,12 @@ TEST(Invariants, InvalidOptionsNameTheField) {
   const Status u = Reconstruct(p, share, &r);
   ASSERT_FALSE(u.ok());
   EXPECT_NE(u.message().find("probeLcShare"), std::string::npos) << u.message();
+  ReconstructionOptions changes;
+  changes.simpleSurfaceChanges = 1;  // fewer than the one edge Guo's test accepts
+  const Status v = Reconstruct(p, changes, &r);
+  ASSERT_FALSE(v.ok());
+  EXPECT_NE(v.message().find("simpleSurfaceChanges"), std::string::npos) << v.message();
+  EXPECT_NE(v.message().find("got 1"), std::string::npos) << v.message();
 }
 
 }  // namespace

@@ -20,6 +20,9 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
   app->add_option("--neighbour-directions", f->neighbourDirections,
                   "directions each side of its block's that an interior pixel tries before the thin-object test "
                   "makes it exact (default 1; paper|guo: 0)");
+  app->add_option("--simple-surface-changes", f->simpleSurfaceChanges,
+                  "a block of at most twice the finest size whose border changes only at surface changes, up to "
+                  "N times, counts as simple (default 8; paper|guo: 2)");
   app->add_flag("--no-texture-split", f->noTextureSplit, "interpolate L instead of (L_i, L_c) (paper 3.3)");
   app->add_option("--object-test", f->objectTest, "none | id | id+shader (paper 3.2)");
   app->add_option("--contrast", f->contrast, "mitchell | display");
@@ -68,6 +71,7 @@ Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {
   if (f.noThin) o->thinObjects = ThinObjectTest::kOff;
   if (!f.thinTest.empty()) DCM_RETURN_IF_ERROR(Parse(f.thinTest, &o->thinObjects));
   if (f.neighbourDirections >= 0) o->neighbourDirections = f.neighbourDirections;
+  if (f.simpleSurfaceChanges) o->simpleSurfaceChanges = f.simpleSurfaceChanges;
   if (f.noTextureSplit) o->textureSplit = false;
   if (!f.objectTest.empty()) DCM_RETURN_IF_ERROR(Parse(f.objectTest, &o->objectTest));
   if (!f.contrast.empty()) DCM_RETURN_IF_ERROR(Parse(f.contrast, &o->contrastMetric));

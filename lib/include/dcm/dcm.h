@@ -148,7 +148,9 @@ DCM_API void dcmSetString(DCMReconstructor r, const char* name, const char* valu
 
 /** Sets an integer option: "elementary_block", "noisy_elementary_block" (the
  *  elementary block with noisy samples, default 8; 0: elementary_block),
- *  "min_block", "directions", "fallback_max_changes",
+ *  "min_block", "directions", "fallback_max_changes", "simple_surface_changes"
+ *  (a block of at most twice the finest size whose border changes only at
+ *  surface changes, up to this many, counts as simple; 2: Guo's test),
  *  "neighbour_directions" (directions each side an interior pixel tries
  *  before the thin-object test makes it exact, default 1), "downsample",
  *  "threads" (0: all cores),
