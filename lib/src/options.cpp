@@ -65,8 +65,11 @@ std::string_view NameOf(E value, const std::array<std::pair<std::string_view, E>
   return "?";
 }
 
-constexpr std::array<std::pair<std::string_view, ObjectTest>, 3> kObjectTests{{
-    {"none", ObjectTest::kNone}, {"id", ObjectTest::kObjectId}, {"id+shader", ObjectTest::kObjectAndShader}}};
+constexpr std::array<std::pair<std::string_view, ObjectTest>, 4> kObjectTests{{
+    {"none", ObjectTest::kNone},
+    {"id", ObjectTest::kObjectId},
+    {"id+shader", ObjectTest::kObjectAndShader},
+    {"id|shader", ObjectTest::kObjectOrShader}}};
 constexpr std::array<std::pair<std::string_view, ThinObjectTest>, 4> kThinTests{{
     {"off", ThinObjectTest::kOff}, {"none-matches", ThinObjectTest::kNoneMatches},
     {"any-differs", ThinObjectTest::kAnyDiffers}, {"end-differs", ThinObjectTest::kEndDiffers}}};

@@ -252,7 +252,8 @@ class Engine {
 Status Engine::LoadGuides() {
   GuideRequest want;
   want.objectId = caps_.objectId && opt_.objectTest != ObjectTest::kNone;
-  want.shaderId = want.objectId && caps_.shaderId && opt_.objectTest == ObjectTest::kObjectAndShader;
+  want.shaderId = want.objectId && caps_.shaderId &&
+                  (opt_.objectTest == ObjectTest::kObjectAndShader || opt_.objectTest == ObjectTest::kObjectOrShader);
   want.texture = split_;
   want.normal = caps_.normal && opt_.creaseAngle > 0.f;
   stats_.usedObjectId = want.objectId;

@@ -1,5 +1,7 @@
 #include "sample_store.h"
 
+#include <unordered_map>
+
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 #include <tbb/task_arena.h>
@@ -28,6 +30,16 @@ SampleStore::SampleStore(int width, int height, bool split, bool variance)
 void SampleStore::SetGuides(GuideImage guides, ObjectTest test, float creaseAngle, int regionCell) {
   guides_ = std::move(guides);
   if (split_) tau_ = std::move(guides_.texture);
+  if (test == ObjectTest::kObjectOrShader && !guides_.objectId.empty() &&
+      guides_.shaderId.size() == guides_.objectId.size()) {
+    // A surface is an (object, shader) pair: one label per pair, numbered in
+    // the order of first appearance (deterministic), instead of the object ID.
+    std::unordered_map<uint64_t, uint32_t> labels;
+    for (size_t i = 0; i < guides_.objectId.size(); ++i) {
+      const uint64_t pair = (uint64_t(guides_.objectId[i]) << 32) | guides_.shaderId[i];
+      guides_.objectId[i] = labels.try_emplace(pair, uint32_t(labels.size())).first->second;
+    }
+  }
   const uint32_t* obj = (test != ObjectTest::kNone && !guides_.objectId.empty()) ? guides_.objectId.data() : nullptr;
   const uint32_t* shader = (obj && test == ObjectTest::kObjectAndShader && !guides_.shaderId.empty())
                                ? guides_.shaderId.data() : nullptr;
