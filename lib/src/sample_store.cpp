@@ -34,10 +34,17 @@ void SampleStore::SetGuides(GuideImage guides, ObjectTest test, float creaseAngl
       guides_.shaderId.size() == guides_.objectId.size()) {
     // A surface is an (object, shader) pair: one label per pair, numbered in
     // the order of first appearance (deterministic), instead of the object ID.
+    // Neighbours mostly repeat the last pair: look up only the changes.
     std::unordered_map<uint64_t, uint32_t> labels;
+    uint64_t lastPair = 0;
+    uint32_t lastLabel = 0;
     for (size_t i = 0; i < guides_.objectId.size(); ++i) {
       const uint64_t pair = (uint64_t(guides_.objectId[i]) << 32) | guides_.shaderId[i];
-      guides_.objectId[i] = labels.try_emplace(pair, uint32_t(labels.size())).first->second;
+      if (i == 0 || pair != lastPair) {
+        lastPair = pair;
+        lastLabel = labels.try_emplace(pair, uint32_t(labels.size())).first->second;
+      }
+      guides_.objectId[i] = lastLabel;
     }
   }
   const uint32_t* obj = (test != ObjectTest::kNone && !guides_.objectId.empty()) ? guides_.objectId.data() : nullptr;
