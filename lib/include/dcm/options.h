@@ -85,7 +85,8 @@ struct ReconstructionOptions {
   /// change only where object AND shader differ) joins objects of one
   /// material, so a chair on a table of the same wood interpolated the
   /// table's samples (docs/AOV.md: +0.02 to +0.98 dB on the Cycles views,
-  /// +0.16 to +0.43 dB on the bundled scenes, for <= 0.09 points).
+  /// +0.16 to +0.46 dB on the bundled scenes, for <= 0.09 points). IDs of
+  /// primitives (one object of many parts) want kObjectAndShader.
   ObjectTest objectTest = ObjectTest::kObjectOrShader;
   ThinObjectTest thinObjects = ThinObjectTest::kEndDiffers;
   /// An interior pixel that the thin-object test would make exact first
@@ -126,7 +127,7 @@ struct ReconstructionOptions {
   /// and its pixels that no direction serves are thin objects. With the
   /// guides, the interpolation serves each surface from its own samples, so
   /// the zero-order test's "one edge" is not what limits it (docs/AOV.md:
-  /// 0.2-0.6 points fewer exact pixels for <= 0.14 dB on the Cycles views).
+  /// 0.2-0.7 points fewer exact pixels for <= 0.15 dB on the Cycles views).
   /// 2: Guo's zero-order test alone.
   int simpleSurfaceChanges = 8;
   /// An edge block with no significant change along its border (a smooth
