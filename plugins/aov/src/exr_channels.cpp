@@ -195,8 +195,44 @@ std::string ChannelSet::Paths() const {
   return s;
 }
 
+const std::vector<std::vector<float>>& ChannelSet::OnePass(int file, int subimage) const {
+  Pass& p = passes_[{file, subimage}];
+  if (p.tried) return p.planes;
+  p.tried = true;
+  const File& f = files_[size_t(file)];
+  const ImageSpec& sp = f.specs[size_t(subimage)];
+  const size_t n = pixels();
+  const int channels = sp.nchannels;
+  if (sp.tile_width != 0 || channels < 2 || int64_t(channels) * int64_t(n) * 4 > kOnePassBytes) return p.planes;
+  std::vector<std::vector<float>> planes(size_t(channels), std::vector<float>(n, 0.f));
+  // Rows per read: about 64 MiB of float, a multiple of 32 scanlines (the
+  // largest EXR scanline block).
+  const size_t rowBytes = size_t(sp.width) * size_t(channels) * 4;
+  const int rows = std::max(32, int((size_t(64) << 20) / std::max<size_t>(1, rowBytes)) / 32 * 32);
+  std::vector<float> buffer(size_t(std::min(rows, sp.height)) * size_t(sp.width) * size_t(channels));
+  for (int y = 0; y < sp.height; y += rows) {
+    const int end = std::min(sp.height, y + rows);
+    if (!f.in->read_scanlines(subimage, 0, sp.y + y, sp.y + end, 0, 0, channels, TypeDesc::FLOAT, buffer.data())) {
+      (void)f.in->geterror();
+      return p.planes;  // empty: the per-channel reads say what is wrong
+    }
+    const size_t first = size_t(y) * size_t(sp.width), count = size_t(end - y) * size_t(sp.width);
+    for (size_t i = 0; i < count; ++i)
+      for (int c = 0; c < channels; ++c) planes[size_t(c)][first + i] = buffer[i * size_t(channels) + size_t(c)];
+  }
+  p.planes = std::move(planes);
+  return p.planes;
+}
+
 Status ChannelSet::ReadRef(const ChannelRef& ref, const std::string& name, TypeDesc type,
                            void* data) const {
+  if (type == TypeDesc::FLOAT) {
+    const auto& planes = OnePass(ref.file, ref.subimage);
+    if (!planes.empty()) {
+      std::memcpy(data, planes[size_t(ref.index)].data(), pixels() * sizeof(float));
+      return Status::Ok();
+    }
+  }
   const File& f = files_[size_t(ref.file)];
   if (!f.in->read_image(ref.subimage, 0, ref.index, ref.index + 1, type, data))
     return Status::Error(Quote(f.path) + ": cannot read channel " + Quote(name) +

@@ -25,6 +25,9 @@ inline constexpr int kMaxSide = 1 << 17;
 /// Planes (RGB roles, IDs, mask, read buffers) the provider may allocate per
 /// pixel, used by the memory guard.
 inline constexpr int kPlanesPerPixel = 24;
+/// A part of a scanline file whose channels take at most this many bytes as
+/// float is read in one pass at its first float read (ChannelSet::ReadFloat).
+inline constexpr int64_t kOnePassBytes = int64_t(1) << 30;
 
 /// Where a channel lives.
 struct ChannelRef {
@@ -115,6 +118,19 @@ class ChannelSet {
   Status ReadRaw(const std::string& name, OIIO::TypeDesc type, void* data) const;
   Status ReadRef(const ChannelRef& ref, const std::string& name, OIIO::TypeDesc type,
                  void* data) const;
+  /// EXR compresses blocks of scanlines with all their channels together, so
+  /// reading one channel at a time decompresses a file once per channel (24
+  /// times for a Blender multilayer EXR in dense mode). A part of a scanline
+  /// file whose channels fit in kOnePassBytes is read in one pass instead,
+  /// at its first float read, and later float reads copy from it. Empty when
+  /// the part is tiled, too large, or the pass failed (the per-channel read
+  /// then reports the error, naming the channel).
+  const std::vector<std::vector<float>>& OnePass(int file, int subimage) const;
+  struct Pass {
+    bool tried = false;
+    std::vector<std::vector<float>> planes;  ///< per channel of the part
+  };
+  mutable std::map<std::pair<int, int>, Pass> passes_;
   void ScanCrypto(int file);
 
   ImageWindows windows_;
