@@ -205,10 +205,10 @@ const std::vector<std::vector<float>>& ChannelSet::OnePass(int file, int subimag
   const int channels = sp.nchannels;
   if (sp.tile_width != 0 || channels < 2 || int64_t(channels) * int64_t(n) * 4 > kOnePassBytes) return p.planes;
   std::vector<std::vector<float>> planes(size_t(channels), std::vector<float>(n, 0.f));
-  // Rows per read: about 64 MiB of float, a multiple of 32 scanlines (the
+  // Rows per read: about 8 MiB of float, a multiple of 32 scanlines (the
   // largest EXR scanline block).
   const size_t rowBytes = size_t(sp.width) * size_t(channels) * 4;
-  const int rows = std::max(32, int((size_t(64) << 20) / std::max<size_t>(1, rowBytes)) / 32 * 32);
+  const int rows = std::max(32, int((size_t(8) << 20) / std::max<size_t>(1, rowBytes)) / 32 * 32);
   std::vector<float> buffer(size_t(std::min(rows, sp.height)) * size_t(sp.width) * size_t(channels));
   for (int y = 0; y < sp.height; y += rows) {
     const int end = std::min(sp.height, y + rows);
@@ -228,7 +228,7 @@ Status ChannelSet::ReadRef(const ChannelRef& ref, const std::string& name, TypeD
                            void* data) const {
   if (type == TypeDesc::FLOAT) {
     const auto& planes = OnePass(ref.file, ref.subimage);
-    if (!planes.empty()) {
+    if (!planes.empty() && !planes[size_t(ref.index)].empty()) {
       std::memcpy(data, planes[size_t(ref.index)].data(), pixels() * sizeof(float));
       return Status::Ok();
     }
@@ -247,6 +247,17 @@ Status ChannelSet::ReadRaw(const std::string& name, TypeDesc type, void* data) c
 }
 
 Status ChannelSet::ReadFloat(const std::string& name, std::vector<float>* plane) const {
+  // A plane of the one-pass read is handed over, not copied (a second read
+  // of the channel reads it from the file again).
+  if (auto ref = Find(name)) {
+    OnePass(ref->file, ref->subimage);
+    auto& planes = passes_[{ref->file, ref->subimage}].planes;
+    if (size_t(ref->index) < planes.size() && !planes[size_t(ref->index)].empty()) {
+      plane->swap(planes[size_t(ref->index)]);
+      std::vector<float>().swap(planes[size_t(ref->index)]);
+      return Status::Ok();
+    }
+  }
   plane->assign(pixels(), 0.f);
   return ReadRaw(name, TypeDesc::FLOAT, plane->data());
 }
