@@ -122,7 +122,8 @@ class ChannelSet {
   /// reading one channel at a time decompresses a file once per channel (24
   /// times for a Blender multilayer EXR in dense mode). A part of a scanline
   /// file whose channels fit in kOnePassBytes is read in one pass instead,
-  /// at its first float read, and later float reads copy from it. Empty when
+  /// at its first float read; ReadFloat then takes a channel's plane from it
+  /// (a second read of the channel reads the file again). Empty when
   /// the part is tiled, too large, or the pass failed (the per-channel read
   /// then reports the error, naming the channel).
   const std::vector<std::vector<float>>& OnePass(int file, int subimage) const;
