@@ -176,25 +176,14 @@ int RunPlan(const PlanFlags& f) {
 /// --frames: one round per frame, '#' in the file names replaced by the
 /// frame number.
 int RunPlanFrames(const PlanFlags& f) {
-  std::vector<int> frames;
-  if (Status st = FrameList(f.tiles, &frames); !st.ok()) return aov_common::Fail("plan", st.message(), kExitUsage);
-  if (frames.empty()) return RunPlan(f);
-  auto names = [](PlanFlags* g, const std::function<void(std::string*)>& each) {
-    for (auto* list : {&g->aov.inputs, &g->aov.samples})
-      for (auto& name : *list) each(&name);
-    for (auto* name : {&g->mask, &g->list, &g->stats}) each(name);
-  };
-  bool any = false;
-  PlanFlags probe = f;
-  names(&probe, [&](std::string* name) { any = any || HasFramePattern(*name); });
-  if (!any)
-    return aov_common::Fail("plan", "--frames " + f.tiles.frames + ": no '#' frame pattern in the input or output names",
-                            kExitUsage);
-  return RunFrames("plan", frames, [&](int frame) {
-    PlanFlags g = f;
-    names(&g, [frame](std::string* name) { *name = ExpandFrame(*name, frame); });
-    return RunPlan(g);
-  });
+  return RunPerFrame<PlanFlags>(
+      "plan", f, f.tiles,
+      [](PlanFlags* g, const std::function<void(std::string*)>& each) {
+        for (auto* list : {&g->aov.inputs, &g->aov.samples})
+          for (auto& name : *list) each(&name);
+        for (auto* name : {&g->mask, &g->list, &g->stats}) each(name);
+      },
+      RunPlan);
 }
 
 Registration reg("plan", "Plan the next round of a file-based round trip (pixels to render)",

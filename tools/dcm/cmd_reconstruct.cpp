@@ -349,28 +349,14 @@ int RunReconstruct(const ReconstructFlags& f) {
 /// --frames: one reconstruction per frame, '#' in the file names replaced by
 /// the frame number.
 int RunReconstructFrames(const ReconstructFlags& f) {
-  std::vector<int> frames;
-  if (Status st = FrameList(f.tiles, &frames); !st.ok())
-    return aov_common::Fail("reconstruct", st.message(), kExitUsage);
-  if (frames.empty()) return RunReconstruct(f);
-  // Every file name of the flags, each handed to `each`.
-  auto names = [](ReconstructFlags* g, const std::function<void(std::string*)>& each) {
-    for (auto* list : {&g->aov.inputs, &g->aov.samples, &g->aov.secondRender})
-      for (auto& name : *list) each(&name);
-    for (auto* name : {&g->output, &g->stats, &g->sampleMap, &g->preview, &g->errorMap, &g->reference}) each(name);
-  };
-  bool any = false;
-  ReconstructFlags probe = f;
-  names(&probe, [&](std::string* name) { any = any || HasFramePattern(*name); });
-  if (!any)
-    return aov_common::Fail("reconstruct", "--frames " + f.tiles.frames +
-                                               ": no '#' frame pattern in the input or output names",
-                            kExitUsage);
-  return RunFrames("reconstruct", frames, [&](int frame) {
-    ReconstructFlags g = f;
-    names(&g, [frame](std::string* name) { *name = ExpandFrame(*name, frame); });
-    return RunReconstruct(g);
-  });
+  return RunPerFrame<ReconstructFlags>(
+      "reconstruct", f, f.tiles,
+      [](ReconstructFlags* g, const std::function<void(std::string*)>& each) {
+        for (auto* list : {&g->aov.inputs, &g->aov.samples, &g->aov.secondRender})
+          for (auto& name : *list) each(&name);
+        for (auto* name : {&g->output, &g->stats, &g->sampleMap, &g->preview, &g->errorMap, &g->reference}) each(name);
+      },
+      RunReconstruct);
 }
 
 Registration reg("reconstruct", "Reconstruct an image from a renderer's EXR AOVs with DCM",

@@ -318,26 +318,13 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
 
 /// --frames: one render per frame, '#' in the file names replaced by the frame.
 int RunRenderFrames(const RenderFlags& f, CLI::App* app) {
-  std::vector<int> frames;
-  if (Status st = FrameList(f.tiles, &frames); !st.ok()) {
-    std::cerr << "dcm render: " << st.message() << "\n";
-    return kExitUsage;
-  }
-  if (frames.empty()) return RunRender(f, app);
-  std::vector<std::string RenderFlags::*> names = {&RenderFlags::scene, &RenderFlags::output, &RenderFlags::compare,
-                                                   &RenderFlags::stats, &RenderFlags::sampleMap, &RenderFlags::preview,
-                                                   &RenderFlags::referenceOut};
-  bool any = false;
-  for (auto name : names) any = any || HasFramePattern(f.*name);
-  if (!any) {
-    std::cerr << "dcm render: --frames " << f.tiles.frames << ": no '#' frame pattern in the scene or output names\n";
-    return kExitUsage;
-  }
-  return RunFrames("render", frames, [&](int frame) {
-    RenderFlags g = f;
-    for (auto name : names) g.*name = ExpandFrame(f.*name, frame);
-    return RunRender(g, app);
-  });
+  return RunPerFrame<RenderFlags>(
+      "render", f, f.tiles,
+      [](RenderFlags* g, const std::function<void(std::string*)>& each) {
+        for (auto* name : {&g->scene, &g->output, &g->compare, &g->stats, &g->sampleMap, &g->preview, &g->referenceOut})
+          each(name);
+      },
+      [app](const RenderFlags& g) { return RunRender(g, app); });
 }
 
 Registration reg("render", "Ray trace a scene file (Embree) with DCM: a few percent of the pixels exact",

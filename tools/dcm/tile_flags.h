@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <cstdio>
 #include <functional>
 #include <string>
 #include <vector>
@@ -51,6 +52,36 @@ bool HasFramePattern(const std::string& name);
 /// Replaces each run of '#' in `pattern` by `frame`, zero-padded to the run's
 /// length (room.####.exr, 7 -> room.0007.exr; longer numbers are not cut).
 std::string ExpandFrame(const std::string& pattern, int frame);
+
+/// --frames for a command whose flags name files: `names(flags, each)` hands
+/// every file name of the flags to `each`. Without --frames, `run(flags)`
+/// once; with it, once per frame, each run of '#' in those names replaced by
+/// the frame number (RunFrames). A bad frame list, or names without any '#',
+/// is a usage error (exit 2) that "dcm CMD: error:" explains.
+template <typename Flags>
+int RunPerFrame(const std::string& cmd, const Flags& flags, const TileFlags& tiles,
+                const std::function<void(Flags*, const std::function<void(std::string*)>&)>& names,
+                const std::function<int(const Flags&)>& run) {
+  std::vector<int> frames;
+  const Status st = FrameList(tiles, &frames);
+  std::string problem = st.ok() ? "" : st.message();
+  if (st.ok() && frames.empty()) return run(flags);
+  if (problem.empty()) {
+    bool any = false;
+    Flags probe = flags;
+    names(&probe, [&](std::string* name) { any = any || HasFramePattern(*name); });
+    if (!any) problem = "--frames " + tiles.frames + ": no '#' frame pattern in the input or output names";
+  }
+  if (!problem.empty()) {
+    std::fprintf(stderr, "dcm %s: error: %s\n", cmd.c_str(), problem.c_str());
+    return 2;  // kExitUsage
+  }
+  return RunFrames(cmd, frames, [&](int frame) {
+    Flags g = flags;
+    names(&g, [frame](std::string* name) { *name = ExpandFrame(*name, frame); });
+    return run(g);
+  });
+}
 
 /// The elementary block in output pixels: the tile alignment (the larger of
 /// the noisy and the noiseless block: whether the samples are noisy is known
