@@ -194,7 +194,7 @@ Registration reg("plan", "Plan the next round of a file-based round trip (pixels
                    app->add_option("--list", f->list, "output text list of the pixels to render ('x y' lines)");
                    app->add_option("--stats", f->stats, "round summary as JSON");
                    AddEngineFlags(app, &f->engine);
-                   AddTileFlags(app, &f->tiles);
+                   AddTileFlags(app, &f->tiles, /*plans=*/true);
                    return [f] { return RunPlanFrames(*f); };
                  });
 

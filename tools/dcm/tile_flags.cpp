@@ -7,11 +7,16 @@
 
 namespace dcm::cli {
 
-void AddTileFlags(CLI::App* app, TileFlags* f) {
-  auto* tile = app->add_option("--tile", f->tile,
-                               "I/N: compute tile I (0-based, as Slurm's --array=0-N-1) of N and write it as a "
-                               "part (the frame's display window, the tile's data window); assemble with dcm merge");
-  app->add_option("--region", f->region, "x,y,w,h: compute this region of the output frame and write it as a part")
+void AddTileFlags(CLI::App* app, TileFlags* f, bool plans) {
+  auto* tile = app->add_option(
+      "--tile", f->tile,
+      plans ? "I/N: plan the pixels tile I (0-based, as Slurm's --array=0-N-1) of N still needs (its window, halo "
+              "included); then dcm reconstruct --tile I/N and dcm merge"
+            : "I/N: compute tile I (0-based, as Slurm's --array=0-N-1) of N and write it as a part (the frame's "
+              "display window, the tile's data window); assemble with dcm merge");
+  app->add_option("--region", f->region,
+                  plans ? "x,y,w,h: plan the pixels this region of the output frame still needs"
+                        : "x,y,w,h: compute this region of the output frame and write it as a part")
       ->excludes(tile);
   app->add_option("--frames", f->frames,
                   "N or A-B: substitute the frame number for each run of '#' in file names (zero-padded to "

@@ -28,8 +28,9 @@ struct TileFlags {
   std::string frames;  ///< "N" or "A-B"
 };
 
-/// Adds --tile, --region (exclusive) and --frames.
-void AddTileFlags(CLI::App* app, TileFlags* flags);
+/// Adds --tile, --region (exclusive) and --frames. `plans`: the command
+/// plans the part's pixels (dcm plan) instead of writing it as a part.
+void AddTileFlags(CLI::App* app, TileFlags* flags, bool plans = false);
 
 /// True when the flags ask for a part of the frame.
 inline bool IsPartial(const TileFlags& f) { return !f.tile.empty() || !f.region.empty(); }
