@@ -460,6 +460,25 @@ namespace {
 
 using Data = AovProvider::Data;
 
+/// Every channel the expressions of `roles` read (of a Cryptomatte layer: its
+/// rank-0 IDs and every coverage channel), for ChannelSet::Want.
+std::vector<std::string> ChannelsOf(const ChannelSet& set, const RoleExprs& roles) {
+  std::vector<std::string> names;
+  for (const auto& e : roles) {
+    if (!e) continue;
+    if (!e->crypto.empty()) {
+      const CryptoLayer* layer = nullptr;
+      if (set.FindCrypto(e->crypto, &layer).ok()) {
+        names.push_back(layer->channel);
+        names.insert(names.end(), layer->coverage.begin(), layer->coverage.end());
+      }
+      continue;
+    }
+    for (const auto& term : e->terms) names.insert(names.end(), term.begin(), term.end());
+  }
+  return names;
+}
+
 Status LoadId(const ChannelSet& set, const Expr& e, std::vector<uint32_t>* ids) {
   if (!e.crypto.empty()) {
     const CryptoLayer* layer = nullptr;
@@ -717,6 +736,21 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
   DCM_RETURN_IF_ERROR(PresetExprs(options.preset, options.viewLayer, guides, /*samples=*/false,
                                   &roles, &d->notes));
   DCM_RETURN_IF_ERROR(ApplyMappings(options.mappings, guides, /*samples=*/false, &roles));
+  {
+    // The channels the guides and, in dense mode, the samples will read:
+    // the file is decoded once for all of them (errors in the sample roles
+    // are reported where they are used, below).
+    std::vector<std::string> wanted = ChannelsOf(guides, roles);
+    RoleExprs sampleRoles;
+    if (!options.sparse &&
+        PresetExprs(options.preset, options.viewLayer, guides, /*samples=*/true, &sampleRoles, nullptr).ok() &&
+        ApplyMappings(options.mappings, guides, /*samples=*/true, &sampleRoles).ok()) {
+      sampleRoles[size_t(Role::kMask)].reset();
+      const auto more = ChannelsOf(guides, sampleRoles);
+      wanted.insert(wanted.end(), more.begin(), more.end());
+    }
+    guides.Want(wanted);
+  }
   const auto& idExpr = roles[size_t(Role::kObjectId)];
   const auto& shaderExpr = roles[size_t(Role::kShaderId)];
   if (idExpr) {
@@ -813,6 +847,7 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
       b.tau = d->tau;
       b.L.assign(n, RGB{});
       if (split) b.Li.assign(n, RGB{}), b.Lc.assign(n, RGB{});
+      second.Want(ChannelsOf(second, roles2));
       Evaluator ev2(second);
       DCM_RETURN_IF_ERROR(ComputeSamples(second, ev2, roles2, split, false, nullptr, &b));
       DCM_RETURN_IF_ERROR(ev2.Report(roles2, {kL, kLi, kLc}, nullptr, &d->warnings));
@@ -879,6 +914,7 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
         DCM_RETURN_IF_ERROR(RgbPresent(sroles, kVar, s, &hasVar));
         if (!hasVar) return Status::Error("samples file " + Quote(path) + ": no variance channels");
       }
+      s.Want(ChannelsOf(s, sroles));
       Evaluator ev(s);
       std::vector<float> maskPlane;
       DCM_RETURN_IF_ERROR(ev.Eval(*sroles[size_t(Role::kMask)], &maskPlane));

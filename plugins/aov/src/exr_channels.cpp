@@ -195,6 +195,16 @@ std::string ChannelSet::Paths() const {
   return s;
 }
 
+void ChannelSet::Want(const std::vector<std::string>& names) {
+  for (const auto& name : names) {
+    const auto ref = Find(name);
+    if (!ref) continue;
+    auto& wanted = wanted_[{ref->file, ref->subimage}];
+    wanted.resize(size_t(files_[size_t(ref->file)].specs[size_t(ref->subimage)].nchannels), 0);
+    wanted[size_t(ref->index)] = 1;
+  }
+}
+
 const std::vector<std::vector<float>>& ChannelSet::OnePass(int file, int subimage) const {
   Pass& p = passes_[{file, subimage}];
   if (p.tried) return p.planes;
@@ -202,23 +212,41 @@ const std::vector<std::vector<float>>& ChannelSet::OnePass(int file, int subimag
   const File& f = files_[size_t(file)];
   const ImageSpec& sp = f.specs[size_t(subimage)];
   const size_t n = pixels();
-  const int channels = sp.nchannels;
-  if (sp.tile_width != 0 || channels < 2 || int64_t(channels) * int64_t(n) * 4 > kOnePassBytes) return p.planes;
-  std::vector<std::vector<float>> planes(size_t(channels), std::vector<float>(n, 0.f));
+  // The channels to keep: the wanted ones, or all of them when none were
+  // named and they fit the budget.
+  std::vector<uint8_t> keep(size_t(sp.nchannels), 1);
+  if (!wanted_.empty()) {
+    const auto it = wanted_.find({file, subimage});
+    if (it == wanted_.end()) return p.planes;
+    keep = it->second;
+  } else if (int64_t(sp.nchannels) * int64_t(n) * 4 > kOnePassBytes) {
+    return p.planes;
+  }
+  int lo = sp.nchannels, hi = -1, kept = 0;
+  for (int c = 0; c < sp.nchannels; ++c)
+    if (keep[size_t(c)]) lo = std::min(lo, c), hi = c, ++kept;
+  if (sp.tile_width != 0 || kept < 2) return p.planes;  // tiled, or nothing to share
+  const int range = hi - lo + 1;
+  std::vector<std::vector<float>> planes(size_t(sp.nchannels));
+  for (int c = lo; c <= hi; ++c)
+    if (keep[size_t(c)]) planes[size_t(c)].assign(n, 0.f);
   // Rows per read: about 8 MiB of float, a multiple of 32 scanlines (the
   // largest EXR scanline block).
-  const size_t rowBytes = size_t(sp.width) * size_t(channels) * 4;
+  const size_t rowBytes = size_t(sp.width) * size_t(range) * 4;
   const int rows = std::max(32, int((size_t(8) << 20) / std::max<size_t>(1, rowBytes)) / 32 * 32);
-  std::vector<float> buffer(size_t(std::min(rows, sp.height)) * size_t(sp.width) * size_t(channels));
+  std::vector<float> buffer(size_t(std::min(rows, sp.height)) * size_t(sp.width) * size_t(range));
   for (int y = 0; y < sp.height; y += rows) {
     const int end = std::min(sp.height, y + rows);
-    if (!f.in->read_scanlines(subimage, 0, sp.y + y, sp.y + end, 0, 0, channels, TypeDesc::FLOAT, buffer.data())) {
+    if (!f.in->read_scanlines(subimage, 0, sp.y + y, sp.y + end, 0, lo, hi + 1, TypeDesc::FLOAT, buffer.data())) {
       (void)f.in->geterror();
       return p.planes;  // empty: the per-channel reads say what is wrong
     }
     const size_t first = size_t(y) * size_t(sp.width), count = size_t(end - y) * size_t(sp.width);
-    for (size_t i = 0; i < count; ++i)
-      for (int c = 0; c < channels; ++c) planes[size_t(c)][first + i] = buffer[i * size_t(channels) + size_t(c)];
+    for (int c = lo; c <= hi; ++c) {
+      if (!keep[size_t(c)]) continue;
+      float* out = planes[size_t(c)].data() + first;
+      for (size_t i = 0; i < count; ++i) out[i] = buffer[i * size_t(range) + size_t(c - lo)];
+    }
   }
   p.planes = std::move(planes);
   return p.planes;

@@ -26,7 +26,8 @@ inline constexpr int kMaxSide = 1 << 17;
 /// pixel, used by the memory guard.
 inline constexpr int kPlanesPerPixel = 24;
 /// A part of a scanline file whose channels take at most this many bytes as
-/// float is read in one pass at its first float read (ChannelSet::ReadFloat).
+/// float is read in one pass at its first float read (ChannelSet::ReadFloat),
+/// when no wanted channels were named (ChannelSet::Want).
 inline constexpr int64_t kOnePassBytes = int64_t(1) << 30;
 
 /// Where a channel lives.
@@ -91,6 +92,10 @@ class ChannelSet {
   /// The files, for messages ("'a.exr'" or "'a.exr', 'b.exr'").
   std::string Paths() const;
 
+  /// Names the channels that will be read as float: the one-pass read of a
+  /// part then decodes and keeps those alone, whatever the part's size.
+  /// Unknown names are ignored.
+  void Want(const std::vector<std::string>& names);
   /// Reads a channel as float (any stored format).
   Status ReadFloat(const std::string& name, std::vector<float>* plane) const;
   /// Reads an ID channel: uint channels as UINT32, float/half channels as
@@ -121,17 +126,21 @@ class ChannelSet {
   /// EXR compresses blocks of scanlines with all their channels together, so
   /// reading one channel at a time decompresses a file once per channel (24
   /// times for a Blender multilayer EXR in dense mode). A part of a scanline
-  /// file whose channels fit in kOnePassBytes is read in one pass instead,
-  /// at its first float read; ReadFloat then takes a channel's plane from it
-  /// (a second read of the channel reads the file again). Empty when
-  /// the part is tiled, too large, or the pass failed (the per-channel read
-  /// then reports the error, naming the channel).
+  /// file is read in one pass instead, at its first float read: the wanted
+  /// channels (Want), or without any every channel when they fit in
+  /// kOnePassBytes. ReadFloat then takes a channel's plane from it (a second
+  /// read of the channel reads the file again). Empty when the part is
+  /// tiled, too large, or the pass failed (the per-channel read then reports
+  /// the error, naming the channel); a plane not read is empty.
   const std::vector<std::vector<float>>& OnePass(int file, int subimage) const;
   struct Pass {
     bool tried = false;
     std::vector<std::vector<float>> planes;  ///< per channel of the part
   };
   mutable std::map<std::pair<int, int>, Pass> passes_;
+  /// Per (file, part): 1 for each channel index named by Want(); empty map:
+  /// nothing named.
+  std::map<std::pair<int, int>, std::vector<uint8_t>> wanted_;
   void ScanCrypto(int file);
 
   ImageWindows windows_;
