@@ -34,13 +34,10 @@ bool NeighbourEstimate(const SampleStore& store, const ContrastTest& contrast, P
   }
   if (n == 0) return false;
   for (int k = 0; k < n; ++k) weight[k] /= total;
-  Value estimate = WeightedSum(used, weight, n);
+  const Value estimate = WeightedSum(used, weight, n);
   if (test)
-    for (int k = 0; k < 8; ++k) {
-      if (!usable[k]) continue;
-      estimate.tau = v[k].tau;  // weighed at the neighbour's tau, as a probe is
-      if (contrast.Differ(v[k], estimate)) return false;
-    }
+    for (int k = 0; k < 8; ++k)
+      if (usable[k] && contrast.Misses(v[k], estimate)) return false;
   *out = estimate;
   return true;
 }

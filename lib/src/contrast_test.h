@@ -39,6 +39,14 @@ class ContrastTest {
     return IsEdge(pair);
   }
 
+  /// True when the exact value of a pixel differs significantly from its
+  /// prediction, both weighed at that pixel's tau (a prediction carries the
+  /// tau of the samples it came from).
+  bool Misses(const Value& exact, Value predicted) const {
+    predicted.tau = exact.tau;
+    return Differ(exact, predicted);
+  }
+
   /// True when noise alone may explain the difference of p and q: it is
   /// within k standard deviations in the luminance of a and (with the split)
   /// of b. Always false for noiseless values or k = 0.

@@ -131,12 +131,6 @@ class Engine {
       store_.Request(p.x, p.y, SampleReason::kCorner);
   }
   Value At(Point2i p) const { return store_.ValueAt(store_.Index(p.x, p.y)); }
-  /// The exact value of a pixel differs significantly from its prediction,
-  /// both weighed at that pixel's tau.
-  bool Misses(const Value& exact, Value predicted) const {
-    predicted.tau = exact.tau;
-    return contrast_.Differ(exact, predicted);
-  }
   bool IsSmooth(const Block& b) const;
   bool HasSurfaceChange(const Block& b) const;
 
@@ -611,7 +605,7 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
         std::vector<uint8_t> split(probe.size());
         ForEach(probe, [&](Block& b, size_t i) {
           split[i] = !store_.IsFinite(store_.Index(b.Centre().x, b.Centre().y)) ||
-                     Misses(At(b.Centre()), Bilinear(store_, b, b.Centre()));
+                     contrast_.Misses(At(b.Centre()), Bilinear(store_, b, b.Centre()));
         });
         for (size_t i = 0; i < probe.size(); ++i) {
           if (split[i]) {
@@ -682,7 +676,7 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
               Resolve(c, &in) != SampleReason::kInterpolated)
             return;
           const Value predicted = Evaluate(store_, in), exact = At(c);
-          if (!store_.IsFinite(store_.Index(c.x, c.y)) || Misses(exact, predicted)) return;
+          if (!store_.IsFinite(store_.Index(c.x, c.y)) || contrast_.Misses(exact, predicted)) return;
           Leaf& leaf = lazy[i];
           leaf = MakeLeaf(b, BlockType::kLazy, e.direction.index);
           leaf.centre = c;
@@ -738,7 +732,7 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
             // A centre on another surface than its interpolants is the thin
             // object test's business, not a miss.
             if (Resolve(c, &in) != SampleReason::kInterpolated) return;
-            fallback[i] = !store_.IsFinite(store_.Index(c.x, c.y)) || Misses(At(c), Evaluate(store_, in));
+            fallback[i] = !store_.IsFinite(store_.Index(c.x, c.y)) || contrast_.Misses(At(c), Evaluate(store_, in));
           });
         }
         for (size_t i = 0; i < eb.size(); ++i) {

@@ -736,17 +736,22 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
   DCM_RETURN_IF_ERROR(PresetExprs(options.preset, options.viewLayer, guides, /*samples=*/false,
                                   &roles, &d->notes));
   DCM_RETURN_IF_ERROR(ApplyMappings(options.mappings, guides, /*samples=*/false, &roles));
+  // Dense mode: the sample roles, read from the same files (an error in
+  // them is reported below, where they are used).
+  RoleExprs sroles;
+  Status sampleRolesStatus;
+  if (!options.sparse) {
+    sampleRolesStatus = PresetExprs(options.preset, options.viewLayer, guides, /*samples=*/true, &sroles, nullptr);
+    sroles[size_t(Role::kMask)].reset();
+    if (sampleRolesStatus.ok())
+      sampleRolesStatus = ApplyMappings(options.mappings, guides, /*samples=*/true, &sroles);
+  }
   {
-    // The channels the guides and, in dense mode, the samples will read:
-    // the file is decoded once for all of them (errors in the sample roles
-    // are reported where they are used, below).
+    // The channels the guides and the samples will read: the file is
+    // decoded once for all of them.
     std::vector<std::string> wanted = ChannelsOf(guides, roles);
-    RoleExprs sampleRoles;
-    if (!options.sparse &&
-        PresetExprs(options.preset, options.viewLayer, guides, /*samples=*/true, &sampleRoles, nullptr).ok() &&
-        ApplyMappings(options.mappings, guides, /*samples=*/true, &sampleRoles).ok()) {
-      sampleRoles[size_t(Role::kMask)].reset();
-      const auto more = ChannelsOf(guides, sampleRoles);
+    if (!options.sparse && sampleRolesStatus.ok()) {
+      const auto more = ChannelsOf(guides, sroles);
       wanted.insert(wanted.end(), more.begin(), more.end());
     }
     guides.Want(wanted);
@@ -800,11 +805,7 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
   // Sample roles.
   bool split = false;
   if (!options.sparse) {
-    RoleExprs sroles;
-    DCM_RETURN_IF_ERROR(PresetExprs(options.preset, options.viewLayer, guides, /*samples=*/true,
-                                    &sroles, nullptr));
-    sroles[size_t(Role::kMask)].reset();
-    DCM_RETURN_IF_ERROR(ApplyMappings(options.mappings, guides, /*samples=*/true, &sroles));
+    DCM_RETURN_IF_ERROR(sampleRolesStatus);
     bool hasLi = false, hasL = false, hasLc = false, hasVar = false;
     DCM_RETURN_IF_ERROR(RgbPresent(sroles, kLi, guides, &hasLi));
     DCM_RETURN_IF_ERROR(RgbPresent(sroles, kL, guides, &hasL));
@@ -893,17 +894,17 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
       if (!(s.windows() == d->windows))
         return Status::Error("inputs of different resolutions or data windows: samples file " + Quote(path) +
                              " is " + s.windows().Text() + ", " + Quote(inputs[0]) + " is " + d->windows.Text());
-      RoleExprs sroles;
-      DCM_RETURN_IF_ERROR(PresetExprs(options.preset, options.viewLayer, s, true, &sroles, nullptr));
-      DCM_RETURN_IF_ERROR(ApplyMappings(options.mappings, s, true, &sroles));
-      if (!sroles[size_t(Role::kMask)])
+      RoleExprs fileRoles;
+      DCM_RETURN_IF_ERROR(PresetExprs(options.preset, options.viewLayer, s, true, &fileRoles, nullptr));
+      DCM_RETURN_IF_ERROR(ApplyMappings(options.mappings, s, true, &fileRoles));
+      if (!fileRoles[size_t(Role::kMask)])
         return Status::Error("samples file " + Quote(path) +
                              ": no mask channel (which pixels were rendered; 'mask' or --map "
                              "mask=CHANNEL); channels: " + s.Describe());
-      DCM_RETURN_IF_ERROR(CheckSampleRoles(sroles, split, hasTau, s, "samples file " + Quote(path)));
+      DCM_RETURN_IF_ERROR(CheckSampleRoles(fileRoles, split, hasTau, s, "samples file " + Quote(path)));
       if (split) {
         bool hasLi = false;
-        DCM_RETURN_IF_ERROR(RgbPresent(sroles, kLi, s, &hasLi));
+        DCM_RETURN_IF_ERROR(RgbPresent(fileRoles, kLi, s, &hasLi));
         if (!hasLi)
           return Status::Error("samples file " + Quote(path) +
                                ": the guides carry tau, so the samples need L_i (Li.R/G/B, or "
@@ -911,17 +912,17 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
       }
       if (variance) {
         bool hasVar = false;
-        DCM_RETURN_IF_ERROR(RgbPresent(sroles, kVar, s, &hasVar));
+        DCM_RETURN_IF_ERROR(RgbPresent(fileRoles, kVar, s, &hasVar));
         if (!hasVar) return Status::Error("samples file " + Quote(path) + ": no variance channels");
       }
-      s.Want(ChannelsOf(s, sroles));
+      s.Want(ChannelsOf(s, fileRoles));
       Evaluator ev(s);
       std::vector<float> maskPlane;
-      DCM_RETURN_IF_ERROR(ev.Eval(*sroles[size_t(Role::kMask)], &maskPlane));
+      DCM_RETURN_IF_ERROR(ev.Eval(*fileRoles[size_t(Role::kMask)], &maskPlane));
       std::vector<uint8_t> mask(n);
       for (size_t i = 0; i < n; ++i) mask[i] = maskPlane[i] > 0.f ? 1 : 0;
-      DCM_RETURN_IF_ERROR(ComputeSamples(s, ev, sroles, split, variance, &mask, d.get()));
-      DCM_RETURN_IF_ERROR(ev.Report(sroles, {kL, kLi, kLc, kVar}, &mask, &d->warnings));
+      DCM_RETURN_IF_ERROR(ComputeSamples(s, ev, fileRoles, split, variance, &mask, d.get()));
+      DCM_RETURN_IF_ERROR(ev.Report(fileRoles, {kL, kLi, kLc, kVar}, &mask, &d->warnings));
       int64_t count = 0;
       for (size_t i = 0; i < n; ++i) {
         count += mask[i];

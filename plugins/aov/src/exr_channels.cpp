@@ -205,7 +205,7 @@ void ChannelSet::Want(const std::vector<std::string>& names) {
   }
 }
 
-const std::vector<std::vector<float>>& ChannelSet::OnePass(int file, int subimage) const {
+std::vector<std::vector<float>>& ChannelSet::OnePass(int file, int subimage) const {
   Pass& p = passes_[{file, subimage}];
   if (p.tried) return p.planes;
   p.tried = true;
@@ -278,8 +278,7 @@ Status ChannelSet::ReadFloat(const std::string& name, std::vector<float>* plane)
   // A plane of the one-pass read is handed over, not copied (a second read
   // of the channel reads it from the file again).
   if (auto ref = Find(name)) {
-    OnePass(ref->file, ref->subimage);
-    auto& planes = passes_[{ref->file, ref->subimage}].planes;
+    auto& planes = OnePass(ref->file, ref->subimage);
     if (size_t(ref->index) < planes.size() && !planes[size_t(ref->index)].empty()) {
       plane->swap(planes[size_t(ref->index)]);
       std::vector<float>().swap(planes[size_t(ref->index)]);

@@ -132,7 +132,7 @@ class ChannelSet {
   /// read of the channel reads the file again). Empty when the part is
   /// tiled, too large, or the pass failed (the per-channel read then reports
   /// the error, naming the channel); a plane not read is empty.
-  const std::vector<std::vector<float>>& OnePass(int file, int subimage) const;
+  std::vector<std::vector<float>>& OnePass(int file, int subimage) const;
   struct Pass {
     bool tried = false;
     std::vector<std::vector<float>> planes;  ///< per channel of the part
