@@ -111,9 +111,9 @@ Status ReconstructionOptions::Validate() const {
   if (simpleSurfaceChanges < 2 || simpleSurfaceChanges > 64)
     return bad("simpleSurfaceChanges", "must be from 2 to 64, got " + std::to_string(simpleSurfaceChanges));
   if (!(probeLcShare >= 0 && probeLcShare <= 1)) return bad("probeLcShare", "must be from 0 to 1");
-  if (neighbourDirections < 0 || 2 * neighbourDirections >= directions)
-    return bad("neighbourDirections", "must be from 0 to (directions - 1) / 2 = " + std::to_string((directions - 1) / 2) +
-                                          ", got " + std::to_string(neighbourDirections));
+  if (neighbourDirections < 0 || neighbourDirections > 32)
+    return bad("neighbourDirections", "must be from 0 to 32 (directions / 2: every direction), got " +
+                                          std::to_string(neighbourDirections));
   if (downsample < 1 || downsample > 64) return bad("downsample", "must be from 1 to 64, got " + std::to_string(downsample));
   if (threads < 0) return bad("threads", "must be >= 0");
   if (tileSize < 1) return bad("tileSize", "must be >= 1");

@@ -151,9 +151,12 @@ class Engine {
   }
   /// For interior pixel q of an oriented leaf that the thin-object test
   /// rejects along the leaf's direction: the interpolant along the nearest
-  /// neighbouring direction that passes it (neighbourDirections each side),
-  /// or kThinObject.
+  /// neighbouring direction that passes it and whose ends agree
+  /// (neighbourDirections each side), or kThinObject.
   SampleReason ResolveAlongNeighbours(const Leaf& leaf, Point2i q, Interpolant* in) const;
+  /// The interpolant's two border points, each on its own, do not differ
+  /// significantly (false when one has no sample).
+  bool EndsAgree(const Interpolant& in) const;
   void WriteSmooth(const Leaf& leaf);
   /// The image as this level knows it, for progressive output: settled leaves,
   /// blocks split further interpolated bilinearly, edge blocks along their
@@ -371,13 +374,31 @@ SampleReason Engine::Resolve(Point2i q, Interpolant* in) const {
   return SampleReason::kInterpolated;
 }
 
+bool Engine::EndsAgree(const Interpolant& in) const {
+  Interpolant end[2];
+  for (int k = 0; k < in.count; ++k) {
+    Interpolant& e = end[in.end[k]];
+    e.index[e.count] = in.index[k], e.weight[e.count++] = in.weight[k];
+  }
+  if (end[0].count == 0 || end[1].count == 0) return false;
+  for (Interpolant& e : end) {
+    double sum = 0;
+    for (int k = 0; k < e.count; ++k) sum += e.weight[k];
+    for (int k = 0; k < e.count; ++k) e.weight[k] /= sum;
+  }
+  return !contrast_.Differ(Evaluate(store_, end[0]), Evaluate(store_, end[1]));
+}
+
 SampleReason Engine::ResolveAlongNeighbours(const Leaf& leaf, Point2i q, Interpolant* in) const {
   const Block& b = leaf.block;
-  for (int step = 1; step <= opt_.neighbourDirections; ++step)
+  const int steps = std::min(opt_.neighbourDirections, opt_.directions / 2);
+  for (int step = 1; step <= steps; ++step)
     for (int sign : {1, -1}) {
+      if (sign < 0 && 2 * step == opt_.directions) continue;  // the perpendicular, tried once
       const int k = Turned(leaf.direction, sign * step);
       Interpolant alt;
-      if (InterpolantAlong(ElementsOf(b, k), b, q, k, &alt) && Resolve(q, &alt) == SampleReason::kInterpolated) {
+      if (InterpolantAlong(ElementsOf(b, k), b, q, k, &alt) && Resolve(q, &alt) == SampleReason::kInterpolated &&
+          EndsAgree(alt)) {
         *in = alt;
         return SampleReason::kInterpolated;
       }

@@ -269,7 +269,7 @@ TEST(CApi, InvalidOptionValuesAreReportedByExecute) {
   EXPECT_NE(m.find("elementaryBlock"), std::string::npos) << m;
   EXPECT_EQ(scene.evaluated.load(), 0);
   dcmSetInt(r, "elementary_block", 8);
-  dcmSetInt(r, "neighbour_directions", 4);  // 8 directions: 3 each side at most
+  dcmSetInt(r, "neighbour_directions", -1);
   EXPECT_EQ(dcmExecute(r), DCM_ERROR_RECONSTRUCTION);
   const std::string n = TakeError(r, &code);
   EXPECT_NE(n.find("neighbourDirections"), std::string::npos) << n;

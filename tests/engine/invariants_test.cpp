@@ -137,15 +137,18 @@ TEST(Invariants, InvalidOptionsNameTheField) {
   const Status s = Reconstruct(p, o, &r);
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("minBlock"), std::string::npos) << s.message();
-  // Four neighbours each side of 8 directions would come round to the
-  // block's own direction from the other side.
+  // A negative count of directions is no count; more than half the
+  // directions is every direction (whatever their number), up to 32.
   ReconstructionOptions turns;
-  turns.neighbourDirections = 4;
+  turns.neighbourDirections = -1;
   const Status t = Reconstruct(p, turns, &r);
   ASSERT_FALSE(t.ok());
   EXPECT_NE(t.message().find("neighbourDirections"), std::string::npos) << t.message();
-  EXPECT_NE(t.message().find("got 4"), std::string::npos) << t.message();
-  turns.neighbourDirections = 3;
+  EXPECT_NE(t.message().find("got -1"), std::string::npos) << t.message();
+  turns.neighbourDirections = 33;
+  EXPECT_FALSE(Reconstruct(p, turns, &r).ok());
+  turns.neighbourDirections = 32;
+  turns.directions = 4;
   EXPECT_TRUE(Reconstruct(p, turns, &r).ok());
   ReconstructionOptions share;
   share.probeLcShare = -0.5f;

@@ -18,8 +18,8 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
   app->add_flag("--no-thin", f->noThin, "switch off the thin-object test (paper 3.1)");
   app->add_option("--thin-test", f->thinTest, "off | none-matches | any-differs | end-differs (default)");
   app->add_option("--neighbour-directions", f->neighbourDirections,
-                  "directions each side of its block's that an interior pixel tries before the thin-object test "
-                  "makes it exact (default 1; paper|guo: 0)");
+                  "directions each side of its block's that an interior pixel tries, where both ends agree, before the "
+                  "thin-object test makes it exact (default 4: every one of 8; paper|guo: 0)");
   app->add_option("--simple-surface-changes", f->simpleSurfaceChanges,
                   "a block of at most twice the finest size whose border changes only at surface changes, up to "
                   "N times, counts as simple (default 8; paper|guo: 2)");

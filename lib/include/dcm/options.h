@@ -92,11 +92,17 @@ struct ReconstructionOptions {
   /// An interior pixel that the thin-object test would make exact first
   /// tries this many neighbouring directions on each side of its block's
   /// (the nearer first, +pi/K before -pi/K) and is interpolated along the
-  /// first one whose border points pass the test. The K directions are
+  /// first one whose border points pass the test and whose two ends agree
+  /// (no significant difference between them: the line crosses no shadow
+  /// or highlight edge on the pixel's surface). The K directions are
   /// quantised: an edge between two of them leaves a pixel beside it whose
   /// line along the block's direction crosses the edge, while the next
-  /// direction stays on its surface. 0: the block's direction only.
-  int neighbourDirections = 1;
+  /// direction stays on its surface; a thin object crossing the block at
+  /// another angle than the block's edge is served along its own direction.
+  /// More than K/2 counts as K/2 (every direction; docs/AOV.md: with the
+  /// agreement, 0.2-0.5 points fewer exact pixels than one each side
+  /// without it, at -0.1 to +0.3 dB). 0: the block's direction only.
+  int neighbourDirections = 4;
   /// An interior pixel interpolates only border samples on its own surface.
   bool surfaceAware = true;
   /// Interpolate (L_i, L_c) and re-apply tau per pixel (paper 3.3).
