@@ -221,13 +221,16 @@ class Engine {
   std::map<std::tuple<int, int, int>, OrientedElements> elements_;
   void PrepareElements(const std::vector<Leaf>& leaves) {
     for (const Leaf& l : leaves)
-      for (int step = -opt_.neighbourDirections; step <= opt_.neighbourDirections; ++step) {
+      for (int step = -NeighbourSteps(); step <= NeighbourSteps(); ++step) {
         const int k = Turned(l.direction, step);
         const auto key = std::tuple(l.block.width(), l.block.height(), k);
         if (!elements_.contains(key))
           elements_.try_emplace(key, l.block.width(), l.block.height(), Direction::Of(k, opt_.directions));
       }
   }
+  /// The neighbouring directions tried each side: neighbourDirections, at
+  /// most K/2 (every direction).
+  int NeighbourSteps() const { return std::min(opt_.neighbourDirections, opt_.directions / 2); }
   /// Direction k turned by `step` directions (modulo the K directions).
   int Turned(int k, int step) const {
     const int K = opt_.directions;
@@ -391,8 +394,7 @@ bool Engine::EndsAgree(const Interpolant& in) const {
 
 SampleReason Engine::ResolveAlongNeighbours(const Leaf& leaf, Point2i q, Interpolant* in) const {
   const Block& b = leaf.block;
-  const int steps = std::min(opt_.neighbourDirections, opt_.directions / 2);
-  for (int step = 1; step <= steps; ++step)
+  for (int step = 1; step <= NeighbourSteps(); ++step)
     for (int sign : {1, -1}) {
       if (sign < 0 && 2 * step == opt_.directions) continue;  // the perpendicular, tried once
       const int k = Turned(leaf.direction, sign * step);
