@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # What accuracy costs on the Cycles room (docs/AOV.md, issue 3): `dcm bench`
-# on each view with its shadow guide, dcm against the paper, Guo and the two
+# on each view with its shadow and highlight guides, dcm against the paper, Guo and the two
 # rivals (uniform grid + bilinear, + joint bilateral) at every threshold,
 # block size and enhancement switch; CSV, summary and plots.
 #
@@ -27,14 +27,16 @@ views=("$@")
 require_tools bench.sh
 command -v oiiotool >/dev/null || { echo "bench.sh: no oiiotool (scripts/install-deps.sh)" >&2; exit 1; }
 
-# guided EXR VIEW RES: the render with its shadow guide appended (one file
-# per scene, as dcm bench takes them).
+# guided EXR VIEW RES: the render with its shadow and highlight guides
+# appended (one file per scene, as dcm bench takes them).
 guided() {
-  local render="$1" view="$2" res="$3" guide="$out/shadow_guide_${2}_${3}.exr" both="$out/guided_${2}_${3}_${SAMPLES}.exr"
+  local render="$1" view="$2" res="$3" shadow="$out/shadow_guide_${2}_${3}.exr"
+  local highlight="$out/highlight_guide_${2}_${3}.exr" all="$out/guided_sh_${2}_${3}_${SAMPLES}.exr"
   render_room "$render" "$view" "$res" "$SAMPLES" 3
-  render_shadow_guide "$guide" "$view" "$res"
-  [ -f "$both" ] || oiiotool "$render" "$guide" --chappend -o "$both"
-  echo "$both"
+  render_shadow_guide "$shadow" "$view" "$res"
+  render_highlight_guide "$highlight" "$view" "$res"
+  [ -f "$all" ] || oiiotool "$render" "$shadow" "$highlight" --chappend --chappend -o "$all"
+  echo "$all"
 }
 
 inputs=()

@@ -42,3 +42,11 @@ render_shadow_guide() {
   [ -f "$1" ] && return 0
   make_and_render "$1" "$2" "$3" --shadow-guide
 }
+
+# render_highlight_guide EXR VIEW RES: where the lights are seen in glossy
+# surfaces (16 samples of direct glossy light, view layer HighlightGuide)
+# unless EXR exists; dcm's blender preset reads it as one more input.
+render_highlight_guide() {
+  [ -f "$1" ] && return 0
+  make_and_render "$1" "$2" "$3" --highlight-guide --samples 16
+}

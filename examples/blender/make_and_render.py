@@ -40,6 +40,9 @@ def parse_args():
     ap.add_argument("--shadow-guide", action="store_true",
                     help="render the sun's shadow guide instead of the AOVs: 1 sample, direct light of the "
                          "sun only on white diffuse materials (view layer 'ShadowGuide', Combined only)")
+    ap.add_argument("--highlight-guide", action="store_true",
+                    help="render the highlight guide instead of the AOVs: direct light only (no bounces), "
+                         "the scene's own materials, --samples samples (view layer 'HighlightGuide', GlossDir)")
     return ap.parse_args(argv)
 
 
@@ -426,6 +429,24 @@ def setup_shadow_guide():
                 pass
 
 
+def setup_highlight_guide():
+    """Where the lights are seen in glossy surfaces: the direct glossy light
+    (GlossDir) of the scene's own materials, so their own roughness decides
+    how sharp a highlight is; no bounces, so it costs a few samples of direct
+    light only (docs/AOV.md)."""
+    sc = bpy.context.scene
+    sc.cycles.max_bounces = 0
+    vl = sc.view_layers[0]
+    vl.name = "HighlightGuide"   # dcm's blender preset takes its GlossDir as the highlight guide
+    for attr in dir(vl):
+        if attr.startswith("use_pass_") and attr not in ("use_pass_combined", "use_pass_glossy_direct"):
+            try:
+                setattr(vl, attr, False)
+            except (AttributeError, TypeError):
+                pass
+    vl.use_pass_glossy_direct = True
+
+
 def main():
     args = parse_args()
     outdir = os.path.dirname(os.path.abspath(args.out))
@@ -435,6 +456,8 @@ def main():
     setup_render(args)
     if args.shadow_guide:
         setup_shadow_guide()
+    if args.highlight_guide:
+        setup_highlight_guide()
     if args.save_blend:
         bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(args.save_blend))
     bpy.ops.render.render(write_still=True)

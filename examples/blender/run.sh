@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Renders the example room with Blender Cycles (only the EXRs that are missing)
-# and its shadow guide (1 sample of the sun's direct light) and runs
-# `dcm reconstruct --preset blender` on each render with its guide.
+# and its guides (the sun's shadow guide: 1 sample of the sun's direct light;
+# the highlight guide: 16 samples of direct glossy light) and runs
+# `dcm reconstruct --preset blender` on each render with its guides.
 #
 #   examples/blender/run.sh [VIEW ...]        views a, b, c (default: all three)
 #
@@ -13,10 +14,10 @@
 #                  final pixel) and reconstruct it with --downsample 2
 #   THREADS=2      Cycles render threads (0: all cores)
 #   DCM_ARGS="..." extra flags for dcm reconstruct (e.g. "--method paper")
-#   GUIDE=1        pass the shadow guide (0: the render alone)
+#   GUIDE=1        pass the guides (0: the render alone)
 #
 # Outputs in examples/blender/out/: room_<view>_<res>.exr (the render),
-# shadow_guide_<view>_<res>.exr, and
+# shadow_guide_<view>_<res>.exr, highlight_guide_<view>_<res>.exr, and
 # room_<view>_<res>/ with dcm.exr, stats.json, sample_map.png, preview.png,
 # error_map.png.
 set -euo pipefail
@@ -51,10 +52,11 @@ print("%-14s %4dx%-4d exact %6.2f %% (%6d of %7d)  PSNR %6.2f dB  relMSE %.6f  S
 EOF
 }
 
-guide() {  # view res: the shadow guide input, or nothing with GUIDE=0
+guide() {  # view res: the guide inputs, or nothing with GUIDE=0
   [ "$GUIDE" = 1 ] || return 0
   render_shadow_guide "$out/shadow_guide_${1}_$2.exr" "$1" "$2"
-  echo "$out/shadow_guide_${1}_$2.exr"
+  render_highlight_guide "$out/highlight_guide_${1}_$2.exr" "$1" "$2"
+  echo "$out/shadow_guide_${1}_$2.exr $out/highlight_guide_${1}_$2.exr"
 }
 
 for v in "${views[@]}"; do

@@ -32,6 +32,7 @@ struct AovFlags {
   std::vector<std::string> samples;
   std::vector<std::string> secondRender;
   bool estimateVariance = false;
+  float highlightLevel = aov::AovOptions{}.highlightLevel;
 };
 
 /// Adds INPUT... and --preset, --map, --texture, --layer, --samples.
@@ -44,7 +45,7 @@ inline void AddAovFlags(CLI::App* app, AovFlags* f, bool samplesHelpForPlan) {
   app->add_option("--preset", f->preset, "channel names: generic (default) or blender (Cycles passes)")
       ->check(CLI::IsMember({"generic", "blender"}));
   app->add_option("--map", f->maps,
-                  "ROLE=CHANNEL: override a role (id, shader, u, v, tau, N, shadow, Li, Lc, L, var, mask or one "
+                  "ROLE=CHANNEL: override a role (id, shader, u, v, tau, N, shadow, highlight, Li, Lc, L, var, mask or one "
                   "component like tau.R); CHANNEL may be A+B, A*B or cryptomatte:LAYER")
       ->allow_extra_args(false);
   app->add_option("--texture", f->textures,
@@ -52,6 +53,9 @@ inline void AddAovFlags(CLI::App* app, AovFlags* f, bool samplesHelpForPlan) {
                   "from a texture file; or MAP.json, an object {\"SHADER\": \"FILE\", ...} (relative files "
                   "from the JSON's folder)")
       ->allow_extra_args(false);
+  app->add_option("--highlight-level", f->highlightLevel,
+                  "highlight guide: a pixel whose guide (R+G+B of direct glossy light with --preset blender) "
+                  "exceeds this is a highlight, a surface of its own (default 1.5)");
   app->add_option("--layer", f->layer, "Blender view layer (default: the only one in the file)");
   app->add_option("--samples", f->samples,
                   samplesHelpForPlan
@@ -111,6 +115,7 @@ inline Status ToAovOptions(const AovFlags& f, bool sparse, bool split, aov::AovO
   o->split = split;
   o->secondRender = f.secondRender;
   o->estimateVariance = f.estimateVariance;
+  o->highlightLevel = f.highlightLevel;
   return Status::Ok();
 }
 

@@ -163,6 +163,7 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
   identity["map"] = f.aov.maps;
   identity["texture"] = f.aov.textures;
   identity["layer"] = f.aov.layer;
+  identity["highlight_level"] = f.aov.highlightLevel;
   identity["alpha"] = f.alpha;
   const nlohmann::json settings = toolkit::PartSettings(cmd, DCM_VERSION, options, identity);
 

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <map>
 #include <optional>
@@ -24,7 +25,7 @@ using detail::Quote;
 namespace {
 
 constexpr std::array<std::string_view, kRoleCount> kRoleNames = {
-    "id",   "shader", "u",    "v",    "tau.R", "tau.G", "tau.B", "N.X",   "N.Y",   "N.Z", "shadow", "Li.R",  "Li.G",  "Li.B",
+    "id",   "shader", "u",    "v",    "tau.R", "tau.G", "tau.B", "N.X",   "N.Y",   "N.Z", "shadow", "highlight", "Li.R",  "Li.G",  "Li.B",
     "Lc.R", "Lc.G",   "Lc.B", "L.R",  "L.G",   "L.B",   "var.R", "var.G", "var.B", "mask"};
 
 constexpr const char* kComp[3] = {"R", "G", "B"};
@@ -106,10 +107,16 @@ Status CheckExpr(Role role, const Expr& e, const ChannelSet& set) {
   return Status::Ok();
 }
 
-/// Blender view layers whose name starts with this hold a light-visibility
-/// guide in their Combined pass (examples/blender/make_and_render.py
-/// --shadow-guide); they are never the layer of the passes.
+/// Blender view layers whose name starts with these hold a guide
+/// (examples/blender/make_and_render.py --shadow-guide, --highlight-guide):
+/// light visibility in their Combined pass, direct glossy light in their
+/// GlossDir pass. They are never the layer of the passes.
 constexpr const char* kShadowGuideLayer = "ShadowGuide";
+constexpr const char* kHighlightGuideLayer = "HighlightGuide";
+
+bool IsGuideLayerChannel(const std::string& name) {
+  return OIIO::Strutil::starts_with(name, kShadowGuideLayer) || OIIO::Strutil::starts_with(name, kHighlightGuideLayer);
+}
 
 /// The Blender view-layer prefix ("ViewLayer." or "") of the passes in `set`.
 Status DetectBlenderLayer(const ChannelSet& set, const std::string& wanted, std::string* prefix,
@@ -122,8 +129,7 @@ Status DetectBlenderLayer(const ChannelSet& set, const std::string& wanted, std:
     for (const char* pass : kPasses) {
       const std::string p(pass);
       if (name == p) bare = true;
-      if (name.size() > p.size() + 1 && OIIO::Strutil::ends_with(name, "." + p) &&
-          !OIIO::Strutil::starts_with(name, kShadowGuideLayer))
+      if (name.size() > p.size() + 1 && OIIO::Strutil::ends_with(name, "." + p) && !IsGuideLayerChannel(name))
         layers.insert(name.substr(0, name.size() - p.size() - 1));
     }
   }
@@ -173,6 +179,7 @@ Status PresetExprs(Preset preset, const std::string& viewLayer, const ChannelSet
       setRgb(kTau, "tau.");
       for (int c = 0; c < 3; ++c) set1(Comp(kNormal, c), std::string("N.") + "XYZ"[c]);
       set1(Role::kShadow, "shadow");
+      set1(Role::kHighlight, "highlight");
     }
     setRgb(kLi, "Li.");
     setRgb(kLc, "Lc.");
@@ -210,17 +217,21 @@ Status PresetExprs(Preset preset, const std::string& viewLayer, const ChannelSet
     set1(Role::kV, p + "UV.V");
     setRgb(kTau, p + "DiffCol.");
     for (int c = 0; c < 3; ++c) set1(Comp(kNormal, c), p + "Normal." + "XYZ"[c]);
-    // The shadow guide: the first ShadowGuide* layer's Combined, R + G + B.
-    for (const auto& name : set.Names()) {
-      if (!OIIO::Strutil::starts_with(name, kShadowGuideLayer) || !OIIO::Strutil::ends_with(name, ".Combined.R"))
-        continue;
-      const std::string base = name.substr(0, name.size() - 1);
-      if (!set.Has(base + "G") || !set.Has(base + "B")) continue;
-      Expr e;
-      e.terms = {{base + "R"}, {base + "G"}, {base + "B"}};
-      (*roles)[size_t(Role::kShadow)] = e;
-      break;
-    }
+    // The guides: the first ShadowGuide* layer's Combined and the first
+    // HighlightGuide* layer's GlossDir, R + G + B each.
+    auto guide = [&](Role r, const char* layer, const std::string& pass) {
+      for (const auto& name : set.Names()) {
+        if (!OIIO::Strutil::starts_with(name, layer) || !OIIO::Strutil::ends_with(name, pass + "R")) continue;
+        const std::string base = name.substr(0, name.size() - 1);
+        if (!set.Has(base + "G") || !set.Has(base + "B")) continue;
+        Expr e;
+        e.terms = {{base + "R"}, {base + "G"}, {base + "B"}};
+        (*roles)[size_t(r)] = e;
+        return;
+      }
+    };
+    guide(Role::kShadow, kShadowGuideLayer, ".Combined.");
+    guide(Role::kHighlight, kHighlightGuideLayer, ".GlossDir.");
   }
   setRgb(kL, p + "Combined.");
   for (int c = 0; c < 3; ++c) {
@@ -499,34 +510,50 @@ std::string IdNote(const ChannelSet& set, const char* what, const Expr& e) {
   return std::string(what) + ": channel " + Quote(e.Text());
 }
 
-/// Folds a light-visibility guide into the IDs, as the tracer's shadow guide
-/// does: a lit pixel (guide > 0) and an unlit one of the same object and
-/// shader become different surfaces, so a hard shadow's edge is a surface
-/// change and a shadow thinner than the lattice is found like a thin object.
-/// Without IDs the guide alone gives them.
-Status FoldShadowGuide(const ChannelSet& set, Evaluator& eval, const Expr& e, Data* d) {
+/// A binary guide folded into the IDs: where its value exceeds `level`, the
+/// IDs are XORed with `bit`, so the pixels above and below the level of one
+/// object and shader become different surfaces. An edge of the guide is then
+/// a surface change, and a region thinner than the lattice is found like a
+/// thin object. Without IDs the guide alone gives them.
+struct FoldedGuide {
+  const char* what;   ///< "shadow guide"
+  float level;        ///< above: the marked side
+  uint32_t bit;       ///< XORed into the IDs of the marked pixels
+  const char* marked; ///< "lit"
+  const char* effect; ///< how the note ends
+};
+
+Status FoldGuide(const FoldedGuide& f, const ChannelSet& set, Evaluator& eval, const Expr& e, Data* d) {
   std::vector<float> g;
   DCM_RETURN_IF_ERROR(eval.Eval(e, &g));
-  size_t lit = 0;
+  size_t marked = 0;
   for (size_t i = 0; i < g.size(); ++i) {
     if (!std::isfinite(g[i]))
-      return Status::Error("shadow guide " + Quote(e.Text()) + " in " + set.Paths() + ": not finite at pixel " +
-                           d->windows.PixelText(i));
-    lit += g[i] > 0.f;
+      return Status::Error(std::string(f.what) + " " + Quote(e.Text()) + " in " + set.Paths() +
+                           ": not finite at pixel " + d->windows.PixelText(i));
+    marked += g[i] > f.level;
   }
-  // A constant far from small IDs and Cryptomatte's float bit patterns'
-  // common values; a collision would only merge two surfaces.
-  constexpr uint32_t kLit = 0x9E3779B9u;
   if (d->objectId.empty()) d->objectId.assign(g.size(), 0u);
   for (size_t i = 0; i < g.size(); ++i)
-    if (g[i] > 0.f) {
-      d->objectId[i] ^= kLit;
-      if (!d->shaderId.empty()) d->shaderId[i] ^= kLit;
+    if (g[i] > f.level) {
+      d->objectId[i] ^= f.bit;
+      if (!d->shaderId.empty()) d->shaderId[i] ^= f.bit;
     }
-  d->notes.push_back("shadow guide: " + e.Text() + " (lit where > 0: " +
-                     std::to_string(int(std::lround(100.0 * double(lit) / double(std::max<size_t>(g.size(), 1))))) +
-                     " % of the pixels; lit and unlit parts of a surface are different surfaces)");
+  const double percent = 100.0 * double(marked) / double(std::max<size_t>(g.size(), 1));
+  char share[32];
+  std::snprintf(share, sizeof share, percent < 1 ? "%.2f" : "%.0f", percent);
+  d->notes.push_back(std::string(f.what) + ": " + e.Text() + " (" + f.marked + " where > " +
+                     OIIO::Strutil::fmt::format("{}", f.level) + ": " + share + " % of the pixels; " + f.effect + ")");
   return Status::Ok();
+}
+
+// Constants far from small IDs and from Cryptomatte's float bit patterns'
+// common values; a collision would only merge two surfaces.
+constexpr FoldedGuide kShadowGuide{"shadow guide", 0.f, 0x9E3779B9u, "lit",
+                                   "lit and unlit parts of a surface are different surfaces"};
+FoldedGuide HighlightGuide(float level) {
+  return {"highlight guide", level, 0x85EBCA6Bu, "a highlight",
+          "a highlight and the rest of its surface are different surfaces"};
 }
 
 /// tau(u, v) from texture files for the bound shaders.
@@ -772,7 +799,7 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
     d->objectId = d->shaderId;
     d->shaderId.clear();
     d->notes.push_back("no object IDs: the shader IDs act as object IDs");
-  } else if (!idExpr && !roles[size_t(Role::kShadow)]) {
+  } else if (!idExpr && !roles[size_t(Role::kShadow)] && !roles[size_t(Role::kHighlight)]) {
     d->notes.push_back("no object or shader IDs: the object and thin-object tests are off (contrast only)");
   } else if (!shaderExpr) {
     d->notes.push_back("no shader IDs: surfaces change where the object ID changes");
@@ -780,7 +807,13 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
 
   Evaluator guideEval(guides);
   if (const auto& shadowExpr = roles[size_t(Role::kShadow)])
-    DCM_RETURN_IF_ERROR(FoldShadowGuide(guides, guideEval, *shadowExpr, d.get()));
+    DCM_RETURN_IF_ERROR(FoldGuide(kShadowGuide, guides, guideEval, *shadowExpr, d.get()));
+  if (const auto& highlightExpr = roles[size_t(Role::kHighlight)]) {
+    if (!(options.highlightLevel >= 0.f) || !std::isfinite(options.highlightLevel))
+      return Status::Error("highlight level " + OIIO::Strutil::fmt::format("{}", options.highlightLevel) +
+                           ": expected a finite value >= 0");
+    DCM_RETURN_IF_ERROR(FoldGuide(HighlightGuide(options.highlightLevel), guides, guideEval, *highlightExpr, d.get()));
+  }
   bool hasTau = false;
   DCM_RETURN_IF_ERROR(RgbPresent(roles, kTau, guides, &hasTau));
   if (hasTau) {

@@ -34,6 +34,7 @@ enum class Role : int {
   kTauR, kTauG, kTauB,  ///< "tau.R/G/B": texture value
   kNX, kNY, kNZ,        ///< "N.X/Y/Z": surface normal (creases inside one object)
   kShadow,    ///< "shadow": light-visibility guide, > 0 where the light reaches the surface
+  kHighlight, ///< "highlight": direct glossy light, a highlight where > AovOptions::highlightLevel
   kLiR, kLiG, kLiB,     ///< "Li.R/G/B": radiance before texturing
   kLcR, kLcG, kLcB,     ///< "Lc.R/G/B": radiance not modulated by the texture
   kLR, kLG, kLB,        ///< "L.R/G/B": beauty radiance
@@ -51,7 +52,7 @@ Status ParseRole(std::string_view name, Role* role);
 
 /// Where the channel names come from.
 enum class Preset {
-  /// Plain names: id, shader, u, v, tau.R/G/B, N.X/Y/Z, shadow, Li.R/G/B,
+  /// Plain names: id, shader, u, v, tau.R/G/B, N.X/Y/Z, shadow, highlight, Li.R/G/B,
   /// Lc.R/G/B, beauty R/G/B, var.R/G/B, mask.
   kGeneric,
   /// Blender Cycles multilayer EXR: <layer>.IndexOB.X, IndexMA.X (or the
@@ -59,7 +60,8 @@ enum class Preset {
   /// L_i = DiffDir + DiffInd, L = Combined, L_c = L - L_i*tau (so that
   /// L_i*tau + L_c = Combined; without Combined, L_c is the sum of the
   /// Gloss, Trans, Volume, Emit and Env contributions). The Combined of a
-  /// view layer named ShadowGuide* is the shadow guide (R + G + B).
+  /// view layer named ShadowGuide* is the shadow guide (R + G + B); the
+  /// GlossDir of one named HighlightGuide* is the highlight guide (R + G + B).
   kBlender,
 };
 Status ParsePreset(std::string_view name, Preset* preset);
@@ -104,6 +106,12 @@ struct AovOptions {
   /// (A - B)^2 / 4, averaged over a 5x5 window of pixels on the same surface
   /// (one pixel's difference alone is one degree of freedom).
   std::vector<std::string> secondRender;
+  /// A pixel whose highlight guide (the value of the `highlight` role; with
+  /// the Blender preset R + G + B of the guide's direct glossy light) exceeds
+  /// this is a highlight: highlight and other pixels of one surface become
+  /// different surfaces. 1.5 is R + G + B of a mean of 0.5, a highlight as
+  /// bright as mid-grey on the display (docs/AOV.md, session 8).
+  float highlightLevel = 1.5f;
   /// Dense mode, one noisy render and no variance channel: the variance is
   /// estimated from the data, as the mean over a 5x5 window on the same
   /// surface of r^2 / 1.25, r = the pixel minus the mean of its same-surface
