@@ -137,8 +137,9 @@ class Engine {
   /// Resolves the interpolant of interior pixel q against the surfaces and the
   /// finite samples. Returns the reason q must be exact, or kInterpolated.
   SampleReason Resolve(Point2i q, Interpolant* in) const;
-  /// With the split: L_c is below probeLcShare of L at every finite pixel of
-  /// the border, which the centre probe then need not search for a highlight.
+  /// With the split: L_c is at most probeLcShare of L at every finite pixel
+  /// of the border, which the centre probe then need not search for a
+  /// highlight or a reflection.
   bool LooksDiffuse(std::span<const Point2i> border) const {
     if (!split_ || !(opt_.probeLcShare > 0)) return false;
     for (Point2i p : border) {
@@ -148,6 +149,13 @@ class Engine {
       if (!(lc <= opt_.probeLcShare * l)) return false;
     }
     return true;
+  }
+  /// The finest edge block's centre is probed: its border shows a
+  /// significant change that no surface change explains (a shading edge of
+  /// unknown shape), or glossy light that may hide a highlight or a
+  /// reflection (not LooksDiffuse).
+  bool ProbeWanted(const EdgeBlock& e) const {
+    return int(e.crossings.size()) > SurfaceChanges(store_, e.border) || !LooksDiffuse(e.border);
   }
   /// For interior pixel q of an oriented leaf that the thin-object test
   /// rejects along the leaf's direction: the interpolant along the nearest
@@ -741,7 +749,7 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
         ForEach(eb, [&](EdgeBlock& e, size_t i) {
           fallback[i] = opt_.fallback && int(e.crossings.size()) > opt_.fallbackMaxChanges;
           e.probe = !fallback[i] && opt_.fallback && opt_.finestCentreProbe && e.block.HasInterior() &&
-                    (!e.crossings.empty() || !LooksDiffuse(e.border));
+                    ProbeWanted(e);
           if (e.probe) store_.Request(e.block.Centre().x, e.block.Centre().y, SampleReason::kCentreProbe);
         });
         if (opt_.fallback && opt_.finestCentreProbe) {

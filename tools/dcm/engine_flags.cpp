@@ -37,8 +37,9 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
                 "first-order test: evaluate the inner pixels at every crossing, also where the guides show the "
                 "surfaces meeting");
   app->add_option("--probe-lc-share", f->probeLcShare,
-                  "with the texture split: no centre probe where the border is unchanging and L_c is below this "
-                  "share of L on all of it (default 0.02; 0: probe every finest edge block)");
+                  "with the texture split: a finest edge block whose border changes only at surface changes is "
+                  "probed only where L_c exceeds this share of L at some border pixel (default 0.5; 0: probe every "
+                  "finest edge block)");
   app->add_flag("--no-checkerboard", f->noCheckerboard,
                 "evaluate every pixel the thin-object test or a fallback wants exact, instead of one colour of a "
                 "checkerboard first and the other only where its exact neighbours disagree");

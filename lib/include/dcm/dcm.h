@@ -159,9 +159,10 @@ DCM_API void dcmSetString(DCMReconstructor r, const char* name, const char* valu
 DCM_API void dcmSetInt(DCMReconstructor r, const char* name, int value);
 
 /** Sets a float option: "contrast_threshold", "noise_significance" (with a
- *  provider that reports variance), "probe_lc_share" (no centre probe where
- *  a finest edge block's border is unchanging and its L_c below this share
- *  of L, default 0.02). Integer options accept whole
+ *  provider that reports variance), "probe_lc_share" (a finest edge block
+ *  whose border changes only at surface changes is probed only where L_c
+ *  exceeds this share of L at some border pixel, default 0.5). Integer
+ *  options accept whole
  *  numbers here too. */
 DCM_API void dcmSetFloat(DCMReconstructor r, const char* name, float value);
 
