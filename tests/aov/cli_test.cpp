@@ -441,6 +441,22 @@ std::vector<BadCase> BadCases() {
        {},
        {"in.exr", "channel 'id'", "non-integer ID 1.25"}},
       {"AbsurdDimensions", [](const ScratchDir& d) { MakeHugeExr(d / "in.exr", 100000); }, {}, {"in.exr", "100000x100000"}},
+      {"NegativeHighlightLevel",
+       [sc](const ScratchDir& d) {
+         auto ch = sc.GenericChannels(false);
+         ch.push_back(Fill("highlight", 16, 16, [](int x, int) { return x < 8 ? 3.f : 0.f; }));
+         WriteExr(d / "in.exr", 16, 16, ch);
+       },
+       {"--highlight-level", "-1"},
+       {"highlight level -1", ">= 0"}},
+      {"NonFiniteHighlightGuide",
+       [sc](const ScratchDir& d) {
+         auto ch = sc.GenericChannels(false);
+         ch.push_back(Fill("highlight", 16, 16, [](int x, int y) { return x == 3 && y == 4 ? NAN : 0.f; }));
+         WriteExr(d / "in.exr", 16, 16, ch);
+       },
+       {},
+       {"highlight guide 'highlight'", "in.exr", "(3, 4)"}},
       {"BadSamplesFile",
        [sc](const ScratchDir& d) {
          WriteExr(d / "in.exr", 16, 16, sc.GenericChannels(false, true));

@@ -449,53 +449,40 @@ TEST(AovProvider, BlenderViewLayers) {
   EXPECT_THAT(st.message(), HasSubstr("no Blender view layer 'Side'"));
 }
 
-TEST(AovProvider, BlenderShadowGuideLayer) {
+TEST(AovProvider, BlenderGuideLayers) {
   // A ShadowGuide view layer (examples/blender/make_and_render.py
-  // --shadow-guide) is taken as the shadow guide, R + G + B, and is not a
-  // candidate for the layer of the passes.
-  ScratchDir dir;
-  auto ch = BlenderChannels("ViewLayer", 8, 8, true);
-  for (const char* c : {"R", "G", "B", "A"})
-    ch.push_back(Fill(std::string("ShadowGuide.Combined.") + c, 8, 8, [](int x, int) { return x < 4 ? 1.f : 0.f; }));
-  WriteExr(dir / "room.exr", 8, 8, ch);
-  AovOptions o;
-  o.preset = Preset::kBlender;
-  auto p = MustOpen({dir / "room.exr"}, o);
-  ASSERT_TRUE(p);
-  bool said = false;
-  for (const auto& n : p->Notes())
-    said |= n.find("shadow guide: ShadowGuide.Combined.R+ShadowGuide.Combined.G+ShadowGuide.Combined.B") !=
-            std::string::npos;
-  EXPECT_TRUE(said);
-  GuideRequest req;
-  req.objectId = true;
-  const GuideImage g = AllGuides(*p, req);
-  EXPECT_NE(g.objectId[3], g.objectId[4]);  // same IndexOB (x < 5), lit and unlit
-}
-
-TEST(AovProvider, BlenderHighlightGuideLayer) {
-  // A HighlightGuide view layer (make_and_render.py --highlight-guide) is
-  // taken as the highlight guide, GlossDir R + G + B, and is not a candidate
-  // for the layer of the passes although it has a GlossDir pass.
-  ScratchDir dir;
-  auto ch = BlenderChannels("ViewLayer", 8, 8, true);
-  for (const char* c : {"R", "G", "B"})
-    ch.push_back(Fill(std::string("HighlightGuide.GlossDir.") + c, 8, 8, [](int x, int) { return x < 4 ? 1.f : 0.1f; }));
-  WriteExr(dir / "room.exr", 8, 8, ch);
-  AovOptions o;
-  o.preset = Preset::kBlender;
-  auto p = MustOpen({dir / "room.exr"}, o);
-  ASSERT_TRUE(p);
-  bool said = false;
-  for (const auto& n : p->Notes())
-    said |= n.find("highlight guide: HighlightGuide.GlossDir.R+HighlightGuide.GlossDir.G+HighlightGuide.GlossDir.B") !=
-            std::string::npos;
-  EXPECT_TRUE(said);
-  GuideRequest req;
-  req.objectId = true;
-  const GuideImage g = AllGuides(*p, req);
-  EXPECT_NE(g.objectId[3], g.objectId[4]);  // same IndexOB, R + G + B 3 > 1.5 and 0.3
-  EXPECT_EQ(g.objectId[0], g.objectId[3]);
+  // --shadow-guide) is taken as the shadow guide, its Combined R + G + B
+  // (lit where > 0); a HighlightGuide one (--highlight-guide) as the
+  // highlight guide, its GlossDir R + G + B (a highlight where > 1.5).
+  // Neither is a candidate for the layer of the passes, although the
+  // highlight guide has a GlossDir pass as the passes' layer does.
+  struct Layer {
+    std::string pass;   // "ShadowGuide.Combined."
+    std::string note;   // what the notes say
+    float marked, rest; // per channel, left (x < 4) and right
+  };
+  for (const Layer& l : {Layer{"ShadowGuide.Combined.", "shadow guide: ", 1.f, 0.f},
+                         Layer{"HighlightGuide.GlossDir.", "highlight guide: ", 1.f, 0.1f}}) {
+    SCOPED_TRACE(l.pass);
+    ScratchDir dir;
+    auto ch = BlenderChannels("ViewLayer", 8, 8, true);
+    for (const char* c : {"R", "G", "B"})
+      ch.push_back(Fill(l.pass + c, 8, 8, [&](int x, int) { return x < 4 ? l.marked : l.rest; }));
+    WriteExr(dir / "room.exr", 8, 8, ch);
+    AovOptions o;
+    o.preset = Preset::kBlender;
+    auto p = MustOpen({dir / "room.exr"}, o);
+    ASSERT_TRUE(p);
+    bool said = false;
+    for (const auto& n : p->Notes())
+      said |= n.find(l.note + l.pass + "R+" + l.pass + "G+" + l.pass + "B") != std::string::npos;
+    EXPECT_TRUE(said);
+    GuideRequest req;
+    req.objectId = true;
+    const GuideImage g = AllGuides(*p, req);
+    EXPECT_NE(g.objectId[3], g.objectId[4]);  // same IndexOB (x < 5), marked and not
+    EXPECT_EQ(g.objectId[0], g.objectId[3]);
+  }
 }
 
 TEST(AovProvider, MapOverrides) {
