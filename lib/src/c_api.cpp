@@ -160,6 +160,7 @@ constexpr IntOption kIntOptions[] = {
     {"min_block", &Options::minBlock},
     {"directions", &Options::directions},
     {"fallback_max_changes", &Options::fallbackMaxChanges},
+    {"fallback_shading_changes", &Options::fallbackShadingChanges},
     {"simple_surface_changes", &Options::simpleSurfaceChanges},
     {"neighbour_directions", &Options::neighbourDirections},
     {"downsample", &Options::downsample},

@@ -38,6 +38,7 @@ ReconstructionOptions ReconstructionOptions::Paper() {
   o.textureSplit = true;
   o.fallback = true;  // "switching back to a full sampling for these few critical cases"
   o.fallbackMaxChanges = 4;  // more than two edges: more than two objects on the border
+  o.fallbackShadingChanges = -1;  // every change counts
   return o;
 }
 
@@ -108,6 +109,9 @@ Status ReconstructionOptions::Validate() const {
   if (!(noiseSignificance >= 0) || !std::isfinite(noiseSignificance))
     return bad("noiseSignificance", "must be a finite number >= 0");
   if (fallbackMaxChanges < 0) return bad("fallbackMaxChanges", "must be >= 0");
+  if (fallbackShadingChanges < -1)
+    return bad("fallbackShadingChanges", "must be >= -1 (-1: every change counts), got " +
+                                             std::to_string(fallbackShadingChanges));
   if (simpleSurfaceChanges < 2 || simpleSurfaceChanges > 64)
     return bad("simpleSurfaceChanges", "must be from 2 to 64, got " + std::to_string(simpleSurfaceChanges));
   if (!(probeLcShare >= 0 && probeLcShare <= 1)) return bad("probeLcShare", "must be from 0 to 1");

@@ -747,7 +747,9 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
         // interpolation that misses the block's centre: evaluate it all.
         std::vector<uint8_t> fallback(eb.size(), 0);
         ForEach(eb, [&](EdgeBlock& e, size_t i) {
-          fallback[i] = opt_.fallback && int(e.crossings.size()) > opt_.fallbackMaxChanges;
+          fallback[i] = opt_.fallback && int(e.crossings.size()) > opt_.fallbackMaxChanges &&
+                        (opt_.fallbackShadingChanges < 0 ||
+                         int(e.crossings.size()) - SurfaceChanges(store_, e.border) > opt_.fallbackShadingChanges);
           e.probe = !fallback[i] && opt_.fallback && opt_.finestCentreProbe && e.block.HasInterior() &&
                     ProbeWanted(e);
           if (e.probe) store_.Request(e.block.Centre().x, e.block.Centre().y, SampleReason::kCentreProbe);

@@ -161,6 +161,12 @@ TEST(Invariants, InvalidOptionsNameTheField) {
   ASSERT_FALSE(v.ok());
   EXPECT_NE(v.message().find("simpleSurfaceChanges"), std::string::npos) << v.message();
   EXPECT_NE(v.message().find("got 1"), std::string::npos) << v.message();
+  ReconstructionOptions shading;
+  shading.fallbackShadingChanges = -2;  // -1 is "every change counts"; below it means nothing
+  const Status w = Reconstruct(p, shading, &r);
+  ASSERT_FALSE(w.ok());
+  EXPECT_NE(w.message().find("fallbackShadingChanges"), std::string::npos) << w.message();
+  EXPECT_NE(w.message().find("got -2"), std::string::npos) << w.message();
 }
 
 }  // namespace

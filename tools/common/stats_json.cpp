@@ -46,6 +46,7 @@ nlohmann::json OptionsToJson(const ReconstructionOptions& o) {
   j["lazy_evaluation"] = o.lazyEvaluation;
   j["fallback"] = o.fallback;
   j["fallback_max_changes"] = o.fallbackMaxChanges;
+  j["fallback_shading_changes"] = o.fallbackShadingChanges;
   j["simple_surface_changes"] = o.simpleSurfaceChanges;
   j["neighbour_directions"] = o.neighbourDirections;
   j["fallback_filled_borders"] = o.fallbackFilledBorders;

@@ -23,6 +23,9 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
   app->add_option("--simple-surface-changes", f->simpleSurfaceChanges,
                   "a block of at most twice the finest size whose border changes only at surface changes, up to "
                   "N times, counts as simple (default 8; paper|guo: 2)");
+  app->add_option("--fallback-shading-changes", f->fallbackShadingChanges,
+                  "a finest block with more than 6 border changes is evaluated only when more than N of them are "
+                  "no surface change (default 2: one shading edge; -1, paper: every such block)");
   app->add_flag("--no-texture-split", f->noTextureSplit, "interpolate L instead of (L_i, L_c) (paper 3.3)");
   app->add_option("--object-test", f->objectTest, "none | id | id+shader (paper 3.2) | id|shader");
   app->add_option("--contrast", f->contrast, "mitchell | display");
@@ -72,6 +75,7 @@ Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {
   if (f.noThin) o->thinObjects = ThinObjectTest::kOff;
   if (!f.thinTest.empty()) DCM_RETURN_IF_ERROR(Parse(f.thinTest, &o->thinObjects));
   if (f.neighbourDirections >= 0) o->neighbourDirections = f.neighbourDirections;
+  if (f.fallbackShadingChanges >= -1) o->fallbackShadingChanges = f.fallbackShadingChanges;
   if (f.simpleSurfaceChanges) o->simpleSurfaceChanges = f.simpleSurfaceChanges;
   if (f.noTextureSplit) o->textureSplit = false;
   if (!f.objectTest.empty()) DCM_RETURN_IF_ERROR(Parse(f.objectTest, &o->objectTest));

@@ -148,11 +148,14 @@ DCM_API void dcmSetString(DCMReconstructor r, const char* name, const char* valu
 
 /** Sets an integer option: "elementary_block", "noisy_elementary_block" (the
  *  elementary block with noisy samples, default 8; 0: elementary_block),
- *  "min_block", "directions", "fallback_max_changes", "simple_surface_changes"
+ *  "min_block", "directions", "fallback_max_changes",
+ *  "fallback_shading_changes" (a finest block over fallback_max_changes
+ *  falls back only when more than this many of its changes are no surface
+ *  change, default 2; -1: every such block), "simple_surface_changes"
  *  (a block of at most twice the finest size whose border changes only at
  *  surface changes, up to this many, counts as simple; 2: Guo's test),
  *  "neighbour_directions" (directions each side an interior pixel tries
- *  before the thin-object test makes it exact, default 1), "downsample",
+ *  before the thin-object test makes it exact, default 4), "downsample",
  *  "threads" (0: all cores),
  *  "tile_size", "batch_size" (pixels per callback call). Bool options accept
  *  0/1 here too. Ranges are checked by dcmExecute(). */

@@ -159,6 +159,17 @@ struct ReconstructionOptions {
   /// points of exact pixels for 0.01-0.5 dB (docs/AOV.md), less than the
   /// same samples buy as a lower threshold.
   int fallbackMaxChanges = 6;
+  /// A finest block over fallbackMaxChanges falls back only when more than
+  /// this many of its border's changes are no surface change. A surface
+  /// change is served by the surface-aware interpolation (each interior
+  /// pixel reads border samples of its own surface, and the thin-object
+  /// test evaluates those that have none); two changes are one shading edge,
+  /// which the block's direction serves. On the Cycles views (chair slats,
+  /// spindles and legs in one block) 2 saves 0.3-0.7 points at 1x for
+  /// 0.4-0.9 dB and 0.2 points at 4x for 0.1 dB or less (docs/AOV.md,
+  /// session 8). -1: every block over fallbackMaxChanges falls back (the
+  /// paper).
+  int fallbackShadingChanges = 2;
   /// With adaptive borders, a fallback block also evaluates the border
   /// pixels that the bisection filled (its ends agreed). Off: the fills are
   /// trusted, as the neighbouring blocks that share the side trust them
