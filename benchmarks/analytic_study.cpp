@@ -36,7 +36,7 @@ int main(int argc, char** argv) {
   std::printf("| method | threshold | exact %% | PSNR dB | corner | border | probes | lazy | thin | fallback |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
   for (const auto& [name, base] : methods)
-    for (float t : {0.03f, 0.06f, 0.1f, 0.12f, 0.15f, 0.25f}) {
+    for (float t : {0.03f, 0.06f, 0.1f, 0.12f, 0.14f, 0.15f, 0.25f}) {
       testing::AnalyticProvider provider(n, n, testing::FurnishedScene(n, n));
       ReconstructionOptions o = base;
       o.contrastThreshold = t;

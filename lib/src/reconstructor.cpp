@@ -203,7 +203,9 @@ class Engine {
   /// Asks for (x, y) exactly, or defers it to ResolveDeferred when the
   /// checkerboard refinement holds it back.
   void RequestOrDefer(int x, int y, SampleReason reason) {
-    if (opt_.checkerboard && !EvaluatedFirst(x, y)) deferred_[size_t(store_.Index(x, y))] = reason;
+    const int64_t i = store_.Index(x, y);
+    if (store_.IsExact(i)) return;  // a probe inside a fallback block, say
+    if (opt_.checkerboard && !EvaluatedFirst(x, y)) deferred_[size_t(i)] = reason;
     else store_.Request(x, y, reason);
   }
   bool IsDeferred(int64_t i) const { return !deferred_.empty() && deferred_[size_t(i)] != SampleReason::kInterpolated; }

@@ -97,14 +97,15 @@ TEST(ReconstructionQuality, PureNoiseFallsBackToTheFullRender) {
   EXPECT_GT(r.stats.exactPixels, r.stats.totalPixels * 99 / 100);
   EXPECT_EQ(r.stats.exactPixels + r.stats.checkerboardFilled, r.stats.totalPixels);
   // Adaptive borders fill gaps whose ends agree; in noise two samples agree
-  // by chance (at threshold 0.12, about one pair in six), so some blocks
-  // escape both detectors (changes along the border, centre probe), and
-  // fallback blocks trust the filled pixels of their borders. Measured:
-  // 72.5 % exact with the defaults.
+  // by chance (at threshold 0.12, about one pair in six; more often at the
+  // default 0.14), so some blocks escape both detectors (changes along the
+  // border, centre probe), and fallback blocks trust the filled pixels of
+  // their borders. Measured: 72.5 % exact at threshold 0.12, 67.7 % at 0.14
+  // (the default); at least 65 % asked.
   AnalyticProvider provider2(N, N, Noise(7));
   r = ReconstructOrFail(provider2, ReconstructionOptions{});
   std::printf("noise: %.2f %% exact with the defaults\n", 100 * r.stats.exactFraction());
-  EXPECT_GT(r.stats.exactFraction(), 0.7);
+  EXPECT_GT(r.stats.exactFraction(), 0.65);
 }
 
 TEST(ReconstructionQuality, FallbackBlocksTrustTheFilledPixelsOfTheirBorders) {

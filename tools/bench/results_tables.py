@@ -14,8 +14,8 @@ import re
 import sys
 
 SCENES = ["room", "room-paper", "cactus", "parquet", "mirror"]
-THRESHOLDS = ["0.015", "0.03", "0.06", "0.1", "0.12", "0.15", "0.25", "0.5"]
-DEFAULT = "0.12"  # dcm's default contrast threshold (ReconstructionOptions)
+THRESHOLDS = ["0.015", "0.03", "0.06", "0.1", "0.12", "0.14", "0.15", "0.25", "0.5"]
+DEFAULT = "0.14"  # dcm's default contrast threshold (ReconstructionOptions)
 
 
 def rows(results, scene):
