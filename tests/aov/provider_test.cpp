@@ -188,6 +188,22 @@ TEST(AovProvider, ShadowGuideSplitsLitAndUnlitSurfaces) {
   EXPECT_THAT(st.message(), HasSubstr("(3, 5)"));
 }
 
+/// The mean |G - value| over the pixels of an n x n input where `where`
+/// holds, reconstructed with the engine's defaults.
+template <typename Pred>
+double MeanGreenError(const std::string& file, const AovOptions& o, int n, Pred where, float value) {
+  auto p = MustOpen({file}, o);
+  Reconstruction r;
+  const Status st = Reconstruct(*p, ReconstructionOptions{}, &r);
+  EXPECT_TRUE(st.ok()) << st.message();
+  double sum = 0;
+  int count = 0;
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x)
+      if (where(x, y)) sum += std::fabs(r.image[size_t(y * n + x)].g - value), ++count;
+  return sum / count;
+}
+
 TEST(AovProvider, ShadowGuideFindsShadowsThinnerThanTheLattice) {
   // A lit floor (0.8, one object, one shader) crossed by three thin hard
   // shadows (0.15) of legs, 1-2 pixels wide, as the sun casts on a Cycles
@@ -211,19 +227,8 @@ TEST(AovProvider, ShadowGuideFindsShadowsThinnerThanTheLattice) {
   WriteExr(dir / "blind.exr", n, n, ch);
   ch.push_back(Fill("shadow", n, n, [&](int x, int y) { return inShadow(x, y) ? 0.f : 1.f; }));
   WriteExr(dir / "guided.exr", n, n, ch);
-  auto shadowError = [&](const std::string& file) {
-    auto p = MustOpen({file});
-    Reconstruction r;
-    const Status st = Reconstruct(*p, ReconstructionOptions{}, &r);
-    EXPECT_TRUE(st.ok()) << st.message();
-    double sum = 0;
-    int count = 0;
-    for (int y = 0; y < n; ++y)
-      for (int x = 0; x < n; ++x)
-        if (inShadow(x, y)) sum += std::fabs(r.image[size_t(y * n + x)].g - 0.15f), ++count;
-    return sum / count;
-  };
-  const double blind = shadowError(dir / "blind.exr"), guided = shadowError(dir / "guided.exr");
+  const double blind = MeanGreenError(dir / "blind.exr", {}, n, inShadow, 0.15f);
+  const double guided = MeanGreenError(dir / "guided.exr", {}, n, inShadow, 0.15f);
   EXPECT_LT(guided * 10, blind) << "guided " << guided << ", blind " << blind;
 }
 
@@ -255,16 +260,7 @@ TEST(AovProvider, HighlightGuideFindsHighlightsSmallerThanTheLattice) {
   auto highlightError = [&](const std::string& file, float level) {
     AovOptions o;
     o.highlightLevel = level;
-    auto p = MustOpen({file}, o);
-    Reconstruction r;
-    const Status st = Reconstruct(*p, ReconstructionOptions{}, &r);
-    EXPECT_TRUE(st.ok()) << st.message();
-    double sum = 0;
-    int count = 0;
-    for (int y = 0; y < n; ++y)
-      for (int x = 0; x < n; ++x)
-        if (inHighlight(x, y)) sum += std::fabs(r.image[size_t(y * n + x)].g - 3.f), ++count;
-    return sum / count;
+    return MeanGreenError(file, o, n, inHighlight, 3.f);
   };
   const double blind = highlightError(dir / "blind.exr", 1.5f);
   const double guided = highlightError(dir / "guided.exr", 1.5f);
