@@ -150,12 +150,12 @@ class Engine {
     }
     return true;
   }
-  /// The finest edge block's centre is probed: its border shows a
-  /// significant change that no surface change explains (a shading edge of
-  /// unknown shape), or glossy light that may hide a highlight or a
-  /// reflection (not LooksDiffuse).
-  bool ProbeWanted(const EdgeBlock& e) const {
-    return int(e.crossings.size()) > SurfaceChanges(store_, e.border) || !LooksDiffuse(e.border);
+  /// The finest edge block's centre is probed: its border shows
+  /// `shadingChanges` > 0 significant changes that no surface change
+  /// explains (a shading edge of unknown shape), or glossy light that may
+  /// hide a highlight or a reflection (not LooksDiffuse).
+  bool ProbeWanted(const EdgeBlock& e, int shadingChanges) const {
+    return shadingChanges > 0 || !LooksDiffuse(e.border);
   }
   /// For interior pixel q of an oriented leaf that the thin-object test
   /// rejects along the leaf's direction: the interpolant along the nearest
@@ -749,11 +749,12 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
         // interpolation that misses the block's centre: evaluate it all.
         std::vector<uint8_t> fallback(eb.size(), 0);
         ForEach(eb, [&](EdgeBlock& e, size_t i) {
+          // The changes no surface change explains: shading edges.
+          const int shading = int(e.crossings.size()) - SurfaceChanges(store_, e.border);
           fallback[i] = opt_.fallback && int(e.crossings.size()) > opt_.fallbackMaxChanges &&
-                        (opt_.fallbackShadingChanges < 0 ||
-                         int(e.crossings.size()) - SurfaceChanges(store_, e.border) > opt_.fallbackShadingChanges);
+                        (opt_.fallbackShadingChanges < 0 || shading > opt_.fallbackShadingChanges);
           e.probe = !fallback[i] && opt_.fallback && opt_.finestCentreProbe && e.block.HasInterior() &&
-                    ProbeWanted(e);
+                    ProbeWanted(e, shading);
           if (e.probe) store_.Request(e.block.Centre().x, e.block.Centre().y, SampleReason::kCentreProbe);
         });
         if (opt_.fallback && opt_.finestCentreProbe) {
