@@ -226,8 +226,15 @@ TEST_P(PlanRoundTrip, SameImageAsDenseBitForBit) {
   const bool split = GetParam();
   ScratchDir dir;
   Scene sc{72, 56};  // not a multiple of the 64-pixel tile: clipped tiles too
-  WriteExr(dir / "dense.exr", sc.width, sc.height, sc.GenericChannels(split));
-  WriteExr(dir / "guides.exr", sc.width, sc.height, sc.GenericChannels(split, /*guidesOnly=*/true));
+  // Both files carry a highlight guide (a 3x2 highlight between the lattice
+  // lines): plan reads it from the guides as reconstruct does.
+  const TestChannel highlight =
+      Fill("highlight", sc.width, sc.height, [](int x, int y) { return x >= 21 && x <= 23 && y >= 9 && y <= 10 ? 3.f : 0.f; });
+  auto denseChannels = sc.GenericChannels(split), guideChannels = sc.GenericChannels(split, /*guidesOnly=*/true);
+  denseChannels.push_back(highlight);
+  guideChannels.push_back(highlight);
+  WriteExr(dir / "dense.exr", sc.width, sc.height, denseChannels);
+  WriteExr(dir / "guides.exr", sc.width, sc.height, guideChannels);
   const std::vector<std::string> engine = {"--threads", "2", "--quiet"};
   auto dense = engine;
   dense.insert(dense.begin(), {"reconstruct", dir / "dense.exr", "-o", dir / "dense_out.exr", "--stats", dir / "dense.json"});
