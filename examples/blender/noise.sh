@@ -6,7 +6,7 @@
 #   examples/blender/noise.sh [VIEW]            view a, b or c (default a)
 #
 # Environment: DCM, BLENDER, THREADS as for run.sh; SPP=64 (the noisy
-# renders), REF_SPP=2048 (the converged reference, about 10-20 min on 2 cores).
+# renders), REF_SPP=2048 (the converged reference: 116 s of Cycles for view a on 2 cores).
 # Renders only the EXRs that are missing (examples/blender/out/noise_*.exr).
 set -euo pipefail
 
