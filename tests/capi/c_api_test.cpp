@@ -97,9 +97,11 @@ TEST(CApi, MethodPresetsResetEveryOption) {
   // The published methods (Guo 1998; Scheel et al. 2001).
   EXPECT_EQ(dcmGetBool(r, "checkerboard"), 1);
   EXPECT_GT(dcmGetInt(r, "simple_surface_changes"), 2);
+  EXPECT_GE(dcmGetInt(r, "fallback_shading_changes"), 0);
   dcmSetString(r, "method", "paper");
   EXPECT_EQ(dcmGetBool(r, "checkerboard"), 0);
   EXPECT_EQ(dcmGetInt(r, "simple_surface_changes"), 2);
+  EXPECT_EQ(dcmGetInt(r, "fallback_shading_changes"), -1);  // every change counts
   EXPECT_EQ(dcmGetBool(r, "surface_aware"), 0);
   EXPECT_EQ(dcmGetBool(r, "texture_split"), 1);
   EXPECT_EQ(dcmGetBool(r, "fallback"), 1);
