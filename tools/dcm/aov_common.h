@@ -16,9 +16,12 @@
 
 #include "commands.h"
 #include "common/progress.h"
+#include "common/tiles.h"
 #include "dcm/aov/aov_provider.h"
 #include "dcm/reconstructor.h"
+#include "dcm/window_provider.h"
 #include "engine_flags.h"
+#include "tile_flags.h"
 
 namespace dcm::cli::aov_common {
 
@@ -140,12 +143,34 @@ inline Status OpenProvider(const std::string& cmd, const AovFlags& flags, const 
   return Status::Ok();
 }
 
-/// Runs the engine with progress on stderr.
+/// --tile / --region: the region of the output frame (and the tile's name,
+/// and the frame's size when `frame` is given) that the AOV `inputs`
+/// ("inputs" or "guides") are cut into; parts are cut from the whole frame,
+/// so the inputs must hold it. An error is a usage error.
+inline Status ResolvePart(const aov::AovProvider& provider, const TileFlags& tiles,
+                          const ReconstructionOptions& options, const std::string& inputs, Bounds2i* region,
+                          std::string* tile, Point2i* frame = nullptr) {
+  if (!(provider.DataWindow() == provider.DisplayWindow()))
+    return Status::Error("--tile and --region need " + inputs +
+                         " whose data window is their display window (the whole frame); these are " +
+                         toolkit::RegionText(provider.DataWindow()) + " of " +
+                         toolkit::RegionText(provider.DisplayWindow()));
+  const ProviderCapabilities caps = provider.Capabilities();
+  const Point2i size = OutputSize(caps.width, caps.height, options.downsample);
+  if (frame) *frame = size;
+  return ResolveRegion(tiles, size.x, size.y, TileAlignment(options), region, tile);
+}
+
+/// Runs the engine with progress on stderr: on the whole frame, or with
+/// `region` on that part of the output frame (ReconstructRegion, which
+/// fills `info`).
 inline Status Run(aov::AovProvider& provider, ReconstructionOptions options, const EngineFlags& engine,
-                  Reconstruction* result, std::vector<Point2i>* pending) {
+                  Reconstruction* result, std::vector<Point2i>* pending, const Bounds2i* region = nullptr,
+                  RegionInfo* info = nullptr) {
   toolkit::Progress progress(!engine.quiet);
   options.progress = [&progress](float f, std::string_view stage) { progress.Update(f, stage); };
-  Status st = Reconstruct(provider, options, result, pending);
+  Status st = region ? ReconstructRegion(provider, options, *region, result, info, pending)
+                     : Reconstruct(provider, options, result, pending);
   progress.Done();
   return st;
 }

@@ -95,25 +95,13 @@ int RunPlan(const PlanFlags& f) {
   Reconstruction r;
   std::vector<Point2i> pending;
   std::string tile;
+  Bounds2i region;
   RegionInfo info;
   if (IsPartial(f.tiles)) {
-    // As `dcm reconstruct --tile`: parts are cut from the whole frame.
-    if (!(provider->DataWindow() == provider->DisplayWindow()))
-      return aov_common::Fail(cmd, "--tile and --region need guides whose data window is their display window (the "
-                                   "whole frame); these are " + toolkit::RegionText(provider->DataWindow()) + " of " +
-                                   toolkit::RegionText(provider->DisplayWindow()), kExitUsage);
-    const ProviderCapabilities caps = provider->Capabilities();
-    const Point2i frame = OutputSize(caps.width, caps.height, options.downsample);
-    Bounds2i region;
-    st = ResolveRegion(f.tiles, frame.x, frame.y, TileAlignment(options), &region, &tile);
+    st = aov_common::ResolvePart(*provider, f.tiles, options, "guides", &region, &tile);
     if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
-    toolkit::Progress progress(!f.engine.quiet);
-    options.progress = [&progress](float v, std::string_view stage) { progress.Update(v, stage); };
-    st = ReconstructRegion(*provider, options, region, &r, &info, &pending);
-    progress.Done();
-  } else {
-    st = aov_common::Run(*provider, options, f.engine, &r, &pending);
   }
+  st = aov_common::Run(*provider, options, f.engine, &r, &pending, IsPartial(f.tiles) ? &region : nullptr, &info);
   if (!st.ok() && !st.pending()) return aov_common::Fail(cmd, st.message());
   const bool done = st.ok();
   std::vector<Point2i> next;

@@ -134,15 +134,10 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
   if (!f.reference.empty() || !f.errorMap.empty())
     return aov_common::Fail(cmd, "--reference and --error-map need the whole frame; not with --tile or --region "
                                  "(compare the merged frame)", kExitUsage);
-  if (!(provider.DataWindow() == provider.DisplayWindow()))
-    return aov_common::Fail(cmd, "--tile and --region need inputs whose data window is their display window (the "
-                                 "whole frame); these are " + toolkit::RegionText(provider.DataWindow()) + " of " +
-                                 toolkit::RegionText(provider.DisplayWindow()), kExitUsage);
-  const ProviderCapabilities caps = provider.Capabilities();
-  const Point2i frame = OutputSize(caps.width, caps.height, options.downsample);
   Bounds2i region;
   std::string tile;
-  Status st = ResolveRegion(f.tiles, frame.x, frame.y, TileAlignment(options), &region, &tile);
+  Point2i frame;
+  Status st = aov_common::ResolvePart(provider, f.tiles, options, "inputs", &region, &tile, &frame);
   if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
 
   // What decides the pixels besides the options: the input files by content
@@ -167,15 +162,12 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
   identity["alpha"] = f.alpha;
   const nlohmann::json settings = toolkit::PartSettings(cmd, DCM_VERSION, options, identity);
 
-  toolkit::Progress progress(!f.engine.quiet);
-  options.progress = [&progress](float v, std::string_view stage) { progress.Update(v, stage); };
   Reconstruction r;
   RegionInfo info;
   std::vector<Point2i> pending;
   const auto t0 = std::chrono::steady_clock::now();
-  st = ReconstructRegion(provider, options, region, &r, &info, &pending);
+  st = aov_common::Run(provider, options, f.engine, &r, &pending, &region, &info);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  progress.Done();
   if (st.pending()) {
     return FailMissingSamples(provider, pending, " for this part");
   }

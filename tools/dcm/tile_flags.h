@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "commands.h"
 #include "common/image_io.h"
 #include "dcm/geometry.h"
 #include "dcm/reconstructor.h"
@@ -75,7 +76,7 @@ int RunPerFrame(const std::string& cmd, const Flags& flags, const TileFlags& til
   }
   if (!problem.empty()) {
     std::fprintf(stderr, "dcm %s: error: %s\n", cmd.c_str(), problem.c_str());
-    return 2;  // kExitUsage
+    return kExitUsage;
   }
   return RunFrames(cmd, frames, [&](int frame) {
     Flags g = flags;
