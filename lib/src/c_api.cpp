@@ -163,6 +163,7 @@ constexpr IntOption kIntOptions[] = {
     {"fallback_shading_changes", &Options::fallbackShadingChanges},
     {"simple_surface_changes", &Options::simpleSurfaceChanges},
     {"neighbour_directions", &Options::neighbourDirections},
+    {"crossing_fill_reach", &Options::crossingFillReach},
     {"downsample", &Options::downsample},
     {"threads", &Options::threads},
     {"tile_size", &Options::tileSize},
@@ -170,6 +171,7 @@ constexpr IntOption kIntOptions[] = {
 };
 constexpr FloatOption kFloatOptions[] = {
     {"contrast_threshold", &Options::contrastThreshold},
+    {"contrast_threshold_supersampled", &Options::contrastThresholdSupersampled},
     {"noise_significance", &Options::noiseSignificance},
     {"probe_lc_share", &Options::probeLcShare},
     {"crease_angle", &Options::creaseAngle},
@@ -415,6 +417,8 @@ DCM_API void dcmSetString(DCMReconstructor r, const char* name, const char* valu
       st = dcm::Parse(v, &r->options.objectTest);
     } else if (n == "thin_objects") {
       st = dcm::Parse(v, &r->options.thinObjects);
+    } else if (n == "thin_objects_supersampled") {
+      st = dcm::Parse(v, &r->options.thinObjectsSupersampled);
     } else if (n == "contrast_metric") {
       st = dcm::Parse(v, &r->options.contrastMetric);
     } else if (n == "smooth_refinement") {

@@ -11,14 +11,15 @@ ReconstructionOptions ReconstructionOptions::Guo() {
   ReconstructionOptions o;
   o.elementaryBlock = 8;  // Guo's and the paper's elementary blocks
   o.noisyElementaryBlock = 0;
-  o.contrastThreshold = 0.06f;
+  o.SetContrastThreshold(0.06f);
   o.objectTest = ObjectTest::kObjectId;
-  o.thinObjects = ThinObjectTest::kOff;
+  o.thinObjects = o.thinObjectsSupersampled = ThinObjectTest::kOff;
   o.neighbourDirections = 0;
   o.surfaceAware = false;
   o.textureSplit = false;
   o.smoothRefinement = SmoothRefinement::kAlways;
   o.adaptiveBorders = false;
+  o.crossingFillReach = 0;
   o.finestCentreProbe = false;
   o.gradientBlocksSimple = false;
   o.firstOrderFromGuides = false;
@@ -34,7 +35,7 @@ ReconstructionOptions ReconstructionOptions::Guo() {
 ReconstructionOptions ReconstructionOptions::Paper() {
   ReconstructionOptions o = Guo();
   o.objectTest = ObjectTest::kObjectAndShader;
-  o.thinObjects = ThinObjectTest::kNoneMatches;
+  o.thinObjects = o.thinObjectsSupersampled = ThinObjectTest::kNoneMatches;
   o.textureSplit = true;
   o.fallback = true;  // "switching back to a full sampling for these few critical cases"
   o.fallbackMaxChanges = 4;  // more than two edges: more than two objects on the border
@@ -104,6 +105,8 @@ Status ReconstructionOptions::Validate() const {
                                "), got " + std::to_string(minBlock));
   if (!(contrastThreshold >= 0) || !std::isfinite(contrastThreshold))
     return bad("contrastThreshold", "must be a finite number >= 0");
+  if (!(contrastThresholdSupersampled >= 0) || !std::isfinite(contrastThresholdSupersampled))
+    return bad("contrastThresholdSupersampled", "must be a finite number >= 0");
   if (directions < 1 || directions > 64) return bad("directions", "must be from 1 to 64, got " + std::to_string(directions));
   if (!(creaseAngle >= 0 && creaseAngle <= 180)) return bad("creaseAngle", "must be from 0 to 180 degrees");
   if (!(noiseSignificance >= 0) || !std::isfinite(noiseSignificance))
@@ -118,6 +121,8 @@ Status ReconstructionOptions::Validate() const {
   if (neighbourDirections < 0 || neighbourDirections > 32)
     return bad("neighbourDirections", "must be from 0 to 32 (directions / 2: every direction), got " +
                                           std::to_string(neighbourDirections));
+  if (crossingFillReach < 0 || crossingFillReach > 256)
+    return bad("crossingFillReach", "must be from 0 to 256, got " + std::to_string(crossingFillReach));
   if (downsample < 1 || downsample > 64) return bad("downsample", "must be from 1 to 64, got " + std::to_string(downsample));
   if (threads < 0) return bad("threads", "must be >= 0");
   if (tileSize < 1) return bad("tileSize", "must be >= 1");

@@ -10,6 +10,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -99,8 +100,10 @@ class Engine {
         split_(split),
         noisy_(NoisySamples(opt, caps)),
         block_(ElementaryBlock(opt, caps)),
+        thinTest_(opt.ThinObjectsFor(opt.downsample)),
+        crossingFillReach_(opt.downsample >= 2 ? opt.crossingFillReach : 0),
         store_(caps.width, caps.height, split, noisy_),
-        contrast_(opt.contrastMetric, opt.contrastThreshold, split, noisy_ ? opt.noiseSignificance : 0.f) {
+        contrast_(opt.contrastMetric, opt.ContrastThresholdFor(opt.downsample), split, noisy_ ? opt.noiseSignificance : 0.f) {
     const int blocksPerTile = std::max(1, opt.tileSize / std::max(1, block_));
     grain_ = size_t(blocksPerTile) * size_t(blocksPerTile);
     request_.split = split;
@@ -125,7 +128,7 @@ class Engine {
   }
 
   Status LoadGuides();
-  Status EvaluateBordersAdaptively(const std::vector<Block>& edges);
+  Status EvaluateBordersAdaptively(const std::vector<Block>& edges, bool finest);
   void RequestCorners(const Block& b) {
     for (Point2i p : {Point2i{b.x0, b.y0}, Point2i{b.x1, b.y0}, Point2i{b.x0, b.y1}, Point2i{b.x1, b.y1}})
       store_.Request(p.x, p.y, SampleReason::kCorner);
@@ -188,6 +191,8 @@ class Engine {
   bool split_;
   bool noisy_;  ///< samples carry their variance and the tests weigh it
   int block_;   ///< the elementary block (ReconstructionOptions::ElementaryBlockFor)
+  ThinObjectTest thinTest_;  ///< ReconstructionOptions::ThinObjectsFor the supersampling
+  int crossingFillReach_;    ///< ReconstructionOptions::crossingFillReach, 0 at final resolution
   SampleStore store_;
   ContrastTest contrast_;
   SampleRequest request_;
@@ -359,7 +364,7 @@ SampleReason Engine::Resolve(Point2i q, Interpolant* in) const {
     }
   }
   const bool anySame = sameAt[0] + sameAt[1] > 0, anyOther = otherAt[0] + otherAt[1] > 0;
-  switch (opt_.thinObjects) {
+  switch (thinTest_) {
     case ThinObjectTest::kOff: break;
     case ThinObjectTest::kNoneMatches:
       if (!anySame && s.enabled()) return SampleReason::kThinObject;
@@ -501,7 +506,7 @@ void Engine::WritePreview(int level, std::vector<Block>& splitSmooth, std::vecto
   opt_.onLevel(level, store_.width(), store_.height(), store_.radiance());
 }
 
-Status Engine::EvaluateBordersAdaptively(const std::vector<Block>& edges) {
+Status Engine::EvaluateBordersAdaptively(const std::vector<Block>& edges, bool finest) {
   // The sides of all edge blocks of this level, each once: blocks of one level
   // sit on one lattice, so two sides are equal or share at most an end. A side
   // is a pure function of its own samples, whichever block it borders.
@@ -532,14 +537,74 @@ Status Engine::EvaluateBordersAdaptively(const std::vector<Block>& edges) {
   auto index = [&](const Side& s, int k) { return store_.Index(s.a.x + k * s.step.x, s.a.y + k * s.step.y); };
   const SurfaceTest& surf = store_.surfaces();
 
+  // Interleaved crossings (ReconstructionOptions::crossingFillReach): the
+  // sides on the lattice lines this level adds, between two lines of the
+  // level above, defer the pixels at their surface changes.
+  const bool interleave = finest && crossingFillReach_ > 0;
+  auto interleaved = [&](const Side& s) {
+    const int across = s.step.y ? s.a.x : s.a.y;
+    return interleave && across % (2 * s.length) == s.length;
+  };
+  std::vector<std::vector<int>> deferred(interleave ? sides.size() : 0);  // positions along the side
+
   // Round 0: the ends, and both pixels of every surface change.
-  ForEach(sides, [&](Side& s, size_t) {
+  ForEach(sides, [&](Side& s, size_t si) {
     for (int k = 0; k <= s.length; k += s.length) store_.Request(s.a.x + k * s.step.x, s.a.y + k * s.step.y, SampleReason::kBorder);
+    const bool defer = interleaved(s);
     for (int k = 0; k < s.length; ++k)
       if (!surf.SameAdjacent(index(s, k), index(s, k + 1)))
-        for (int j : {k, k + 1}) store_.Request(s.a.x + j * s.step.x, s.a.y + j * s.step.y, SampleReason::kBorder);
+        for (int j : {k, k + 1}) {
+          if (defer && j > 0 && j < s.length) deferred[si].push_back(j);
+          else store_.Request(s.a.x + j * s.step.x, s.a.y + j * s.step.y, SampleReason::kBorder);
+        }
   });
   DCM_RETURN_IF_ERROR(Flush());
+  // A deferred pixel on surface S takes the mean of the nearest exact pixels
+  // of S on the two neighbouring lines when both exist and agree, and is
+  // evaluated otherwise. Those lines are sides of the level above (exact at
+  // their surface changes), and the search stays inside the two blocks the
+  // side borders: both children of one parent, so a window of the frame on
+  // the lattice decides as the whole frame does.
+  std::vector<uint8_t> crossingFilled(interleave ? size_t(store_.width()) * size_t(store_.height()) : 0);
+  if (interleave) {
+    std::atomic<int64_t> filled{0};
+    ForEach(sides, [&](Side& s, size_t si) {
+      const Point2i across{s.step.y, s.step.x};
+      for (int j : deferred[si]) {
+        const int64_t ij = index(s, j);
+        if (store_.IsExact(ij)) continue;
+        int64_t nearest[2] = {-1, -1};
+        for (int n = 0; n < 2; ++n) {
+          const int sign = n ? 1 : -1;
+          const Point2i line{s.a.x + sign * s.length * across.x, s.a.y + sign * s.length * across.y};
+          // Beside the last, narrower blocks of a row or column the line
+          // lies outside the image.
+          if (line.x < 0 || line.y < 0 || line.x >= store_.width() || line.y >= store_.height()) continue;
+          for (int d = 0; d <= crossingFillReach_ && nearest[n] < 0; ++d)
+            for (int k : {j - d, j + d}) {
+              if (k < 0 || k > s.length) continue;
+              const int64_t ik = store_.Index(line.x + k * s.step.x, line.y + k * s.step.y);
+              if (store_.IsExact(ik) && store_.IsFinite(ik) && surf.Same(ik, ij)) {
+                nearest[n] = ik;
+                break;
+              }
+            }
+        }
+        if (nearest[0] >= 0 && nearest[1] >= 0 &&
+            !contrast_.Differ(store_.ValueAt(nearest[0]), store_.ValueAt(nearest[1]))) {
+          store_.SetFilled(ij, Lerp(store_.ValueAt(nearest[0]), store_.ValueAt(nearest[1]), 0.5f));
+          crossingFilled[size_t(ij)] = 1;
+          ++filled;
+        } else {
+          store_.Request(s.a.x + j * s.step.x, s.a.y + j * s.step.y, SampleReason::kBorder);
+        }
+      }
+    });
+    stats_.crossingsFilled += filled;
+    DCM_RETURN_IF_ERROR(Flush());
+  }
+  // The pixels bisection and the fill start from: exact, or filled crossings.
+  auto known = [&](int64_t i) { return store_.IsExact(i) || (interleave && crossingFilled[size_t(i)]); };
   // Bisect every gap whose known ends differ, until none is left. A side
   // that asked for nothing in a round has nothing new in the next (sides
   // share only their ends, exact since round 0): only the others are read.
@@ -550,7 +615,7 @@ Status Engine::EvaluateBordersAdaptively(const std::vector<Block>& edges) {
       active[i] = 0;
       int last = 0;
       for (int k = 1; k <= s.length; ++k) {
-        if (!store_.IsExact(index(s, k))) continue;
+        if (!known(index(s, k))) continue;
         const bool usable = store_.IsFinite(index(s, last)) && store_.IsFinite(index(s, k));
         if (k > last + 1 &&
             (!usable || contrast_.Differ(store_.ValueAt(index(s, last)), store_.ValueAt(index(s, k))))) {
@@ -568,7 +633,7 @@ Status Engine::EvaluateBordersAdaptively(const std::vector<Block>& edges) {
   ForEach(sides, [&](Side& s, size_t) {
     int last = 0;
     for (int k = 1; k <= s.length; ++k) {
-      if (!store_.IsExact(index(s, k))) continue;
+      if (!known(index(s, k))) continue;
       const int64_t i0 = index(s, last), i1 = index(s, k);
       const Value v0 = store_.ValueAt(i0), v1 = store_.ValueAt(i1);
       for (int j = last + 1; j < k; ++j) {
@@ -659,7 +724,7 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
         if (!opt_.adaptiveBorders)
           for (Point2i p : eb[i].border) store_.Request(p.x, p.y, SampleReason::kBorder);
       });
-      if (opt_.adaptiveBorders) DCM_RETURN_IF_ERROR(EvaluateBordersAdaptively(edges));
+      if (opt_.adaptiveBorders) DCM_RETURN_IF_ERROR(EvaluateBordersAdaptively(edges, finest));
       DCM_RETURN_IF_ERROR(Flush());
       PrepareBorderPairs(eb);
       ForEach(eb, [&](EdgeBlock& e, size_t) {

@@ -144,6 +144,36 @@ TEST(DcmReconstruct, DownsampleComparesAtOutputResolution) {
   EXPECT_LT(double(s["reference"]["rmse"]), 1e-6);
 }
 
+// The stats record the settings in effect: supersampled input has its own
+// threshold, thin-object test and crossing fill (dcm/options.h), and the
+// flags set them at every supersampling.
+TEST(DcmReconstruct, SupersampledInputHasItsOwnDefaults) {
+  ScratchDir dir;
+  Scene sc{64, 64};
+  WriteExr(dir / "in.exr", 64, 64, sc.GenericChannels(false));
+  auto options = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = {"reconstruct", dir / "in.exr", "-o", dir / "out.exr", "--stats", dir / "s.json",
+                                      "--quiet"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const auto r = RunDcm(args, dir);
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    return ReadJson(dir / "s.json")["options"];
+  };
+  const ReconstructionOptions defaults;
+  const auto final1 = options({});
+  EXPECT_FLOAT_EQ(float(final1["contrast_threshold"]), defaults.contrastThreshold);
+  EXPECT_EQ(final1["thin_objects"], std::string(ToString(defaults.thinObjects)));
+  EXPECT_EQ(final1["crossing_fill_reach"], 0) << "off at final resolution";
+  const auto x2 = options({"--downsample", "2"});
+  EXPECT_FLOAT_EQ(float(x2["contrast_threshold"]), defaults.contrastThresholdSupersampled);
+  EXPECT_EQ(x2["thin_objects"], std::string(ToString(defaults.thinObjectsSupersampled)));
+  EXPECT_EQ(x2["crossing_fill_reach"], defaults.crossingFillReach);
+  const auto set = options({"--downsample", "2", "--threshold", "0.1", "--thin-test", "any-differs", "--crossing-fill", "0"});
+  EXPECT_FLOAT_EQ(float(set["contrast_threshold"]), 0.1f);
+  EXPECT_EQ(set["thin_objects"], "any-differs");
+  EXPECT_EQ(set["crossing_fill_reach"], 0);
+}
+
 TEST(DcmReconstruct, VerboseSaysWhichTestsAreOff) {
   ScratchDir dir;
   Scene sc{16, 16};

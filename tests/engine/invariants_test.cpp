@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 
 #include "run_helpers.h"
 
@@ -167,6 +168,18 @@ TEST(Invariants, InvalidOptionsNameTheField) {
   ASSERT_FALSE(w.ok());
   EXPECT_NE(w.message().find("fallbackShadingChanges"), std::string::npos) << w.message();
   EXPECT_NE(w.message().find("got -2"), std::string::npos) << w.message();
+  ReconstructionOptions reach;
+  reach.crossingFillReach = -1;
+  const Status x = Reconstruct(p, reach, &r);
+  ASSERT_FALSE(x.ok());
+  EXPECT_NE(x.message().find("crossingFillReach"), std::string::npos) << x.message();
+  EXPECT_NE(x.message().find("got -1"), std::string::npos) << x.message();
+  // Checked at every supersampling, whichever threshold the run uses.
+  ReconstructionOptions supersampled;
+  supersampled.contrastThresholdSupersampled = std::numeric_limits<float>::quiet_NaN();
+  const Status y = Reconstruct(p, supersampled, &r);
+  ASSERT_FALSE(y.ok());
+  EXPECT_NE(y.message().find("contrastThresholdSupersampled"), std::string::npos) << y.message();
 }
 
 }  // namespace

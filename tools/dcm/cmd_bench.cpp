@@ -203,8 +203,8 @@ struct Enhancement {
   void (*on)(ReconstructionOptions*);
 };
 const Enhancement kEnhancements[] = {
-    {"thinObjects", [](ReconstructionOptions* o) { o->thinObjects = ThinObjectTest::kOff; },
-     [](ReconstructionOptions* o) { o->thinObjects = ThinObjectTest::kNoneMatches; }},
+    {"thinObjects", [](ReconstructionOptions* o) { o->thinObjects = o->thinObjectsSupersampled = ThinObjectTest::kOff; },
+     [](ReconstructionOptions* o) { o->thinObjects = o->thinObjectsSupersampled = ThinObjectTest::kNoneMatches; }},
     {"neighbourDirections", [](ReconstructionOptions* o) { o->neighbourDirections = 0; },
      [](ReconstructionOptions* o) { o->neighbourDirections = ReconstructionOptions{}.neighbourDirections; }},
     {"objectTest", [](ReconstructionOptions* o) { o->objectTest = ObjectTest::kObjectId; },
@@ -213,6 +213,8 @@ const Enhancement kEnhancements[] = {
      [](ReconstructionOptions* o) { o->textureSplit = true; }},
     {"adaptiveBorders", [](ReconstructionOptions* o) { o->adaptiveBorders = false; },
      [](ReconstructionOptions* o) { o->adaptiveBorders = true; }},
+    {"crossingFill", [](ReconstructionOptions* o) { o->crossingFillReach = 0; },
+     [](ReconstructionOptions* o) { o->crossingFillReach = ReconstructionOptions{}.crossingFillReach; }},
     {"smoothRefinement", [](ReconstructionOptions* o) { o->smoothRefinement = SmoothRefinement::kAlways; },
      [](ReconstructionOptions* o) { o->smoothRefinement = SmoothRefinement::kCentreProbe; }},
     {"finestCentreProbe", [](ReconstructionOptions* o) { o->finestCentreProbe = false; },
@@ -248,9 +250,10 @@ nlohmann::json AllOptionsJson(const ReconstructionOptions& o) {
 }
 std::string OptionsKey(const ReconstructionOptions& o) { return AllOptionsJson(o).dump(); }
 
-/// The label of a method's point at its default settings ("dcm t=0.15").
-std::string DefaultLabel(const std::string& method) {
-  return method + " t=" + Fmt("%g", double(MethodOptions(method).contrastThreshold));
+/// The label of a method's point at its default settings ("dcm t=0.14") for
+/// this much supersampling.
+std::string DefaultLabel(const std::string& method, int supersampling) {
+  return method + " t=" + Fmt("%g", double(MethodOptions(method).ContrastThresholdFor(supersampling)));
 }
 
 /// The DCM-family points of the sweep, deduplicated (a point that belongs to
@@ -291,12 +294,12 @@ std::vector<Config> SweepConfigs(const BenchFlags& f, const Subject& s) {
   for (const char* m : {"dcm", "paper", "guo"}) {
     // The method's default threshold is always part of its sweep.
     std::vector<float> ts = thresholds;
-    const float def = MethodOptions(m).contrastThreshold;
+    const float def = MethodOptions(m).ContrastThresholdFor(s.defaultSs);
     if (std::find(ts.begin(), ts.end(), def) == ts.end()) ts.push_back(def);
     std::sort(ts.begin(), ts.end());
     for (float t : ts) {
       Config c = base(m);
-      c.options.contrastThreshold = t;
+      c.options.SetContrastThreshold(t);
       c.label = std::string(m) + " t=" + Fmt("%g", t);
       c.sweeps = "threshold";
       add(c);
@@ -435,13 +438,13 @@ std::string PointToCsv(const Point& p) {
   s << CsvQuote(p.scene) << ',' << CsvQuote(p.input) << ',' << p.config.method << ',' << CsvQuote(p.config.label)
     << ',' << p.config.sweeps << ',';
   if (engine) {
-    s << CsvNum(o.contrastThreshold) << ',' << o.elementaryBlock << ',' << o.minBlock << ',';
+    s << CsvNum(o.ContrastThresholdFor(p.config.supersampling)) << ',' << o.elementaryBlock << ',' << o.minBlock << ',';
   } else {
     s << ",,,";
   }
   s << p.config.supersampling << ',';
   if (engine) {
-    s << ToString(o.thinObjects) << ',' << ToString(o.objectTest) << ',' << int(o.textureSplit) << ','
+    s << ToString(o.ThinObjectsFor(p.config.supersampling)) << ',' << ToString(o.objectTest) << ',' << int(o.textureSplit) << ','
       << int(o.adaptiveBorders) << ',' << ToString(o.smoothRefinement) << ',' << int(o.finestCentreProbe) << ','
       << int(o.lazyEvaluation) << ',';
   } else {
@@ -692,7 +695,7 @@ int RunBench(const BenchFlags& f) {
       std::cerr << "\n";
     };
     std::vector<RGB> dcmDefaultImage;
-    const std::string defaultLabel = DefaultLabel("dcm");
+    const std::string defaultLabel = DefaultLabel("dcm", s.defaultSs);
     for (const Config& c : configs) {
       Point p;
       std::vector<RGB> img;
@@ -847,7 +850,7 @@ int RunBench(const BenchFlags& f) {
               << "|---|---|---|---|---|---|---|---|---|---|---|\n";
       for (const auto& row : table) {
         const std::string ours = row.ours;
-        const Point* p = Find(pts, ours == "dcm" || ours == "paper" || ours == "guo" ? DefaultLabel(ours) : ours);
+        const Point* p = Find(pts, ours == "dcm" || ours == "paper" || ours == "guo" ? DefaultLabel(ours, s.defaultSs) : ours);
         if (!p) continue;
         summary << "| " << row.name << " | " << row.pixels << " | " << row.timeDcm << " | " << row.timeIllum << " | "
                 << p->config.label << " | " << Fmt("%.2f", 100 * p->exactFraction) << " % | "

@@ -11,12 +11,13 @@ namespace dcm::cli {
 void AddEngineFlags(CLI::App* app, EngineFlags* f) {
   app->add_option("--method", f->method, "dcm (default), paper (Scheel et al. 2001) or guo (Guo 1998)")
       ->check(CLI::IsMember({"dcm", "paper", "guo"}));
-  app->add_option("--threshold", f->threshold, "contrast threshold of the smooth/edge test (default 0.14; paper|guo: 0.06)");
+  app->add_option("--threshold", f->threshold, "contrast threshold of the smooth/edge test (default 0.14, 0.08 with --downsample 2 or more; paper|guo: 0.06)");
   app->add_option("--block", f->block, "elementary block size (power of two; default 16, 8 with noisy samples; --method paper|guo: 8)");
   app->add_option("--min-block", f->minBlock, "finest block size (power of two, default 4)");
   app->add_option("--directions", f->directions, "candidate directions of the least-discrepancy search (default 8)");
   app->add_flag("--no-thin", f->noThin, "switch off the thin-object test (paper 3.1)");
-  app->add_option("--thin-test", f->thinTest, "off | none-matches | any-differs | end-differs (default)");
+  app->add_option("--thin-test", f->thinTest,
+                  "off | none-matches | any-differs | end-differs (default; none-matches with --downsample 2 or more)");
   app->add_option("--neighbour-directions", f->neighbourDirections,
                   "directions each side of its block's that an interior pixel tries, where both ends agree, before the "
                   "thin-object test makes it exact (default 4: every one of 8; paper|guo: 0)");
@@ -35,6 +36,10 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
                 "fallback blocks also evaluate the border pixels adaptive borders filled");
   app->add_flag("--no-surface-aware", f->noSurfaceAware, "interpolate across surfaces (Guo)");
   app->add_flag("--no-adaptive-borders", f->noAdaptiveBorders, "evaluate every border pixel of edge blocks (the paper)");
+  app->add_option("--crossing-fill", f->crossingFill,
+                  "with --downsample 2 or more: a finest side between two lattice lines of the level above takes its "
+                  "surface-change pixels from exact pixels of the same surface on both lines within N pixels, where "
+                  "they agree (default 2; 0: evaluate them all)");
   app->add_flag("--no-centre-probe", f->noCentreProbe, "no centre probe of the finest edge blocks");
   app->add_flag("--no-guide-first-order", f->noGuideFirstOrder,
                 "first-order test: evaluate the inner pixels at every crossing, also where the guides show the "
@@ -68,12 +73,15 @@ Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {
   if (f.method == "paper") *o = ReconstructionOptions::Paper();
   else if (f.method == "guo") *o = ReconstructionOptions::Guo();
   else *o = ReconstructionOptions{};
-  if (f.threshold >= 0) o->contrastThreshold = f.threshold;
+  if (f.threshold >= 0) o->SetContrastThreshold(f.threshold);
   if (f.block) o->elementaryBlock = f.block, o->noisyElementaryBlock = 0;  // with noisy samples too
   if (f.minBlock) o->minBlock = f.minBlock;
   if (f.directions) o->directions = f.directions;
-  if (f.noThin) o->thinObjects = ThinObjectTest::kOff;
-  if (!f.thinTest.empty()) DCM_RETURN_IF_ERROR(Parse(f.thinTest, &o->thinObjects));
+  if (f.noThin) o->thinObjects = o->thinObjectsSupersampled = ThinObjectTest::kOff;
+  if (!f.thinTest.empty()) {
+    DCM_RETURN_IF_ERROR(Parse(f.thinTest, &o->thinObjects));
+    o->thinObjectsSupersampled = o->thinObjects;  // at every supersampling
+  }
   if (f.neighbourDirections >= 0) o->neighbourDirections = f.neighbourDirections;
   if (f.fallbackShadingChanges >= -1) o->fallbackShadingChanges = f.fallbackShadingChanges;
   if (f.simpleSurfaceChanges) o->simpleSurfaceChanges = f.simpleSurfaceChanges;
@@ -85,6 +93,7 @@ Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {
   if (f.fallbackFilledBorders) o->fallbackFilledBorders = true;
   if (f.noSurfaceAware) o->surfaceAware = false;
   if (f.noAdaptiveBorders) o->adaptiveBorders = false;
+  if (f.crossingFill >= 0) o->crossingFillReach = f.crossingFill;
   if (f.noCentreProbe) o->finestCentreProbe = false;
   if (f.noGuideFirstOrder) o->firstOrderFromGuides = false;
   if (f.noCheckerboard) o->checkerboard = false;

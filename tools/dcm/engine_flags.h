@@ -19,6 +19,7 @@ struct EngineFlags {
   int block = 0, minBlock = 0, directions = 0, downsample = 1, threads = 0, tile = 0;
   int neighbourDirections = -1;  ///< <0: the method's default
   int fallbackShadingChanges = -2;  ///< < -1: the method's default
+  int crossingFill = -1;            ///< < 0: the method's default
   int simpleSurfaceChanges = 0;  ///< 0: the method's default
   bool noThin = false, noTextureSplit = false, noLazy = false, noFallback = false;
   bool noSurfaceAware = false, full = false;

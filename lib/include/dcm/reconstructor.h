@@ -56,6 +56,7 @@ struct ReconstructionStats {
   int64_t smoothBlocks = 0, simpleEdgeBlocks = 0, complexEdgeBlocks = 0;
   int64_t lazyAccepted = 0, lazyRejected = 0, fallbackBlocks = 0;
   int64_t checkerboardFilled = 0;  ///< pixels the tests wanted exact, filled from their exact neighbours
+  int64_t crossingsFilled = 0;  ///< surface-change border pixels filled from the neighbouring lattice lines
   int64_t providerCalls = 0;
   double timeGuidesS = 0;    ///< in the provider's Guides()
   double timeProviderS = 0;  ///< in the provider's Evaluate() (the illumination)
