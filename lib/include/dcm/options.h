@@ -105,9 +105,9 @@ struct ReconstructionOptions {
   /// The thin-object test with supersampled input (downsample >= 2): a work
   /// pixel is 1/downsample^2 of an output pixel, so a pixel interpolated from
   /// one end on its surface errs in a fraction of an output pixel only.
-  /// docs/AOV.md (session 9): on the Cycles views at 4x, 0.3-0.5 points
-  /// fewer exact pixels at equal error than kEndDiffers; at final resolution
-  /// it loses up to 1.5 dB (view b cannot reach 40 dB with it).
+  /// docs/AOV.md (session 9): on the Cycles views at 4x, 0.07-0.33 points
+  /// fewer exact pixels than kEndDiffers at 45 dB; at final resolution it
+  /// loses 1.0-1.7 dB at the same threshold (view b stays below 40 dB).
   ThinObjectTest thinObjectsSupersampled = ThinObjectTest::kNoneMatches;
   /// The thin-object test for this much supersampling per axis.
   ThinObjectTest ThinObjectsFor(int supersampling) const {
@@ -156,10 +156,11 @@ struct ReconstructionOptions {
   /// pixel of the same surface within this many pixels along the line (inside
   /// the side's extent) and the two agree; the others are evaluated. An edge
   /// crossing three lattice lines is then sampled on the outer two and
-  /// interpolated on the middle one. docs/AOV.md (session 9): with
-  /// thinObjectsSupersampled, 0.03-0.34 points fewer exact pixels for
-  /// <= 0.12 dB on the Cycles views and bundled scenes; at final resolution
-  /// it costs more error than the threshold's trade. 0: off.
+  /// interpolated on the middle one. docs/AOV.md (session 9): at the
+  /// supersampled defaults, 0.20-0.32 points fewer exact pixels for 0.08-0.17
+  /// dB on the Cycles views at 4x (0.13-0.26 points fewer at 45 dB), 0.03-0.08
+  /// points for <= 0.11 dB on the bundled scenes; at final resolution it
+  /// costs more error than the threshold's trade. 0: off.
   int crossingFillReach = 2;
 
   bool zeroOrderTest = true;   ///< simple/complex: exactly two changes along the border
