@@ -274,6 +274,8 @@ std::vector<Config> SweepConfigs(const BenchFlags& f, const Subject& s) {
 
   std::vector<Config> out;
   auto add = [&](Config c) {
+    // The options as run: what a field is worth depends on the supersampling.
+    c.options.downsample = c.supersampling;
     const std::string key = OptionsKey(c.options) + "#" + std::to_string(c.supersampling);
     for (auto& e : out) {
       if (OptionsKey(e.options) + "#" + std::to_string(e.supersampling) == key) {
@@ -356,7 +358,7 @@ std::vector<Config> NoiseConfigs(const BenchFlags& f, const Subject& s) {
       c.sweeps = "noise";
       c.options = o;
       c.options.threads = f.threads;
-      c.supersampling = s.defaultSs;
+      c.supersampling = c.options.downsample = s.defaultSs;
       c.spp = spp;
       out.push_back(std::move(c));
     };

@@ -159,8 +159,9 @@ struct ReconstructionOptions {
   /// interpolated on the middle one. docs/AOV.md (session 9): at the
   /// supersampled defaults, 0.20-0.32 points fewer exact pixels for 0.08-0.17
   /// dB on the Cycles views at 4x (0.13-0.26 points fewer at 45 dB), 0.03-0.08
-  /// points for <= 0.11 dB on the bundled scenes; at final resolution it
-  /// costs more error than the threshold's trade. 0: off.
+  /// points for <= 0.11 dB on the bundled scenes; at final resolution it is
+  /// about even with the threshold's trade and costs view c the 1 dB the 1x
+  /// target has no room for. 0: off.
   int crossingFillReach = 2;
 
   bool zeroOrderTest = true;   ///< simple/complex: exactly two changes along the border
