@@ -172,6 +172,12 @@ TEST(DcmReconstruct, SupersampledInputHasItsOwnDefaults) {
   EXPECT_FLOAT_EQ(float(set["contrast_threshold"]), 0.1f);
   EXPECT_EQ(set["thin_objects"], "any-differs");
   EXPECT_EQ(set["crossing_fill_reach"], 0);
+  // -v says which settings the run uses, and why.
+  const auto v = RunDcm({"reconstruct", dir / "in.exr", "-o", dir / "out.exr", "--downsample", "2", "-v"}, dir);
+  ASSERT_EQ(v.exitCode, 0) << v.err;
+  EXPECT_THAT(v.err, HasSubstr("thin-object test " + std::string(ToString(defaults.thinObjectsSupersampled)) +
+                               ", crossing fill " + std::to_string(defaults.crossingFillReach) +
+                               " (supersampled input: --downsample 2)"));
 }
 
 TEST(DcmReconstruct, VerboseSaysWhichTestsAreOff) {

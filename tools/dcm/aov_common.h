@@ -128,15 +128,18 @@ inline int Fail(const std::string& cmd, const std::string& message, int code = k
   return code;
 }
 
-/// Opens the provider and prints its notes (-v) and warnings (unless --quiet).
+/// Opens the provider and prints its notes and the engine's settings (-v)
+/// and its warnings (unless --quiet).
 inline Status OpenProvider(const std::string& cmd, const AovFlags& flags, const aov::AovOptions& options,
-                           const EngineFlags& engine, std::unique_ptr<aov::AovProvider>* provider) {
+                           const EngineFlags& engine, const ReconstructionOptions& engineOptions,
+                           std::unique_ptr<aov::AovProvider>* provider) {
   DCM_RETURN_IF_ERROR(aov::AovProvider::Open(flags.inputs, options, provider));
   if (engine.verbose) {
     const auto caps = (*provider)->Capabilities();
     std::cerr << "dcm " << cmd << ": " << caps.width << "x" << caps.height << ", "
               << ((*provider)->dense() ? "dense" : "sparse") << " input\n";
     for (const auto& n : (*provider)->Notes()) std::cerr << "dcm " << cmd << ": " << n << "\n";
+    std::cerr << "dcm " << cmd << ": " << SettingsSummary(engineOptions) << "\n";
   }
   if (!engine.quiet)
     for (const auto& w : (*provider)->Warnings()) std::cerr << "dcm " << cmd << ": warning: " << w << "\n";

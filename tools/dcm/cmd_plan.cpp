@@ -89,7 +89,7 @@ int RunPlan(const PlanFlags& f) {
   if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
 
   std::unique_ptr<aov::AovProvider> provider;
-  st = aov_common::OpenProvider(cmd, f.aov, aovOptions, f.engine, &provider);
+  st = aov_common::OpenProvider(cmd, f.aov, aovOptions, f.engine, options, &provider);
   if (!st.ok()) return aov_common::Fail(cmd, st.message());
 
   Reconstruction r;

@@ -256,7 +256,7 @@ int RunReconstruct(const ReconstructFlags& f) {
     return aov_common::Fail(cmd, "--error-map needs dense input or --reference", kExitUsage);
 
   std::unique_ptr<aov::AovProvider> provider;
-  st = aov_common::OpenProvider(cmd, f.aov, aovOptions, f.engine, &provider);
+  st = aov_common::OpenProvider(cmd, f.aov, aovOptions, f.engine, options, &provider);
   if (!st.ok()) return aov_common::Fail(cmd, st.message());
   if (IsPartial(f.tiles)) return RunReconstructPart(f, options, *provider);
   Bounds2i display, data;

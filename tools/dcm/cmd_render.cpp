@@ -213,7 +213,8 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
     std::cerr << "scene " << f.scene << ": " << scene.objects.size() << " objects, "
               << provider->triangleCount() << " triangles, " << scene.lights.size() << " lights; working image "
               << provider->workWidth() << "x" << provider->workHeight() << "; effects "
-              << Join(provider->effects().Names()) << "\n";
+              << Join(provider->effects().Names()) << "\n"
+              << "engine settings: " << SettingsSummary(options) << "\n";
   }
   if (IsPartial(f.tiles)) return RunRenderPart(f, scene, options, *provider, progress);
 

@@ -69,6 +69,16 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
   app->add_flag("--quiet", f->quiet, "no progress on stderr");
 }
 
+std::string SettingsSummary(const ReconstructionOptions& o) {
+  const int s = o.downsample;
+  char threshold[32];
+  std::snprintf(threshold, sizeof threshold, "%g", double(o.ContrastThresholdFor(s)));
+  std::string text = std::string("threshold ") + threshold + ", thin-object test " +
+                     std::string(ToString(o.ThinObjectsFor(s))) + ", crossing fill " +
+                     std::to_string(s >= 2 ? o.crossingFillReach : 0);
+  return text + (s >= 2 ? " (supersampled input: --downsample " + std::to_string(s) + ")" : " (final resolution)");
+}
+
 Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {
   if (f.method == "paper") *o = ReconstructionOptions::Paper();
   else if (f.method == "guo") *o = ReconstructionOptions::Guo();

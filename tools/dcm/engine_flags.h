@@ -43,4 +43,9 @@ void AddEngineFlags(CLI::App* app, EngineFlags* flags);
 /// The options the flags select. The message names the flag at fault.
 Status ToOptions(const EngineFlags& flags, ReconstructionOptions* options);
 
+/// For -v: the settings that depend on the supersampling, as the engine will
+/// use them ("threshold 0.08, thin-object test none-matches, crossing fill 2
+/// (supersampled input: --downsample 2)").
+std::string SettingsSummary(const ReconstructionOptions& options);
+
 }  // namespace dcm::cli
