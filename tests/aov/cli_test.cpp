@@ -7,7 +7,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -178,6 +180,56 @@ TEST(DcmReconstruct, SupersampledInputHasItsOwnDefaults) {
   EXPECT_THAT(v.err, HasSubstr("thin-object test " + std::string(ToString(defaults.thinObjectsSupersampled)) +
                                ", crossing fill " + std::to_string(defaults.crossingFillReach) +
                                " (supersampled input: --downsample 2)"));
+}
+
+// `dcm bench` on an AOV input reads the guides as `dcm reconstruct` does,
+// --highlight-level included: small sharp highlights off the lattice
+// (AovProvider.HighlightGuideFindsHighlightsSmallerThanTheLattice) are found
+// with the default level and missed with a level above the guide's values.
+TEST(DcmBench, AovInputTakesTheHighlightLevel) {
+  ScratchDir dir;
+  constexpr int n = 128;
+  const auto inHighlight = [](int x, int y) {
+    const int u = x % 16, v = y % 16;
+    return (x / 16 + y / 16) % 3 == 0 && u >= 5 && u <= 7 && v >= 9 && v <= 10;
+  };
+  std::vector<TestChannel> ch;
+  for (const char* c : {"R", "G", "B"})
+    ch.push_back(Fill(c, n, n, [&](int x, int y) { return inHighlight(x, y) ? 3.f : 0.4f; }));
+  ch.push_back(Fill("id", n, n, [](int, int) { return 1.f; }));
+  ch.push_back(Fill("highlight", n, n, [&](int x, int y) { return inHighlight(x, y) ? 9.f : 0.6f; }));
+  WriteExr(dir / "guided.exr", n, n, ch);
+  // The PSNR of dcm's point at threshold 0.14 in the bench's CSV.
+  auto psnr = [&](const std::string& out, std::vector<std::string> extra) {
+    std::vector<std::string> args = {"bench", dir / "guided.exr", "--quick", "--no-plots", "--thresholds", "0.14",
+                                     "--quiet", "--out", dir / out};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const auto r = RunDcm(args, dir);
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    const std::string csvPath = std::string(dir / out) + "/bench.csv";
+    std::ifstream csv(csvPath);
+    std::string line;
+    std::getline(csv, line);
+    std::vector<std::string> header;
+    std::stringstream hs(line);
+    for (std::string f; std::getline(hs, f, ',');) header.push_back(f);
+    const size_t column = size_t(std::find(header.begin(), header.end(), "psnr_db") - header.begin());
+    while (std::getline(csv, line)) {
+      std::vector<std::string> fields;
+      std::stringstream ls(line);
+      for (std::string f; std::getline(ls, f, ',');) fields.push_back(f);
+      if (fields.size() > column && fields[3] == "dcm t=0.14") return std::stod(fields[column]);
+    }
+    ADD_FAILURE() << "no point 'dcm t=0.14' in " << csvPath;
+    return 0.0;
+  };
+  const double found = psnr("found", {}), missed = psnr("missed", {"--highlight-level", "10"});
+  std::printf("highlights: %.2f dB found, %.2f dB missed\n", found, missed);
+  // Found, every pixel is right (measured: infinite PSNR); missed, the 3x2
+  // highlights (3.0 on 0.4) of 1/3 of the 16x16 cells are interpolated over
+  // (30.6 dB). 10 dB between them is asked.
+  EXPECT_GT(found, missed + 10) << "found " << found << " dB, missed " << missed << " dB";
+  EXPECT_NE(RunDcm({"bench", dir / "guided.exr", "--highlight-level", "-1", "--out", dir / "bad"}, dir).exitCode, 0);
 }
 
 TEST(DcmReconstruct, VerboseSaysWhichTestsAreOff) {

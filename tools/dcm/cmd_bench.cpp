@@ -67,6 +67,7 @@ struct BenchFlags {
   std::string preset = "generic";
   std::vector<std::string> maps;
   int downsample = 1;
+  float highlightLevel = -1;  ///< < 0: the AOV provider's default
   bench::JbuParams jbu;
   // Scenes: scene overrides and the noise sweep.
   std::vector<std::string> overrides;
@@ -164,6 +165,7 @@ Status OpenSubject(const BenchFlags& f, const std::string& input, Subject* s) {
     aov::AovOptions o;
     DCM_RETURN_IF_ERROR(aov::ParsePreset(f.preset, &o.preset));
     for (const auto& m : f.maps) DCM_RETURN_IF_ERROR(aov::ParseMapping(m, &o.mappings));
+    if (f.highlightLevel >= 0) o.highlightLevel = f.highlightLevel;
     o.sparse = false;
     o.split = true;
     std::unique_ptr<aov::AovProvider> p;
@@ -961,6 +963,10 @@ Registration reg(
       app->add_option("--map", f->maps, "AOV inputs: ROLE=CHANNEL (as dcm reconstruct)");
       app->add_option("--downsample", f->downsample, "AOV inputs: supersampled N times per axis")
           ->check(CLI::Range(1, 16));
+      app->add_option("--highlight-level", f->highlightLevel,
+                      "AOV inputs: a pixel whose highlight guide exceeds this is a highlight (as dcm reconstruct; "
+                      "default 1.5)")
+          ->check(CLI::NonNegativeNumber);
 #endif
       app->add_option("--set", f->overrides,
                       "scenes: override a setting before the scene is read, KEY.PATH=JSON (repeatable; as dcm render)")
