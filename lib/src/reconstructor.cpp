@@ -101,7 +101,7 @@ class Engine {
         noisy_(NoisySamples(opt, caps)),
         block_(ElementaryBlock(opt, caps)),
         thinTest_(opt.ThinObjectsFor(opt.downsample)),
-        crossingFillReach_(opt.downsample >= 2 ? opt.crossingFillReach : 0),
+        crossingFillReach_(opt.CrossingFillReachFor(opt.downsample)),
         store_(caps.width, caps.height, split, noisy_),
         contrast_(opt.contrastMetric, opt.ContrastThresholdFor(opt.downsample), split, noisy_ ? opt.noiseSignificance : 0.f) {
     const int blocksPerTile = std::max(1, opt.tileSize / std::max(1, block_));
@@ -192,7 +192,7 @@ class Engine {
   bool noisy_;  ///< samples carry their variance and the tests weigh it
   int block_;   ///< the elementary block (ReconstructionOptions::ElementaryBlockFor)
   ThinObjectTest thinTest_;  ///< ReconstructionOptions::ThinObjectsFor the supersampling
-  int crossingFillReach_;    ///< ReconstructionOptions::crossingFillReach, 0 at final resolution
+  int crossingFillReach_;    ///< ReconstructionOptions::CrossingFillReachFor the supersampling
   SampleStore store_;
   ContrastTest contrast_;
   SampleRequest request_;

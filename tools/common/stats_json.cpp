@@ -34,7 +34,7 @@ nlohmann::json OptionsToJson(const ReconstructionOptions& o) {
   j["directions"] = o.directions;
   j["object_test"] = std::string(ToString(o.objectTest));
   j["thin_objects"] = std::string(ToString(o.ThinObjectsFor(o.downsample)));
-  j["crossing_fill_reach"] = o.downsample >= 2 ? o.crossingFillReach : 0;
+  j["crossing_fill_reach"] = o.CrossingFillReachFor(o.downsample);
   j["surface_aware"] = o.surfaceAware;
   j["texture_split"] = o.textureSplit;
   j["smooth_refinement"] = std::string(ToString(o.smoothRefinement));

@@ -75,7 +75,7 @@ std::string SettingsSummary(const ReconstructionOptions& o) {
   std::snprintf(threshold, sizeof threshold, "%g", double(o.ContrastThresholdFor(s)));
   std::string text = std::string("threshold ") + threshold + ", thin-object test " +
                      std::string(ToString(o.ThinObjectsFor(s))) + ", crossing fill " +
-                     std::to_string(s >= 2 ? o.crossingFillReach : 0);
+                     std::to_string(o.CrossingFillReachFor(s));
   return text + (s >= 2 ? " (supersampled input: --downsample " + std::to_string(s) + ")" : " (final resolution)");
 }
 

@@ -163,6 +163,8 @@ struct ReconstructionOptions {
   /// about even with the threshold's trade and costs view c the 1 dB the 1x
   /// target has no room for. 0: off.
   int crossingFillReach = 2;
+  /// The crossing fill's reach for this much supersampling per axis (0: off).
+  int CrossingFillReachFor(int supersampling) const { return supersampling >= 2 ? crossingFillReach : 0; }
 
   bool zeroOrderTest = true;   ///< simple/complex: exactly two changes along the border
   /// A block of at most twice the finest size whose border changes only
