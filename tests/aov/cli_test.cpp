@@ -188,17 +188,10 @@ TEST(DcmReconstruct, SupersampledInputHasItsOwnDefaults) {
 // with the default level and missed with a level above the guide's values.
 TEST(DcmBench, AovInputTakesTheHighlightLevel) {
   ScratchDir dir;
-  constexpr int n = 128;
-  const auto inHighlight = [](int x, int y) {
-    const int u = x % 16, v = y % 16;
-    return (x / 16 + y / 16) % 3 == 0 && u >= 5 && u <= 7 && v >= 9 && v <= 10;
-  };
-  std::vector<TestChannel> ch;
-  for (const char* c : {"R", "G", "B"})
-    ch.push_back(Fill(c, n, n, [&](int x, int y) { return inHighlight(x, y) ? 3.f : 0.4f; }));
-  ch.push_back(Fill("id", n, n, [](int, int) { return 1.f; }));
-  ch.push_back(Fill("highlight", n, n, [&](int x, int y) { return inHighlight(x, y) ? 9.f : 0.6f; }));
-  WriteExr(dir / "guided.exr", n, n, ch);
+  const HighlightScene scene;
+  std::vector<TestChannel> ch = scene.Channels();
+  ch.push_back(scene.Guide());
+  WriteExr(dir / "guided.exr", scene.size, scene.size, ch);
   // The PSNR of dcm's point at threshold 0.14 in the bench's CSV.
   auto psnr = [&](const std::string& out, std::vector<std::string> extra) {
     std::vector<std::string> args = {"bench", dir / "guided.exr", "--quick", "--no-plots", "--thresholds", "0.14",

@@ -244,18 +244,12 @@ TEST(AovProvider, HighlightGuideFindsHighlightsSmallerThanTheLattice) {
   // blind error is asked. A level above the guide's highlights (10) marks
   // nothing and changes nothing.
   ScratchDir dir;
-  constexpr int n = 128;
-  const auto inHighlight = [](int x, int y) {
-    const int u = x % 16, v = y % 16;
-    return (x / 16 + y / 16) % 3 == 0 && u >= 5 && u <= 7 && v >= 9 && v <= 10;
-  };
-  std::vector<TestChannel> ch;
-  for (const char* c : {"R", "G", "B"})
-    ch.push_back(Fill(c, n, n, [&](int x, int y) { return inHighlight(x, y) ? 3.f : 0.4f; }));
-  ch.push_back(Fill("id", n, n, [](int, int) { return 1.f; }));
-  ch.push_back(Fill("shader", n, n, [](int, int) { return 1.f; }));
+  const HighlightScene scene;
+  const int n = scene.size;
+  const auto inHighlight = HighlightScene::InHighlight;
+  std::vector<TestChannel> ch = scene.Channels();
   WriteExr(dir / "blind.exr", n, n, ch);
-  ch.push_back(Fill("highlight", n, n, [&](int x, int y) { return inHighlight(x, y) ? 9.f : 0.6f; }));
+  ch.push_back(scene.Guide());
   WriteExr(dir / "guided.exr", n, n, ch);
   auto highlightError = [&](const std::string& file, float level) {
     AovOptions o;

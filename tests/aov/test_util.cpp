@@ -81,6 +81,24 @@ std::vector<RGB> ReadRgbExr(const std::string& path, int* width, int* height) {
   return px;
 }
 
+bool HighlightScene::InHighlight(int x, int y) {
+  const int u = x % 16, v = y % 16;
+  return (x / 16 + y / 16) % 3 == 0 && u >= 5 && u <= 7 && v >= 9 && v <= 10;
+}
+
+std::vector<TestChannel> HighlightScene::Channels() const {
+  std::vector<TestChannel> ch;
+  for (const char* c : {"R", "G", "B"})
+    ch.push_back(Fill(c, size, size, [](int x, int y) { return InHighlight(x, y) ? 3.f : 0.4f; }));
+  ch.push_back(Fill("id", size, size, [](int, int) { return 1.f; }));
+  ch.push_back(Fill("shader", size, size, [](int, int) { return 1.f; }));
+  return ch;
+}
+
+TestChannel HighlightScene::Guide() const {
+  return Fill("highlight", size, size, [](int x, int y) { return InHighlight(x, y) ? 9.f : 0.6f; });
+}
+
 TestChannel Fill(const std::string& name, int width, int height, const std::function<float(int, int)>& f) {
   TestChannel c;
   c.name = name;

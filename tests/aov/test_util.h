@@ -67,6 +67,19 @@ void MakeHugeExr(const std::string& path, int side);
 /// Reads a whole text file.
 std::string ReadText(const std::string& path);
 
+/// Small sharp highlights off the lattice: a glossy surface (0.4, one
+/// object, one shader) with highlights of 3.0, 3x2 pixels, in 1/3 of its
+/// 16x16 cells, where no corner, border or probe of a 4x4 block falls.
+struct HighlightScene {
+  int size = 128;
+  static bool InHighlight(int x, int y);
+  /// R, G, B, id, shader.
+  std::vector<TestChannel> Channels() const;
+  /// The highlight guide (direct glossy light, R + G + B): 9 on a
+  /// highlight, 0.6 elsewhere.
+  TestChannel Guide() const;
+};
+
 /// The analytic test scene (sizes multiple of 8 or not): a disc object on a
 /// floor, a shadow edge, a checker texture on the floor and a highlight.
 struct Scene {
