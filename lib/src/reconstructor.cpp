@@ -100,10 +100,11 @@ class Engine {
         split_(split),
         noisy_(NoisySamples(opt, caps)),
         block_(ElementaryBlock(opt, caps)),
-        thinTest_(opt.ThinObjectsFor(opt.downsample)),
-        crossingFillReach_(opt.CrossingFillReachFor(opt.downsample)),
+        supersampledRules_(opt.SupersampledRules(noisy_)),
+        thinTest_(opt.ThinObjectsFor(supersampledRules_)),
+        crossingFillReach_(opt.CrossingFillReachFor(supersampledRules_)),
         store_(caps.width, caps.height, split, noisy_),
-        contrast_(opt.contrastMetric, opt.ContrastThresholdFor(opt.downsample), split, noisy_ ? opt.noiseSignificance : 0.f) {
+        contrast_(opt.contrastMetric, opt.ContrastThresholdFor(supersampledRules_), split, noisy_ ? opt.noiseSignificance : 0.f) {
     const int blocksPerTile = std::max(1, opt.tileSize / std::max(1, block_));
     grain_ = size_t(blocksPerTile) * size_t(blocksPerTile);
     request_.split = split;
@@ -191,8 +192,9 @@ class Engine {
   bool split_;
   bool noisy_;  ///< samples carry their variance and the tests weigh it
   int block_;   ///< the elementary block (ReconstructionOptions::ElementaryBlockFor)
-  ThinObjectTest thinTest_;  ///< ReconstructionOptions::ThinObjectsFor the supersampling
-  int crossingFillReach_;    ///< ReconstructionOptions::CrossingFillReachFor the supersampling
+  bool supersampledRules_;   ///< ReconstructionOptions::SupersampledRules
+  ThinObjectTest thinTest_;  ///< ReconstructionOptions::ThinObjectsFor the rules
+  int crossingFillReach_;    ///< ReconstructionOptions::CrossingFillReachFor the rules
   SampleStore store_;
   ContrastTest contrast_;
   SampleRequest request_;
@@ -274,6 +276,7 @@ Status Engine::LoadGuides() {
   stats_.usedObjectId = want.objectId;
   stats_.usedShaderId = want.shaderId;
   stats_.usedSplit = split_;
+  stats_.usedSupersampledRules = supersampledRules_;
   stats_.usedNormals = want.normal;
   if (!want.objectId && !want.texture && !want.normal) {
     store_.SetGuides({}, ObjectTest::kNone);
@@ -960,6 +963,10 @@ void Engine::RecordLeaves(Reconstruction* out) {
 
 }  // namespace
 }  // namespace detail
+
+bool UsesSupersampledRules(const ReconstructionOptions& options, const ProviderCapabilities& caps) {
+  return options.SupersampledRules(detail::NoisySamples(options, caps));
+}
 
 Status Reconstruct(SampleProvider& provider, const ReconstructionOptions& options, Reconstruction* out,
                    std::vector<Point2i>* pending) {

@@ -146,40 +146,53 @@ TEST(DcmReconstruct, DownsampleComparesAtOutputResolution) {
   EXPECT_LT(double(s["reference"]["rmse"]), 1e-6);
 }
 
-// The stats record the settings in effect: supersampled input has its own
-// threshold, thin-object test and crossing fill (dcm/options.h), and the
-// flags set them at every supersampling.
+// Supersampled input whose samples are not noisy has its own threshold,
+// thin-object test and crossing fill (dcm/options.h): the stats record the
+// settings and whether the run used those rules, -v says which it uses and
+// why, and the flags set them at every supersampling.
 TEST(DcmReconstruct, SupersampledInputHasItsOwnDefaults) {
   ScratchDir dir;
   Scene sc{64, 64};
-  WriteExr(dir / "in.exr", 64, 64, sc.GenericChannels(false));
-  auto options = [&](std::vector<std::string> extra) {
-    std::vector<std::string> args = {"reconstruct", dir / "in.exr", "-o", dir / "out.exr", "--stats", dir / "s.json",
-                                      "--quiet"};
+  auto ch = sc.GenericChannels(false);
+  WriteExr(dir / "in.exr", 64, 64, ch);
+  for (const char* c : {"var.R", "var.G", "var.B"}) ch.push_back(Fill(c, 64, 64, [](int, int) { return 1e-4f; }));
+  WriteExr(dir / "noisy.exr", 64, 64, ch);
+  auto run = [&](const std::string& input, std::vector<std::string> extra) {
+    std::vector<std::string> args = {"reconstruct", dir / input, "-o", dir / "out.exr", "--stats", dir / "s.json", "-v"};
     args.insert(args.end(), extra.begin(), extra.end());
     const auto r = RunDcm(args, dir);
     EXPECT_EQ(r.exitCode, 0) << r.err;
-    return ReadJson(dir / "s.json")["options"];
+    return std::pair(ReadJson(dir / "s.json"), r.err);
   };
   const ReconstructionOptions defaults;
-  const auto final1 = options({});
-  EXPECT_FLOAT_EQ(float(final1["contrast_threshold"]), defaults.contrastThreshold);
-  EXPECT_EQ(final1["thin_objects"], std::string(ToString(defaults.thinObjects)));
-  EXPECT_EQ(final1["crossing_fill_reach"], 0) << "off at final resolution";
-  const auto x2 = options({"--downsample", "2"});
-  EXPECT_FLOAT_EQ(float(x2["contrast_threshold"]), defaults.contrastThresholdSupersampled);
-  EXPECT_EQ(x2["thin_objects"], std::string(ToString(defaults.thinObjectsSupersampled)));
-  EXPECT_EQ(x2["crossing_fill_reach"], defaults.crossingFillReach);
-  const auto set = options({"--downsample", "2", "--threshold", "0.1", "--thin-test", "any-differs", "--crossing-fill", "0"});
-  EXPECT_FLOAT_EQ(float(set["contrast_threshold"]), 0.1f);
-  EXPECT_EQ(set["thin_objects"], "any-differs");
-  EXPECT_EQ(set["crossing_fill_reach"], 0);
-  // -v says which settings the run uses, and why.
-  const auto v = RunDcm({"reconstruct", dir / "in.exr", "-o", dir / "out.exr", "--downsample", "2", "-v"}, dir);
-  ASSERT_EQ(v.exitCode, 0) << v.err;
-  EXPECT_THAT(v.err, HasSubstr("thin-object test " + std::string(ToString(defaults.thinObjectsSupersampled)) +
-                               ", crossing fill " + std::to_string(defaults.crossingFillReach) +
-                               " (supersampled input: --downsample 2)"));
+  auto said = [](const ReconstructionOptions& o, bool rules, const std::string& why) {
+    std::ostringstream s;
+    s << "threshold " << o.ContrastThresholdFor(rules) << ", thin-object test " << ToString(o.ThinObjectsFor(rules))
+      << ", crossing fill " << o.CrossingFillReachFor(rules) << " (" << why << ")";
+    return s.str();
+  };
+  const auto [final1, final1Err] = run("in.exr", {});
+  EXPECT_FALSE(bool(final1["used"]["supersampled_rules"]));
+  EXPECT_THAT(final1Err, HasSubstr(said(defaults, false, "final resolution")));
+  const auto [x2, x2Err] = run("in.exr", {"--downsample", "2"});
+  EXPECT_TRUE(bool(x2["used"]["supersampled_rules"]));
+  EXPECT_THAT(x2Err, HasSubstr(said(defaults, true, "supersampled rules: --downsample 2")));
+  EXPECT_FLOAT_EQ(float(x2["options"]["contrast_threshold_supersampled"]), defaults.contrastThresholdSupersampled);
+  EXPECT_EQ(x2["options"]["thin_objects_supersampled"], std::string(ToString(defaults.thinObjectsSupersampled)));
+  EXPECT_EQ(x2["options"]["crossing_fill_reach"], defaults.crossingFillReach);
+  // Noisy samples (a variance channel): the noise regime's settings.
+  const auto [noisy, noisyErr] = run("noisy.exr", {"--downsample", "2"});
+  EXPECT_FALSE(bool(noisy["used"]["supersampled_rules"]));
+  EXPECT_EQ(noisy["crossings_filled"], 0);
+  EXPECT_THAT(noisyErr, HasSubstr(said(defaults, false, "noisy samples: the supersampled rules are off")));
+  // The flags set both regimes.
+  const auto [set, setErr] =
+      run("in.exr", {"--downsample", "2", "--threshold", "0.1", "--thin-test", "any-differs", "--crossing-fill", "0"});
+  for (const char* f : {"contrast_threshold", "contrast_threshold_supersampled"})
+    EXPECT_FLOAT_EQ(float(set["options"][f]), 0.1f) << f;
+  for (const char* f : {"thin_objects", "thin_objects_supersampled"}) EXPECT_EQ(set["options"][f], "any-differs") << f;
+  EXPECT_EQ(set["options"]["crossing_fill_reach"], 0);
+  EXPECT_EQ(set["crossings_filled"], 0);
 }
 
 // `dcm bench` on an AOV input reads the guides as `dcm reconstruct` does,

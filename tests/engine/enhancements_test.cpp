@@ -7,6 +7,7 @@
 
 #include "../../lib/src/contrast_test.h"
 
+#include "noisy_provider.h"
 #include "run_helpers.h"
 
 namespace dcm::testing {
@@ -411,10 +412,19 @@ TEST(CrossingFill, AnEdgeAcrossThreeLatticeLinesIsSampledOnTheOuterTwo) {
   // and at most 2 along: off by at most 2 pixels of the slope on each
   // (0.004 for the background's slope along both axes; 0.008 bounds both).
   EXPECT_LE(worst, 4 * kGradient + 1e-5);
-  // At final resolution the fill is off.
+  // The supersampled rules are on here; at final resolution, or with noisy
+  // samples (the noise regime's settings hold at every supersampling), they
+  // and the fill are off.
+  EXPECT_TRUE(r.stats.usedSupersampledRules);
   ReconstructionOptions final1 = fill;
   final1.downsample = 1;
-  EXPECT_EQ(ReconstructOrFail(provider, final1).stats.crossingsFilled, 0);
+  const Reconstruction f1 = ReconstructOrFail(provider, final1);
+  EXPECT_FALSE(f1.stats.usedSupersampledRules);
+  EXPECT_EQ(f1.stats.crossingsFilled, 0);
+  NoisyProvider noisy(provider, NoiseModel{0.02f, 0.002f, 3});
+  const Reconstruction n = ReconstructOrFail(noisy, fill);
+  EXPECT_FALSE(n.stats.usedSupersampledRules);
+  EXPECT_EQ(n.stats.crossingsFilled, 0);
 }
 
 // 3.3: with the texture split a textured floor needs several times fewer

@@ -29,12 +29,14 @@ nlohmann::json OptionsToJson(const ReconstructionOptions& o) {
   j["elementary_block"] = o.elementaryBlock;
   j["noisy_elementary_block"] = o.noisyElementaryBlock;
   j["min_block"] = o.minBlock;
-  j["contrast_threshold"] = Decimal(o.ContrastThresholdFor(o.downsample));
+  j["contrast_threshold"] = Decimal(o.contrastThreshold);
+  j["contrast_threshold_supersampled"] = Decimal(o.contrastThresholdSupersampled);
   j["contrast_metric"] = std::string(ToString(o.contrastMetric));
   j["directions"] = o.directions;
   j["object_test"] = std::string(ToString(o.objectTest));
-  j["thin_objects"] = std::string(ToString(o.ThinObjectsFor(o.downsample)));
-  j["crossing_fill_reach"] = o.CrossingFillReachFor(o.downsample);
+  j["thin_objects"] = std::string(ToString(o.thinObjects));
+  j["thin_objects_supersampled"] = std::string(ToString(o.thinObjectsSupersampled));
+  j["crossing_fill_reach"] = o.crossingFillReach;
   j["surface_aware"] = o.surfaceAware;
   j["texture_split"] = o.textureSplit;
   j["smooth_refinement"] = std::string(ToString(o.smoothRefinement));
@@ -88,6 +90,7 @@ nlohmann::json StatsToJson(const ReconstructionStats& s) {
   j["crossings_filled"] = s.crossingsFilled;
   j["provider_calls"] = s.providerCalls;
   j["used"] = {{"split", s.usedSplit}, {"object_id", s.usedObjectId}, {"shader_id", s.usedShaderId},
+               {"supersampled_rules", s.usedSupersampledRules},
                {"normals", s.usedNormals}};
   return j;
 }

@@ -139,7 +139,7 @@ inline Status OpenProvider(const std::string& cmd, const AovFlags& flags, const 
     std::cerr << "dcm " << cmd << ": " << caps.width << "x" << caps.height << ", "
               << ((*provider)->dense() ? "dense" : "sparse") << " input\n";
     for (const auto& n : (*provider)->Notes()) std::cerr << "dcm " << cmd << ": " << n << "\n";
-    std::cerr << "dcm " << cmd << ": " << SettingsSummary(engineOptions) << "\n";
+    std::cerr << "dcm " << cmd << ": " << SettingsSummary(engineOptions, caps) << "\n";
   }
   if (!engine.quiet)
     for (const auto& w : (*provider)->Warnings()) std::cerr << "dcm " << cmd << ": warning: " << w << "\n";

@@ -97,6 +97,7 @@ struct Point {
   double exactFraction = 0;
   double timeIllumS = 0, timeGuidesS = 0, timeEngineS = 0, timeTotalS = 0;
   toolkit::ImageError error;
+  bool supersampledRules = false;  ///< the run used them (ReconstructionStats)
 };
 
 /// An input: a scene file or a dense AOV EXR, with a provider factory.
@@ -252,10 +253,17 @@ nlohmann::json AllOptionsJson(const ReconstructionOptions& o) {
 }
 std::string OptionsKey(const ReconstructionOptions& o) { return AllOptionsJson(o).dump(); }
 
-/// The label of a method's point at its default settings ("dcm t=0.14") for
-/// this much supersampling.
+/// A method's default threshold for this much supersampling (the accuracy
+/// sweeps' samples are not noisy).
+float DefaultThreshold(const std::string& method, int supersampling) {
+  ReconstructionOptions o = MethodOptions(method);
+  o.downsample = supersampling;
+  return o.ContrastThresholdFor(o.SupersampledRules(/*noisySamples=*/false));
+}
+
+/// The label of a method's point at its default settings ("dcm t=0.14").
 std::string DefaultLabel(const std::string& method, int supersampling) {
-  return method + " t=" + Fmt("%g", double(MethodOptions(method).ContrastThresholdFor(supersampling)));
+  return method + " t=" + Fmt("%g", double(DefaultThreshold(method, supersampling)));
 }
 
 /// The DCM-family points of the sweep, deduplicated (a point that belongs to
@@ -298,7 +306,7 @@ std::vector<Config> SweepConfigs(const BenchFlags& f, const Subject& s) {
   for (const char* m : {"dcm", "paper", "guo"}) {
     // The method's default threshold is always part of its sweep.
     std::vector<float> ts = thresholds;
-    const float def = MethodOptions(m).ContrastThresholdFor(s.defaultSs);
+    const float def = DefaultThreshold(m, s.defaultSs);
     if (std::find(ts.begin(), ts.end(), def) == ts.end()) ts.push_back(def);
     std::sort(ts.begin(), ts.end());
     for (float t : ts) {
@@ -442,13 +450,13 @@ std::string PointToCsv(const Point& p) {
   s << CsvQuote(p.scene) << ',' << CsvQuote(p.input) << ',' << p.config.method << ',' << CsvQuote(p.config.label)
     << ',' << p.config.sweeps << ',';
   if (engine) {
-    s << CsvNum(o.ContrastThresholdFor(p.config.supersampling)) << ',' << o.elementaryBlock << ',' << o.minBlock << ',';
+    s << CsvNum(o.ContrastThresholdFor(p.supersampledRules)) << ',' << o.elementaryBlock << ',' << o.minBlock << ',';
   } else {
     s << ",,,";
   }
   s << p.config.supersampling << ',';
   if (engine) {
-    s << ToString(o.ThinObjectsFor(p.config.supersampling)) << ',' << ToString(o.objectTest) << ',' << int(o.textureSplit) << ','
+    s << ToString(o.ThinObjectsFor(p.supersampledRules)) << ',' << ToString(o.objectTest) << ',' << int(o.textureSplit) << ','
       << int(o.adaptiveBorders) << ',' << ToString(o.smoothRefinement) << ',' << int(o.finestCentreProbe) << ','
       << int(o.lazyEvaluation) << ',';
   } else {
@@ -668,6 +676,7 @@ int RunBench(const BenchFlags& f) {
         p->timeIllumS = rec.stats.timeProviderS;
         p->timeGuidesS = rec.stats.timeGuidesS;
         p->timeEngineS = rec.stats.timeEngineS;
+        p->supersampledRules = rec.stats.usedSupersampledRules;
         ow = rec.width;
         oh = rec.height;
         *image = std::move(rec.image);

@@ -62,7 +62,7 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
               << caps.width << "x" << caps.height << (caps.objectId ? ", object IDs" : "")
               << (caps.shaderId ? ", shader IDs" : "") << (caps.texture ? ", texture" : "")
               << (caps.splitRadiance ? ", split radiance" : "") << "\n"
-              << "engine settings: " << SettingsSummary(options) << "\n";
+              << "engine settings: " << SettingsSummary(options, caps) << "\n";
   }
   if (caps.width % options.downsample != 0 || caps.height % options.downsample != 0) {
     return Fail("the provider's image " + std::to_string(caps.width) + "x" + std::to_string(caps.height) +

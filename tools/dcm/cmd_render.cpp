@@ -214,7 +214,7 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
               << provider->triangleCount() << " triangles, " << scene.lights.size() << " lights; working image "
               << provider->workWidth() << "x" << provider->workHeight() << "; effects "
               << Join(provider->effects().Names()) << "\n"
-              << "engine settings: " << SettingsSummary(options) << "\n";
+              << "engine settings: " << SettingsSummary(options, provider->Capabilities()) << "\n";
   }
   if (IsPartial(f.tiles)) return RunRenderPart(f, scene, options, *provider, progress);
 

@@ -69,14 +69,15 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
   app->add_flag("--quiet", f->quiet, "no progress on stderr");
 }
 
-std::string SettingsSummary(const ReconstructionOptions& o) {
-  const int s = o.downsample;
+std::string SettingsSummary(const ReconstructionOptions& o, const ProviderCapabilities& caps) {
+  const bool rules = UsesSupersampledRules(o, caps);
   char threshold[32];
-  std::snprintf(threshold, sizeof threshold, "%g", double(o.ContrastThresholdFor(s)));
-  std::string text = std::string("threshold ") + threshold + ", thin-object test " +
-                     std::string(ToString(o.ThinObjectsFor(s))) + ", crossing fill " +
-                     std::to_string(o.CrossingFillReachFor(s));
-  return text + (s >= 2 ? " (supersampled input: --downsample " + std::to_string(s) + ")" : " (final resolution)");
+  std::snprintf(threshold, sizeof threshold, "%g", double(o.ContrastThresholdFor(rules)));
+  const std::string why = rules ? "supersampled rules: --downsample " + std::to_string(o.downsample)
+                          : o.downsample >= 2 ? "noisy samples: the supersampled rules are off"
+                                              : "final resolution";
+  return std::string("threshold ") + threshold + ", thin-object test " + std::string(ToString(o.ThinObjectsFor(rules))) +
+         ", crossing fill " + std::to_string(o.CrossingFillReachFor(rules)) + " (" + why + ")";
 }
 
 Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "dcm/options.h"
+#include "dcm/reconstructor.h"
 #include "dcm/status.h"
 
 namespace dcm::cli {
@@ -44,8 +45,8 @@ void AddEngineFlags(CLI::App* app, EngineFlags* flags);
 Status ToOptions(const EngineFlags& flags, ReconstructionOptions* options);
 
 /// For -v: the settings that depend on the supersampling, as the engine will
-/// use them ("threshold 0.08, thin-object test none-matches, crossing fill 2
-/// (supersampled input: --downsample 2)").
-std::string SettingsSummary(const ReconstructionOptions& options);
+/// use them on a provider with `caps` ("threshold 0.08, thin-object test
+/// none-matches, crossing fill 2 (supersampled rules: --downsample 2)").
+std::string SettingsSummary(const ReconstructionOptions& options, const ProviderCapabilities& caps);
 
 }  // namespace dcm::cli

@@ -80,14 +80,14 @@ struct ReconstructionOptions {
   /// until the highlight guide and the session-8 probe and fallback rules
   /// left the samples of 0.12 buying less than the points they cost.
   float contrastThreshold = 0.14f;
-  /// The threshold with supersampled input (downsample >= 2), where the
-  /// reconstruction is judged after the box filter: 0.08 is the largest
+  /// The threshold under the supersampled rules (SupersampledRules), where
+  /// the reconstruction is judged after the box filter: 0.08 is the largest
   /// tested that keeps every Cycles view at 4x at or above 45 dB (issue 3's
   /// target there) with thinObjectsSupersampled and crossingFillReach.
   float contrastThresholdSupersampled = 0.08f;
-  /// The threshold for this much supersampling per axis.
-  float ContrastThresholdFor(int supersampling) const {
-    return supersampling >= 2 ? contrastThresholdSupersampled : contrastThreshold;
+  /// The threshold in effect, with the supersampled rules or without.
+  float ContrastThresholdFor(bool supersampledRules) const {
+    return supersampledRules ? contrastThresholdSupersampled : contrastThreshold;
   }
   /// Sets the threshold of every supersampling (a command line's --threshold).
   void SetContrastThreshold(float t) { contrastThreshold = contrastThresholdSupersampled = t; }
@@ -102,16 +102,16 @@ struct ReconstructionOptions {
   /// primitives (one object of many parts) want kObjectAndShader.
   ObjectTest objectTest = ObjectTest::kObjectOrShader;
   ThinObjectTest thinObjects = ThinObjectTest::kEndDiffers;
-  /// The thin-object test with supersampled input (downsample >= 2): a work
-  /// pixel is 1/downsample^2 of an output pixel, so a pixel interpolated from
-  /// one end on its surface errs in a fraction of an output pixel only.
+  /// The thin-object test under the supersampled rules: a work pixel is
+  /// 1/downsample^2 of an output pixel, so a pixel interpolated from one end
+  /// on its surface errs in a fraction of an output pixel only.
   /// docs/AOV.md (session 9): on the Cycles views at 4x, 0.07-0.33 points
   /// fewer exact pixels than kEndDiffers at 45 dB; at final resolution it
   /// loses 1.0-1.7 dB at the same threshold (view b stays below 40 dB).
   ThinObjectTest thinObjectsSupersampled = ThinObjectTest::kNoneMatches;
-  /// The thin-object test for this much supersampling per axis.
-  ThinObjectTest ThinObjectsFor(int supersampling) const {
-    return supersampling >= 2 ? thinObjectsSupersampled : thinObjects;
+  /// The thin-object test in effect, with the supersampled rules or without.
+  ThinObjectTest ThinObjectsFor(bool supersampledRules) const {
+    return supersampledRules ? thinObjectsSupersampled : thinObjects;
   }
   /// An interior pixel that the thin-object test would make exact first
   /// tries this many neighbouring directions on each side of its block's
@@ -149,8 +149,7 @@ struct ReconstructionOptions {
   /// from known pixels of the same surface. Off: every border pixel exactly
   /// (the paper).
   bool adaptiveBorders = true;
-  /// Adaptive borders with supersampled input (downsample >= 2), finest
-  /// level: a side on every other lattice line (the lines the finest level
+  /// Adaptive borders under the supersampled rules, finest level: a side on every other lattice line (the lines the finest level
   /// adds) takes the pixels at its surface changes from the two neighbouring
   /// lines, a finest block away on either side, where each has an exact
   /// pixel of the same surface within this many pixels along the line (inside
@@ -163,8 +162,8 @@ struct ReconstructionOptions {
   /// about even with the threshold's trade and costs view c the 1 dB the 1x
   /// target has no room for. 0: off.
   int crossingFillReach = 2;
-  /// The crossing fill's reach for this much supersampling per axis (0: off).
-  int CrossingFillReachFor(int supersampling) const { return supersampling >= 2 ? crossingFillReach : 0; }
+  /// The crossing fill's reach in effect (0: off).
+  int CrossingFillReachFor(bool supersampledRules) const { return supersampledRules ? crossingFillReach : 0; }
 
   bool zeroOrderTest = true;   ///< simple/complex: exactly two changes along the border
   /// A block of at most twice the finest size whose border changes only
@@ -254,6 +253,15 @@ struct ReconstructionOptions {
   bool denoiseSamples = true;
 
   int downsample = 1;   ///< the working image is `downsample`x the output per axis
+  /// Whether the supersampled rules (contrastThresholdSupersampled,
+  /// thinObjectsSupersampled, crossingFillReach) apply: supersampled input
+  /// whose samples are not noisy. With noisy samples (a provider that
+  /// reports variance, noiseSignificance > 0) the noise regime's settings
+  /// hold at every supersampling: on the tracer's room at 2x with 16
+  /// estimates per pixel the supersampled rules took 12.5 % exact pixels for
+  /// 38.53 dB against a 256-spp render, the others 8.0 % for 38.47 dB
+  /// (docs/NOISE.md). dcm::UsesSupersampledRules decides it for a provider.
+  bool SupersampledRules(bool noisySamples) const { return downsample >= 2 && !noisySamples; }
   bool fullEvaluation = false;  ///< baseline: evaluate every pixel exactly
 
   int threads = 0;      ///< 0: all cores

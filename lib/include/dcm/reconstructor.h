@@ -62,6 +62,7 @@ struct ReconstructionStats {
   double timeProviderS = 0;  ///< in the provider's Evaluate() (the illumination)
   double timeEngineS = 0;    ///< everything else
   bool usedSplit = false, usedObjectId = false, usedShaderId = false, usedNormals = false;
+  bool usedSupersampledRules = false;  ///< ReconstructionOptions::SupersampledRules
   double exactFraction() const { return totalPixels ? double(exactPixels) / double(totalPixels) : 0.0; }
 };
 
@@ -75,6 +76,11 @@ struct Reconstruction {
   std::vector<BlockRecord> blocks;    ///< final leaf blocks
   ReconstructionStats stats;
 };
+
+/// Whether a reconstruction with `options` of a provider with `caps` uses the
+/// supersampled rules (ReconstructionOptions::SupersampledRules: supersampled
+/// input whose samples are not noisy).
+bool UsesSupersampledRules(const ReconstructionOptions& options, const ProviderCapabilities& caps);
 
 /// Reconstructs the provider's image with DCM. On error `out` is unspecified.
 /// With a provider that answers Status::Pending, returns that status and
