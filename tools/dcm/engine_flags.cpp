@@ -11,13 +11,15 @@ namespace dcm::cli {
 void AddEngineFlags(CLI::App* app, EngineFlags* f) {
   app->add_option("--method", f->method, "dcm (default), paper (Scheel et al. 2001) or guo (Guo 1998)")
       ->check(CLI::IsMember({"dcm", "paper", "guo"}));
-  app->add_option("--threshold", f->threshold, "contrast threshold of the smooth/edge test (default 0.14, 0.08 with --downsample 2 or more; paper|guo: 0.06)");
+  app->add_option("--threshold", f->threshold, "contrast threshold of the smooth/edge test (default 0.14, 0.08 with --downsample 2 or more and samples that are "
+                  "not noisy; paper|guo: 0.06)");
   app->add_option("--block", f->block, "elementary block size (power of two; default 16, 8 with noisy samples; --method paper|guo: 8)");
   app->add_option("--min-block", f->minBlock, "finest block size (power of two, default 4)");
   app->add_option("--directions", f->directions, "candidate directions of the least-discrepancy search (default 8)");
   app->add_flag("--no-thin", f->noThin, "switch off the thin-object test (paper 3.1)");
   app->add_option("--thin-test", f->thinTest,
-                  "off | none-matches | any-differs | end-differs (default; none-matches with --downsample 2 or more)");
+                  "off | none-matches | any-differs | end-differs (default; none-matches with --downsample 2 or more and samples "
+                  "that are not noisy)");
   app->add_option("--neighbour-directions", f->neighbourDirections,
                   "directions each side of its block's that an interior pixel tries, where both ends agree, before the "
                   "thin-object test makes it exact (default 4: every one of 8; paper|guo: 0)");
@@ -37,7 +39,7 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
   app->add_flag("--no-surface-aware", f->noSurfaceAware, "interpolate across surfaces (Guo)");
   app->add_flag("--no-adaptive-borders", f->noAdaptiveBorders, "evaluate every border pixel of edge blocks (the paper)");
   app->add_option("--crossing-fill", f->crossingFill,
-                  "with --downsample 2 or more: a finest side between two lattice lines of the level above takes its "
+                  "with --downsample 2 or more and samples that are not noisy: a finest side between two lattice lines of the level above takes its "
                   "surface-change pixels from exact pixels of the same surface on both lines within N pixels, where "
                   "they agree (default 2; 0: evaluate them all)");
   app->add_flag("--no-centre-probe", f->noCentreProbe, "no centre probe of the finest edge blocks");

@@ -141,8 +141,9 @@ DCM_API DCMError dcmGetError(DCMReconstructor r, const char** message);
  *                        it first;
  *   "object_test"        "none" | "id" | "id+shader";
  *   "thin_objects"       "off" | "none-matches" | "any-differs" | "end-differs";
- *   "thin_objects_supersampled"  the same, used instead with downsample >= 2
- *                        (default "none-matches");
+ *   "thin_objects_supersampled"  the same, used instead under the
+ *                        supersampled rules: downsample >= 2 and samples that
+ *                        are not noisy (default "none-matches");
  *   "contrast_metric"    "mitchell" | "display";
  *   "smooth_refinement"  "always" | "centre-probe" | "never".
  *  An unknown name or value records DCM_ERROR_INVALID_ARGUMENT. */
@@ -158,7 +159,7 @@ DCM_API void dcmSetString(DCMReconstructor r, const char* name, const char* valu
  *  surface changes, up to this many, counts as simple; 2: Guo's test),
  *  "neighbour_directions" (directions each side an interior pixel tries
  *  before the thin-object test makes it exact, default 4),
- *  "crossing_fill_reach" (with downsample >= 2: the finest sides between
+ *  "crossing_fill_reach" (under the supersampled rules: the finest sides between
  *  two lattice lines of the level above take their surface-change pixels
  *  from exact pixels of the same surface on both lines within this many
  *  pixels, where they agree; default 2, 0: off), "downsample",
@@ -168,8 +169,8 @@ DCM_API void dcmSetString(DCMReconstructor r, const char* name, const char* valu
 DCM_API void dcmSetInt(DCMReconstructor r, const char* name, int value);
 
 /** Sets a float option: "contrast_threshold" (default 0.14),
- *  "contrast_threshold_supersampled" (used instead with downsample >= 2,
- *  default 0.08), "noise_significance" (with a
+ *  "contrast_threshold_supersampled" (used instead under the supersampled
+ *  rules, default 0.08), "noise_significance" (with a
  *  provider that reports variance), "probe_lc_share" (a finest edge block
  *  whose border changes only at surface changes is probed only where L_c
  *  exceeds this share of L at some border pixel, default 0.5). Integer
