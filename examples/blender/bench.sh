@@ -27,18 +27,6 @@ views=("$@")
 require_tools bench.sh
 command -v oiiotool >/dev/null || { echo "bench.sh: no oiiotool (scripts/install-deps.sh)" >&2; exit 1; }
 
-# guided EXR VIEW RES: the render with its shadow and highlight guides
-# appended (one file per scene, as dcm bench takes them).
-guided() {
-  local render="$1" view="$2" res="$3" shadow="$out/shadow_guide_${2}_${3}.exr"
-  local highlight="$out/highlight_guide_${2}_${3}.exr" all="$out/guided_sh_${2}_${3}_${SAMPLES}.exr"
-  render_room "$render" "$view" "$res" "$SAMPLES" 3
-  render_shadow_guide "$shadow" "$view" "$res"
-  render_highlight_guide "$highlight" "$view" "$res"
-  [ -f "$all" ] || oiiotool "$render" "$shadow" "$highlight" --chappend --chappend -o "$all"
-  echo "$all"
-}
-
 inputs=()
 for v in "${views[@]}"; do inputs+=("$(guided "$out/noise_${v}_${SAMPLES}_s3.exr" "$v" 256)"); done
 "$DCM" bench "${inputs[@]}" --preset blender --out "$dest/1x"

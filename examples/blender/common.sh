@@ -50,3 +50,16 @@ render_highlight_guide() {
   [ -f "$1" ] && return 0
   make_and_render "$1" "$2" "$3" --highlight-guide --samples 16
 }
+
+# guided EXR VIEW RES: the render EXR (SAMPLES spp, seed 3) with its shadow
+# and highlight guides appended, one file per view as dcm bench takes it;
+# renders what is missing. Needs oiiotool.
+guided() {
+  local render="$1" view="$2" res="$3" shadow="$out/shadow_guide_${2}_${3}.exr"
+  local highlight="$out/highlight_guide_${2}_${3}.exr" all="$out/guided_sh_${2}_${3}_${SAMPLES}.exr"
+  render_room "$render" "$view" "$res" "$SAMPLES" 3
+  render_shadow_guide "$shadow" "$view" "$res"
+  render_highlight_guide "$highlight" "$view" "$res"
+  [ -f "$all" ] || oiiotool "$render" "$shadow" "$highlight" --chappend --chappend -o "$all"
+  echo "$all"
+}

@@ -105,7 +105,7 @@ struct ReconstructionOptions {
   /// The thin-object test under the supersampled rules: a work pixel is
   /// 1/downsample^2 of an output pixel, so a pixel interpolated from one end
   /// on its surface errs in a fraction of an output pixel only.
-  /// docs/AOV.md (session 9): on the Cycles views at 4x, 0.07-0.33 points
+  /// docs/AOV.md (session 9): on the Cycles views at 4x, 0.08-0.34 points
   /// fewer exact pixels than kEndDiffers at 45 dB; at final resolution it
   /// loses 1.0-1.7 dB at the same threshold (view b stays below 40 dB).
   ThinObjectTest thinObjectsSupersampled = ThinObjectTest::kNoneMatches;
