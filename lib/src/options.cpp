@@ -13,7 +13,7 @@ ReconstructionOptions ReconstructionOptions::Guo() {
   o.noisyElementaryBlock = 0;
   o.SetContrastThreshold(0.06f);
   o.objectTest = ObjectTest::kObjectId;
-  o.thinObjects = o.thinObjectsSupersampled = ThinObjectTest::kOff;
+  o.SetThinObjects(ThinObjectTest::kOff);
   o.neighbourDirections = 0;
   o.surfaceAware = false;
   o.textureSplit = false;
@@ -35,7 +35,7 @@ ReconstructionOptions ReconstructionOptions::Guo() {
 ReconstructionOptions ReconstructionOptions::Paper() {
   ReconstructionOptions o = Guo();
   o.objectTest = ObjectTest::kObjectAndShader;
-  o.thinObjects = o.thinObjectsSupersampled = ThinObjectTest::kNoneMatches;
+  o.SetThinObjects(ThinObjectTest::kNoneMatches);
   o.textureSplit = true;
   o.fallback = true;  // "switching back to a full sampling for these few critical cases"
   o.fallbackMaxChanges = 4;  // more than two edges: more than two objects on the border

@@ -383,7 +383,9 @@ TEST_P(PlanRoundTrip, SameImageAsDenseBitForBit) {
   EXPECT_EQ(ds["crossings_filled"], ss["crossings_filled"]);
   EXPECT_EQ(bool(ds["used"]["supersampled_rules"]), supersampling >= 2);
   // At 2x the fill is exercised (measured: 10 crossings beauty, 8 split).
-  if (supersampling >= 2) EXPECT_GT(int64_t(ds["crossings_filled"]), 0);
+  if (supersampling >= 2) {
+    EXPECT_GT(int64_t(ds["crossings_filled"]), 0);
+  }
   std::printf("plan round trip: %lld exact pixels, %lld crossings filled\n", (long long)int64_t(ds["exact_pixels"]),
               (long long)int64_t(ds["crossings_filled"]));
   // The renderer rendered exactly the exact pixels, each once.

@@ -99,8 +99,9 @@ int64_t CompareTiles(const Case& c, int count, int halo, bool expectOk) {
   // supersampled cases without noise fill crossings from the neighbouring
   // lattice lines.
   EXPECT_EQ(whole.stats.usedSupersampledRules, c.downsample >= 2 && !c.noisy) << c.name;
-  if (whole.stats.usedSupersampledRules && c.options.adaptiveBorders && c.options.crossingFillReach > 0)
+  if (whole.stats.usedSupersampledRules && c.options.adaptiveBorders && c.options.crossingFillReach > 0) {
     EXPECT_GT(whole.stats.crossingsFilled, 0) << c.name;
+  }
   int64_t differ = 0, exact = 0;
   std::vector<int> covered(size_t(whole.width) * size_t(whole.height), 0);
   const int align = std::max(1, c.options.elementaryBlock / std::max(1, c.options.downsample));

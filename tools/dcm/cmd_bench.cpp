@@ -206,8 +206,8 @@ struct Enhancement {
   void (*on)(ReconstructionOptions*);
 };
 const Enhancement kEnhancements[] = {
-    {"thinObjects", [](ReconstructionOptions* o) { o->thinObjects = o->thinObjectsSupersampled = ThinObjectTest::kOff; },
-     [](ReconstructionOptions* o) { o->thinObjects = o->thinObjectsSupersampled = ThinObjectTest::kNoneMatches; }},
+    {"thinObjects", [](ReconstructionOptions* o) { o->SetThinObjects(ThinObjectTest::kOff); },
+     [](ReconstructionOptions* o) { o->SetThinObjects(ThinObjectTest::kNoneMatches); }},
     {"neighbourDirections", [](ReconstructionOptions* o) { o->neighbourDirections = 0; },
      [](ReconstructionOptions* o) { o->neighbourDirections = ReconstructionOptions{}.neighbourDirections; }},
     {"objectTest", [](ReconstructionOptions* o) { o->objectTest = ObjectTest::kObjectId; },

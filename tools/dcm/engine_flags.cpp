@@ -90,10 +90,11 @@ Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {
   if (f.block) o->elementaryBlock = f.block, o->noisyElementaryBlock = 0;  // with noisy samples too
   if (f.minBlock) o->minBlock = f.minBlock;
   if (f.directions) o->directions = f.directions;
-  if (f.noThin) o->thinObjects = o->thinObjectsSupersampled = ThinObjectTest::kOff;
+  if (f.noThin) o->SetThinObjects(ThinObjectTest::kOff);
   if (!f.thinTest.empty()) {
-    DCM_RETURN_IF_ERROR(Parse(f.thinTest, &o->thinObjects));
-    o->thinObjectsSupersampled = o->thinObjects;  // at every supersampling
+    ThinObjectTest t;
+    DCM_RETURN_IF_ERROR(Parse(f.thinTest, &t));
+    o->SetThinObjects(t);
   }
   if (f.neighbourDirections >= 0) o->neighbourDirections = f.neighbourDirections;
   if (f.fallbackShadingChanges >= -1) o->fallbackShadingChanges = f.fallbackShadingChanges;

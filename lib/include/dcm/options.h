@@ -113,6 +113,8 @@ struct ReconstructionOptions {
   ThinObjectTest ThinObjectsFor(bool supersampledRules) const {
     return supersampledRules ? thinObjectsSupersampled : thinObjects;
   }
+  /// Sets the test with the supersampled rules and without (--thin-test).
+  void SetThinObjects(ThinObjectTest t) { thinObjects = thinObjectsSupersampled = t; }
   /// An interior pixel that the thin-object test would make exact first
   /// tries this many neighbouring directions on each side of its block's
   /// (the nearer first, +pi/K before -pi/K) and is interpolated along the
@@ -149,9 +151,9 @@ struct ReconstructionOptions {
   /// from known pixels of the same surface. Off: every border pixel exactly
   /// (the paper).
   bool adaptiveBorders = true;
-  /// Adaptive borders under the supersampled rules, finest level: a side on every other lattice line (the lines the finest level
-  /// adds) takes the pixels at its surface changes from the two neighbouring
-  /// lines, a finest block away on either side, where each has an exact
+  /// Adaptive borders under the supersampled rules, finest level: a side on
+  /// every other lattice line (the lines the finest level adds) takes the
+  /// pixels at its surface changes from the two neighbouring lines, a finest block away on either side, where each has an exact
   /// pixel of the same surface within this many pixels along the line (inside
   /// the side's extent) and the two agree; the others are evaluated. An edge
   /// crossing three lattice lines is then sampled on the outer two and
