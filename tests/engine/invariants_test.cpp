@@ -130,56 +130,46 @@ TEST(Invariants, PendingProviderGetsTheFirstRoundOfRequests) {
   EXPECT_EQ(pending.size(), 6u);
 }
 
-TEST(Invariants, InvalidOptionsNameTheField) {
-  AnalyticProvider p(8, 8, Constant(RGB::Gray(1)));
+/// Options that `set` makes invalid are rejected with a message naming
+/// `field` (and containing `got`, the value, when given).
+template <typename Set>
+void ExpectRejected(SampleProvider& p, Set set, const std::string& field, const std::string& got = "") {
   ReconstructionOptions o;
-  o.minBlock = 2 * o.elementaryBlock;
+  set(o);
   Reconstruction r;
   const Status s = Reconstruct(p, o, &r);
-  ASSERT_FALSE(s.ok());
-  EXPECT_NE(s.message().find("minBlock"), std::string::npos) << s.message();
+  ASSERT_FALSE(s.ok()) << field;
+  EXPECT_NE(s.message().find(field), std::string::npos) << s.message();
+  if (!got.empty()) {
+    EXPECT_NE(s.message().find(got), std::string::npos) << s.message();
+  }
+}
+
+TEST(Invariants, InvalidOptionsNameTheField) {
+  AnalyticProvider p(8, 8, Constant(RGB::Gray(1)));
+  ExpectRejected(p, [](ReconstructionOptions& o) { o.minBlock = 2 * o.elementaryBlock; }, "minBlock");
   // A negative count of directions is no count; more than half the
   // directions is every direction (whatever their number), up to 32.
+  ExpectRejected(p, [](ReconstructionOptions& o) { o.neighbourDirections = -1; }, "neighbourDirections", "got -1");
+  ExpectRejected(p, [](ReconstructionOptions& o) { o.neighbourDirections = 33; }, "neighbourDirections");
   ReconstructionOptions turns;
-  turns.neighbourDirections = -1;
-  const Status t = Reconstruct(p, turns, &r);
-  ASSERT_FALSE(t.ok());
-  EXPECT_NE(t.message().find("neighbourDirections"), std::string::npos) << t.message();
-  EXPECT_NE(t.message().find("got -1"), std::string::npos) << t.message();
-  turns.neighbourDirections = 33;
-  EXPECT_FALSE(Reconstruct(p, turns, &r).ok());
   turns.neighbourDirections = 32;
   turns.directions = 4;
+  Reconstruction r;
   EXPECT_TRUE(Reconstruct(p, turns, &r).ok());
-  ReconstructionOptions share;
-  share.probeLcShare = -0.5f;
-  const Status u = Reconstruct(p, share, &r);
-  ASSERT_FALSE(u.ok());
-  EXPECT_NE(u.message().find("probeLcShare"), std::string::npos) << u.message();
-  ReconstructionOptions changes;
-  changes.simpleSurfaceChanges = 1;  // fewer than the one edge Guo's test accepts
-  const Status v = Reconstruct(p, changes, &r);
-  ASSERT_FALSE(v.ok());
-  EXPECT_NE(v.message().find("simpleSurfaceChanges"), std::string::npos) << v.message();
-  EXPECT_NE(v.message().find("got 1"), std::string::npos) << v.message();
-  ReconstructionOptions shading;
-  shading.fallbackShadingChanges = -2;  // -1 is "every change counts"; below it means nothing
-  const Status w = Reconstruct(p, shading, &r);
-  ASSERT_FALSE(w.ok());
-  EXPECT_NE(w.message().find("fallbackShadingChanges"), std::string::npos) << w.message();
-  EXPECT_NE(w.message().find("got -2"), std::string::npos) << w.message();
-  ReconstructionOptions reach;
-  reach.crossingFillReach = -1;
-  const Status x = Reconstruct(p, reach, &r);
-  ASSERT_FALSE(x.ok());
-  EXPECT_NE(x.message().find("crossingFillReach"), std::string::npos) << x.message();
-  EXPECT_NE(x.message().find("got -1"), std::string::npos) << x.message();
+  ExpectRejected(p, [](ReconstructionOptions& o) { o.probeLcShare = -0.5f; }, "probeLcShare");
+  // Fewer than the one edge Guo's test accepts.
+  ExpectRejected(p, [](ReconstructionOptions& o) { o.simpleSurfaceChanges = 1; }, "simpleSurfaceChanges", "got 1");
+  // -1 is "every change counts"; below it means nothing.
+  ExpectRejected(p, [](ReconstructionOptions& o) { o.fallbackShadingChanges = -2; }, "fallbackShadingChanges",
+                 "got -2");
+  ExpectRejected(p, [](ReconstructionOptions& o) { o.crossingFillReach = -1; }, "crossingFillReach", "got -1");
   // Checked at every supersampling, whichever threshold the run uses.
-  ReconstructionOptions supersampled;
-  supersampled.contrastThresholdSupersampled = std::numeric_limits<float>::quiet_NaN();
-  const Status y = Reconstruct(p, supersampled, &r);
-  ASSERT_FALSE(y.ok());
-  EXPECT_NE(y.message().find("contrastThresholdSupersampled"), std::string::npos) << y.message();
+  ExpectRejected(p,
+                 [](ReconstructionOptions& o) {
+                   o.contrastThresholdSupersampled = std::numeric_limits<float>::quiet_NaN();
+                 },
+                 "contrastThresholdSupersampled");
 }
 
 }  // namespace
