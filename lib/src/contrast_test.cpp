@@ -64,6 +64,10 @@ float ContrastTest::Contrast(std::span<const Value> values) const {
     const float total = std::fabs(T.hi) + std::fabs(T.lo);
     if (total > 1e-12f) c = std::max(c, (B.hi - B.lo) / total);
   }
+  if (metric_ == ContrastMetric::kDisplayWeighted) {
+    static const float kMidGrey = SrgbRelativeSlope(0.18f);
+    c *= SrgbRelativeSlope(0.5f * (std::fabs(T.hi) + std::fabs(T.lo))) / kMidGrey;
+  }
   return c;
 }
 

@@ -75,8 +75,10 @@ constexpr std::array<std::pair<std::string_view, ObjectTest>, 4> kObjectTests{{
 constexpr std::array<std::pair<std::string_view, ThinObjectTest>, 4> kThinTests{{
     {"off", ThinObjectTest::kOff}, {"none-matches", ThinObjectTest::kNoneMatches},
     {"any-differs", ThinObjectTest::kAnyDiffers}, {"end-differs", ThinObjectTest::kEndDiffers}}};
-constexpr std::array<std::pair<std::string_view, ContrastMetric>, 2> kMetrics{{
-    {"mitchell", ContrastMetric::kMitchell}, {"display", ContrastMetric::kDisplay}}};
+constexpr std::array<std::pair<std::string_view, ContrastMetric>, 3> kMetrics{{
+    {"mitchell", ContrastMetric::kMitchell},
+    {"display", ContrastMetric::kDisplay},
+    {"display-weighted", ContrastMetric::kDisplayWeighted}}};
 constexpr std::array<std::pair<std::string_view, SmoothRefinement>, 3> kRefinements{{
     {"always", SmoothRefinement::kAlways}, {"centre-probe", SmoothRefinement::kCentreProbe},
     {"never", SmoothRefinement::kNever}}};

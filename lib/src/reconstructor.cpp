@@ -305,7 +305,7 @@ Status Engine::LoadGuides() {
       if (!IsFinite(g.texture[size_t(i)]))
         store_.Request(int(i % caps_.width), int(i / caps_.width), SampleReason::kFallback);
   store_.SetGuides(std::move(g), want.objectId ? opt_.objectTest : ObjectTest::kNone,
-                   want.normal ? opt_.creaseAngle : 0.f, block_);
+                   want.normal ? opt_.WorkCreaseAngle() : 0.f, block_);
   return Status::Ok();
 }
 

@@ -31,7 +31,7 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
                   "no surface change (default 2: one shading edge; -1, paper: every such block)");
   app->add_flag("--no-texture-split", f->noTextureSplit, "interpolate L instead of (L_i, L_c) (paper 3.3)");
   app->add_option("--object-test", f->objectTest, "none | id | id+shader (paper 3.2) | id|shader");
-  app->add_option("--contrast", f->contrast, "mitchell | display");
+  app->add_option("--contrast", f->contrast, "mitchell | display | display-weighted");
   app->add_flag("--no-lazy", f->noLazy, "full border evaluation for children of simple edge blocks");
   app->add_flag("--no-fallback", f->noFallback, "never fall back to exact evaluation of a block interior");
   app->add_flag("--fallback-filled-borders", f->fallbackFilledBorders,

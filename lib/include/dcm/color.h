@@ -37,6 +37,16 @@ inline float SrgbEncode(float linear) {
   return 1.055f * std::pow(linear, 1.f / 2.4f) - 0.055f;
 }
 
+/// How much a relative change of a linear value moves its sRGB encoding:
+/// x * d(SrgbEncode)/dx at x clipped to [0,1] (0 at and below 0; above 1
+/// the slope at 1, the brightest value a display shows).
+inline float SrgbRelativeSlope(float linear) {
+  if (!(linear > 0.f)) return 0.f;
+  if (linear > 1.f) linear = 1.f;
+  if (linear <= 0.0031308f) return 12.92f * linear;
+  return 1.055f / 2.4f * std::pow(linear, 1.f / 2.4f);
+}
+
 /// True when all three channels are finite (no NaN, no infinity).
 inline bool IsFinite(RGB c) {
   return std::isfinite(c.r) && std::isfinite(c.g) && std::isfinite(c.b);

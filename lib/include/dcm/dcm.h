@@ -144,7 +144,7 @@ DCM_API DCMError dcmGetError(DCMReconstructor r, const char** message);
  *   "thin_objects_supersampled"  the same, used instead under the
  *                        supersampled rules: downsample >= 2 and samples that
  *                        are not noisy (default "none-matches");
- *   "contrast_metric"    "mitchell" | "display";
+ *   "contrast_metric"    "mitchell" | "display" | "display-weighted";
  *   "smooth_refinement"  "always" | "centre-probe" | "never".
  *  An unknown name or value records DCM_ERROR_INVALID_ARGUMENT. */
 DCM_API void dcmSetString(DCMReconstructor r, const char* name, const char* value);
