@@ -421,6 +421,8 @@ DCM_API void dcmSetString(DCMReconstructor r, const char* name, const char* valu
       st = dcm::Parse(v, &r->options.thinObjectsSupersampled);
     } else if (n == "contrast_metric") {
       st = dcm::Parse(v, &r->options.contrastMetric);
+    } else if (n == "contrast_metric_supersampled") {
+      st = dcm::Parse(v, &r->options.contrastMetricSupersampled);
     } else if (n == "smooth_refinement") {
       st = dcm::Parse(v, &r->options.smoothRefinement);
     } else {

@@ -12,6 +12,7 @@ ReconstructionOptions ReconstructionOptions::Guo() {
   o.elementaryBlock = 8;  // Guo's and the paper's elementary blocks
   o.noisyElementaryBlock = 0;
   o.SetContrastThreshold(0.06f);
+  o.SetContrastMetric(ContrastMetric::kMitchell);
   o.objectTest = ObjectTest::kObjectId;
   o.SetThinObjects(ThinObjectTest::kOff);
   o.neighbourDirections = 0;

@@ -104,7 +104,7 @@ class Engine {
         thinTest_(opt.ThinObjectsFor(supersampledRules_)),
         crossingFillReach_(opt.CrossingFillReachFor(supersampledRules_)),
         store_(caps.width, caps.height, split, noisy_),
-        contrast_(opt.contrastMetric, opt.ContrastThresholdFor(supersampledRules_), split, noisy_ ? opt.noiseSignificance : 0.f) {
+        contrast_(opt.ContrastMetricFor(supersampledRules_), opt.ContrastThresholdFor(supersampledRules_), split, noisy_ ? opt.noiseSignificance : 0.f) {
     const int blocksPerTile = std::max(1, opt.tileSize / std::max(1, block_));
     grain_ = size_t(blocksPerTile) * size_t(blocksPerTile);
     request_.split = split;

@@ -58,10 +58,11 @@ TEST(DcmRender, ReachesHighPsnrWithAFractionOfThePixels) {
   RecordProperty("psnr", std::to_string(e.psnr));
   RecordProperty("exact_fraction", std::to_string(dcm.stats.exactFraction()));
   std::printf("DCM: %.2f dB at %.1f %% exact pixels\n", e.psnr, 100.0 * dcm.stats.exactFraction());
-  // Thresholds from measurement with margin: this scene gives 54.7 dB at 23.8 %
-  // exact pixels (a tiny image is mostly block borders). 45 dB leaves room for
-  // engine tuning while a wrong split, tau or guide costs far more than 10 dB.
-  EXPECT_GT(e.psnr, 45.0);
+  // Thresholds from measurement with margin: this scene (2x supersampled,
+  // the display-weighted contrast at 0.12) gives 44.2 dB at 6.3 % exact
+  // pixels (Mitchell's contrast at 0.12: 45.3 dB at 11.1 %). 40 dB leaves
+  // room for engine tuning while a wrong split, tau or guide costs far more.
+  EXPECT_GT(e.psnr, 40.0);
   EXPECT_LT(dcm.stats.exactFraction(), 0.4);
   EXPECT_EQ(full.stats.exactFraction(), 1.0);
   EXPECT_EQ(e.nonFinite, 0);

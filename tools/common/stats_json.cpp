@@ -32,6 +32,7 @@ nlohmann::json OptionsToJson(const ReconstructionOptions& o) {
   j["contrast_threshold"] = Decimal(o.contrastThreshold);
   j["contrast_threshold_supersampled"] = Decimal(o.contrastThresholdSupersampled);
   j["contrast_metric"] = std::string(ToString(o.contrastMetric));
+  j["contrast_metric_supersampled"] = std::string(ToString(o.contrastMetricSupersampled));
   j["directions"] = o.directions;
   j["object_test"] = std::string(ToString(o.objectTest));
   j["thin_objects"] = std::string(ToString(o.thinObjects));

@@ -216,6 +216,8 @@ const Enhancement kEnhancements[] = {
      [](ReconstructionOptions* o) { o->textureSplit = true; }},
     {"adaptiveBorders", [](ReconstructionOptions* o) { o->adaptiveBorders = false; },
      [](ReconstructionOptions* o) { o->adaptiveBorders = true; }},
+    {"displayWeightedContrast", [](ReconstructionOptions* o) { o->SetContrastMetric(ContrastMetric::kMitchell); },
+     [](ReconstructionOptions* o) { o->SetContrastMetric(ContrastMetric::kDisplayWeighted); }},
     {"crossingFill", [](ReconstructionOptions* o) { o->crossingFillReach = 0; },
      [](ReconstructionOptions* o) { o->crossingFillReach = ReconstructionOptions{}.crossingFillReach; }},
     {"smoothRefinement", [](ReconstructionOptions* o) { o->smoothRefinement = SmoothRefinement::kAlways; },

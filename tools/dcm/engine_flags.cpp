@@ -11,7 +11,7 @@ namespace dcm::cli {
 void AddEngineFlags(CLI::App* app, EngineFlags* f) {
   app->add_option("--method", f->method, "dcm (default), paper (Scheel et al. 2001) or guo (Guo 1998)")
       ->check(CLI::IsMember({"dcm", "paper", "guo"}));
-  app->add_option("--threshold", f->threshold, "contrast threshold of the smooth/edge test (default 0.14, 0.08 with --downsample 2 or more and samples that are "
+  app->add_option("--threshold", f->threshold, "contrast threshold of the smooth/edge test (default 0.14, 0.12 with --downsample 2 or more and samples that are "
                   "not noisy; paper|guo: 0.06)");
   app->add_option("--block", f->block, "elementary block size (power of two; default 16, 8 with noisy samples; --method paper|guo: 8)");
   app->add_option("--min-block", f->minBlock, "finest block size (power of two, default 4)");
@@ -31,7 +31,9 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
                   "no surface change (default 2: one shading edge; -1, paper: every such block)");
   app->add_flag("--no-texture-split", f->noTextureSplit, "interpolate L instead of (L_i, L_c) (paper 3.3)");
   app->add_option("--object-test", f->objectTest, "none | id | id+shader (paper 3.2) | id|shader");
-  app->add_option("--contrast", f->contrast, "mitchell | display | display-weighted");
+  app->add_option("--contrast", f->contrast,
+                  "mitchell | display | display-weighted (default mitchell; display-weighted with --downsample 2 or more and samples that "
+                  "are not noisy; docs/ENGINE.md)");
   app->add_flag("--no-lazy", f->noLazy, "full border evaluation for children of simple edge blocks");
   app->add_flag("--no-fallback", f->noFallback, "never fall back to exact evaluation of a block interior");
   app->add_flag("--fallback-filled-borders", f->fallbackFilledBorders,
@@ -78,7 +80,8 @@ std::string SettingsSummary(const ReconstructionOptions& o, const ProviderCapabi
   const std::string why = rules ? "supersampled rules: --downsample " + std::to_string(o.downsample)
                           : o.downsample >= 2 ? "noisy samples: the supersampled rules are off"
                                               : "final resolution";
-  return std::string("threshold ") + threshold + ", thin-object test " + std::string(ToString(o.ThinObjectsFor(rules))) +
+  return std::string("contrast ") + std::string(ToString(o.ContrastMetricFor(rules))) + ", threshold " + threshold +
+         ", thin-object test " + std::string(ToString(o.ThinObjectsFor(rules))) +
          ", crossing fill " + std::to_string(o.CrossingFillReachFor(rules)) + " (" + why + ")";
 }
 
@@ -101,7 +104,11 @@ Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {
   if (f.simpleSurfaceChanges) o->simpleSurfaceChanges = f.simpleSurfaceChanges;
   if (f.noTextureSplit) o->textureSplit = false;
   if (!f.objectTest.empty()) DCM_RETURN_IF_ERROR(Parse(f.objectTest, &o->objectTest));
-  if (!f.contrast.empty()) DCM_RETURN_IF_ERROR(Parse(f.contrast, &o->contrastMetric));
+  if (!f.contrast.empty()) {
+    ContrastMetric m;
+    DCM_RETURN_IF_ERROR(Parse(f.contrast, &m));
+    o->SetContrastMetric(m);
+  }
   if (f.noLazy) o->lazyEvaluation = false;
   if (f.noFallback) o->fallback = false;
   if (f.fallbackFilledBorders) o->fallbackFilledBorders = true;

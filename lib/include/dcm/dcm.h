@@ -145,6 +145,8 @@ DCM_API DCMError dcmGetError(DCMReconstructor r, const char** message);
  *                        supersampled rules: downsample >= 2 and samples that
  *                        are not noisy (default "none-matches");
  *   "contrast_metric"    "mitchell" | "display" | "display-weighted";
+ *   "contrast_metric_supersampled"  the same, used instead under the
+ *                        supersampled rules (default "display-weighted");
  *   "smooth_refinement"  "always" | "centre-probe" | "never".
  *  An unknown name or value records DCM_ERROR_INVALID_ARGUMENT. */
 DCM_API void dcmSetString(DCMReconstructor r, const char* name, const char* value);
@@ -170,7 +172,7 @@ DCM_API void dcmSetInt(DCMReconstructor r, const char* name, int value);
 
 /** Sets a float option: "contrast_threshold" (default 0.14),
  *  "contrast_threshold_supersampled" (used instead under the supersampled
- *  rules, default 0.08), "noise_significance" (with a
+ *  rules, default 0.12), "noise_significance" (with a
  *  provider that reports variance), "probe_lc_share" (a finest edge block
  *  whose border changes only at surface changes is probed only where L_c
  *  exceeds this share of L at some border pixel, default 0.5). Integer
