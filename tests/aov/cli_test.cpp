@@ -168,7 +168,8 @@ TEST(DcmReconstruct, SupersampledInputHasItsOwnDefaults) {
   const ReconstructionOptions defaults;
   auto said = [](const ReconstructionOptions& o, bool rules, const std::string& why) {
     std::ostringstream s;
-    s << "threshold " << o.ContrastThresholdFor(rules) << ", thin-object test " << ToString(o.ThinObjectsFor(rules))
+    s << "contrast " << ToString(o.ContrastMetricFor(rules)) << ", threshold " << o.ContrastThresholdFor(rules)
+      << ", thin-object test " << ToString(o.ThinObjectsFor(rules))
       << ", crossing fill " << o.CrossingFillReachFor(rules) << " (" << why << ")";
     return s.str();
   };
@@ -180,6 +181,8 @@ TEST(DcmReconstruct, SupersampledInputHasItsOwnDefaults) {
   EXPECT_THAT(x2Err, HasSubstr(said(defaults, true, "supersampled rules: --downsample 2")));
   EXPECT_FLOAT_EQ(float(x2["options"]["contrast_threshold_supersampled"]), defaults.contrastThresholdSupersampled);
   EXPECT_EQ(x2["options"]["thin_objects_supersampled"], std::string(ToString(defaults.thinObjectsSupersampled)));
+  EXPECT_EQ(x2["options"]["contrast_metric_supersampled"], std::string(ToString(defaults.contrastMetricSupersampled)));
+  EXPECT_NE(defaults.contrastMetricSupersampled, defaults.contrastMetric);
   EXPECT_EQ(x2["options"]["crossing_fill_reach"], defaults.crossingFillReach);
   // Noisy samples (a variance channel): the noise regime's settings.
   const auto [noisy, noisyErr] = run("noisy.exr", {"--downsample", "2"});
@@ -188,10 +191,12 @@ TEST(DcmReconstruct, SupersampledInputHasItsOwnDefaults) {
   EXPECT_THAT(noisyErr, HasSubstr(said(defaults, false, "noisy samples: the supersampled rules are off")));
   // The flags set both regimes.
   const auto [set, setErr] =
-      run("in.exr", {"--downsample", "2", "--threshold", "0.1", "--thin-test", "any-differs", "--crossing-fill", "0"});
+      run("in.exr", {"--downsample", "2", "--threshold", "0.1", "--thin-test", "any-differs", "--crossing-fill", "0",
+                     "--contrast", "display"});
   for (const char* f : {"contrast_threshold", "contrast_threshold_supersampled"})
     EXPECT_FLOAT_EQ(float(set["options"][f]), 0.1f) << f;
   for (const char* f : {"thin_objects", "thin_objects_supersampled"}) EXPECT_EQ(set["options"][f], "any-differs") << f;
+  for (const char* f : {"contrast_metric", "contrast_metric_supersampled"}) EXPECT_EQ(set["options"][f], "display") << f;
   EXPECT_EQ(set["options"]["crossing_fill_reach"], 0);
   EXPECT_EQ(set["crossings_filled"], 0);
 }

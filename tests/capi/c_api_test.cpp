@@ -106,6 +106,10 @@ TEST(CApi, MethodPresetsResetEveryOption) {
   DCMError bad;
   EXPECT_NE(TakeError(r, &bad).find("thin-object test"), std::string::npos);
   EXPECT_EQ(bad, DCM_ERROR_INVALID_ARGUMENT);
+  dcmSetString(r, "contrast_metric_supersampled", "mitchell");
+  dcmSetString(r, "contrast_metric_supersampled", "loud");
+  EXPECT_NE(TakeError(r, &bad).find("contrast metric: unknown value 'loud'"), std::string::npos);
+  EXPECT_EQ(bad, DCM_ERROR_INVALID_ARGUMENT);
   dcmSetString(r, "method", "paper");
   EXPECT_EQ(dcmGetBool(r, "checkerboard"), 0);
   EXPECT_EQ(dcmGetInt(r, "simple_surface_changes"), 2);
