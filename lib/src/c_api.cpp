@@ -231,6 +231,7 @@ class CallbackProvider final : public dcm::SampleProvider {
     c.splitRadiance = (r_.sampleFlags & DCM_SAMPLE_SPLIT) != 0;
     c.variance = r_.noisySample != nullptr;
     c.threadSafe = (r_.sampleFlags & DCM_SAMPLE_THREAD_SAFE) != 0;
+    c.hardShadowsGuided = (r_.sampleFlags & DCM_SAMPLE_HARD_SHADOWS_GUIDED) != 0;
     c.name = "C API sample function";
     return c;
   }
@@ -338,7 +339,7 @@ void SetSampleFunctions(DCMReconstructor r, const char* function, DCMSampleFunct
                         DCMNoisySampleFunction noisy, void* user, int flags) noexcept {
   try {
     if (!r) return SetError(nullptr, DCM_ERROR_INVALID_ARGUMENT, std::string(function) + ": NULL reconstructor");
-    if (flags & ~(DCM_SAMPLE_THREAD_SAFE | DCM_SAMPLE_SPLIT))
+    if (flags & ~(DCM_SAMPLE_THREAD_SAFE | DCM_SAMPLE_SPLIT | DCM_SAMPLE_HARD_SHADOWS_GUIDED))
       return SetError(r, DCM_ERROR_INVALID_ARGUMENT, std::string(function) + ": unknown flags");
   } catch (...) {  // the message could not be built
     return SetError(r, DCM_ERROR_OUT_OF_MEMORY, "out of memory");

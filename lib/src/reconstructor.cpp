@@ -103,6 +103,7 @@ class Engine {
         supersampledRules_(opt.SupersampledRules(noisy_)),
         thinTest_(opt.ThinObjectsFor(supersampledRules_)),
         crossingFillReach_(opt.CrossingFillReachFor(supersampledRules_)),
+        smoothRefinement_(UsedSmoothRefinement(opt, caps)),
         store_(caps.width, caps.height, split, noisy_),
         contrast_(opt.ContrastMetricFor(supersampledRules_), opt.ContrastThresholdFor(supersampledRules_), split, noisy_ ? opt.noiseSignificance : 0.f) {
     const int blocksPerTile = std::max(1, opt.tileSize / std::max(1, block_));
@@ -195,6 +196,7 @@ class Engine {
   bool supersampledRules_;   ///< ReconstructionOptions::SupersampledRules
   ThinObjectTest thinTest_;  ///< ReconstructionOptions::ThinObjectsFor the rules
   int crossingFillReach_;    ///< ReconstructionOptions::CrossingFillReachFor the rules
+  SmoothRefinement smoothRefinement_;  ///< UsedSmoothRefinement: kNever where the guides show the hard shadows
   SampleStore store_;
   ContrastTest contrast_;
   SampleRequest request_;
@@ -688,10 +690,9 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
         const Block& b = classify[i];
         if (!smooth[i]) {
           edges.push_back(b);
-        } else if (finest || (b.width() <= 1 && b.height() <= 1) ||
-                   opt_.smoothRefinement == SmoothRefinement::kNever) {
+        } else if (finest || (b.width() <= 1 && b.height() <= 1) || smoothRefinement_ == SmoothRefinement::kNever) {
           smoothLeaves_.push_back(MakeLeaf(b, BlockType::kSmooth));
-        } else if (opt_.smoothRefinement == SmoothRefinement::kAlways) {
+        } else if (smoothRefinement_ == SmoothRefinement::kAlways) {
           ChildBlocks(b, size / 2, W, H, &nextClassify);
           splitSmooth.push_back(b);
         } else {
@@ -966,6 +967,11 @@ void Engine::RecordLeaves(Reconstruction* out) {
 
 bool UsesSupersampledRules(const ReconstructionOptions& options, const ProviderCapabilities& caps) {
   return options.SupersampledRules(detail::NoisySamples(options, caps));
+}
+
+SmoothRefinement UsedSmoothRefinement(const ReconstructionOptions& options, const ProviderCapabilities& caps) {
+  const SmoothRefinement r = options.smoothRefinement;
+  return r == SmoothRefinement::kCentreProbe && caps.hardShadowsGuided ? SmoothRefinement::kNever : r;
 }
 
 Status Reconstruct(SampleProvider& provider, const ReconstructionOptions& options, Reconstruction* out,

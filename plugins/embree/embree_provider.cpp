@@ -109,6 +109,8 @@ ProviderCapabilities EmbreeProvider::Capabilities() const {
   c.texture = effects_.textures;
   c.splitRadiance = effects_.textures;
   c.variance = scene_.render.samplesPerPixel > 1;
+  // Point lights cast the only hard shadows; the shadow guide marks them.
+  c.hardShadowsGuided = !effects_.pointLights || effects_.shadowGuide;
   c.threadSafe = true;
   c.name = "embree";
   return c;

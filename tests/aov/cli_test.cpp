@@ -176,6 +176,9 @@ TEST(DcmReconstruct, SupersampledInputHasItsOwnDefaults) {
   const auto [final1, final1Err] = run("in.exr", {});
   EXPECT_FALSE(bool(final1["used"]["supersampled_rules"]));
   EXPECT_THAT(final1Err, HasSubstr(said(defaults, false, "final resolution")));
+  // No shadow guide: the smooth blocks keep their centre probes.
+  EXPECT_FALSE(bool(final1["capabilities"]["hard_shadows_guided"]));
+  EXPECT_THAT(final1Err, HasSubstr("smooth blocks: centre-probe\n"));
   const auto [x2, x2Err] = run("in.exr", {"--downsample", "2"});
   EXPECT_TRUE(bool(x2["used"]["supersampled_rules"]));
   EXPECT_THAT(x2Err, HasSubstr(said(defaults, true, "supersampled rules: --downsample 2")));

@@ -170,6 +170,8 @@ TEST(AovProvider, ShadowGuideSplitsLitAndUnlitSurfaces) {
   bool said = false;
   for (const auto& n : p->Notes()) said |= n.find("shadow guide: shadow") != std::string::npos;
   EXPECT_TRUE(said);
+  // The guide shows the hard shadows: no centre probes of smooth blocks.
+  EXPECT_TRUE(p->Capabilities().hardShadowsGuided);
 
   WriteExr(dir / "beauty.exr", 16, 8, {ch[2], ch[3], ch[4], ch.back()});
   auto q = MustOpen({dir / "beauty.exr"});

@@ -503,3 +503,20 @@ TEST(CApi, LevelFunctionGivesProgressiveImages) {
   EXPECT_EQ(levels.last, std::vector<float>(rgb, rgb + 3 * w * h));
   dcmReleaseReconstructor(r);
 }
+
+namespace {
+
+// DCM_SAMPLE_HARD_SHADOWS_GUIDED: the host's guides show every hard shadow,
+// so the smooth blocks get no centre probes; fewer exact pixels on the same
+// two flat surfaces, none of them a probe's.
+TEST(CApi, HardShadowsGuidedSkipsTheCentreProbes) {
+  Scene a, b;
+  DCMReconstructor probed = Make(a), guided = Make(b, DCM_SAMPLE_THREAD_SAFE | DCM_SAMPLE_HARD_SHADOWS_GUIDED);
+  ASSERT_EQ(dcmExecute(probed), DCM_ERROR_NONE) << TakeError(probed);
+  ASSERT_EQ(dcmExecute(guided), DCM_ERROR_NONE) << TakeError(guided);
+  EXPECT_LT(dcmGetStat(guided, "exact_pixels"), dcmGetStat(probed, "exact_pixels"));
+  dcmReleaseReconstructor(probed);
+  dcmReleaseReconstructor(guided);
+}
+
+}  // namespace

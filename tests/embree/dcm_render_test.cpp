@@ -96,6 +96,8 @@ TEST(DcmRender, ShadowGuideFindsShadowsSmallerThanTheLattice) {
     auto p = MakeProvider(scene(guide));
     ASSERT_TRUE(p);
     ASSERT_EQ(p->effects().shadowGuide, guide);
+    // A point light: its hard shadows show in the guides only with the guide.
+    EXPECT_EQ(p->Capabilities().hardShadowsGuided, guide);
     ReconstructionOptions o = Options(*p);
     Reconstruction dcm, full;
     ASSERT_TRUE(Reconstruct(*p, o, &dcm).ok());

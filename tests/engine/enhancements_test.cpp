@@ -683,3 +683,40 @@ TEST(ObjectTest, NoIdsMeansContrastOnly) {
 
 }  // namespace
 }  // namespace dcm::testing
+
+namespace dcm::testing {
+namespace {
+
+// A provider whose guides show every hard shadow gets no centre probes of
+// smooth blocks: on a flat 64x64 image, the 16 probes of the level-0 blocks
+// (one per 16x16 block) are exactly what it saves. A shadow dot of 3 pixels
+// at a block's centre that the guides do not show (a provider that claims
+// the capability wrongly) is then missed; with the probe it is found.
+TEST(SmoothRefinement, NoCentreProbesWhereTheGuidesShowTheHardShadows) {
+  constexpr int N = 64;
+  auto dot = [](int x, int y) { return std::abs(x - 40) <= 1 && std::abs(y - 40) <= 1; };
+  const SceneFunction scene = [&](int x, int y) {
+    PixelTruth t;
+    t.Li = RGB::Gray(dot(x, y) ? 0.05f : 0.5f);
+    return t;
+  };
+  AnalyticChannels probed, guided;
+  guided.hardShadowsGuided = true;
+  AnalyticProvider withProbes(N, N, scene, probed), withoutProbes(N, N, scene, guided);
+  const Reconstruction a = ReconstructOrFail(withProbes, {}), b = ReconstructOrFail(withoutProbes, {});
+  EXPECT_EQ(UsedSmoothRefinement({}, withProbes.Capabilities()), SmoothRefinement::kCentreProbe);
+  EXPECT_EQ(UsedSmoothRefinement({}, withoutProbes.Capabilities()), SmoothRefinement::kNever);
+  const auto corner = size_t(SampleReason::kCorner);
+  EXPECT_EQ(b.stats.byReason[corner], 25);  // the 5x5 corners of the 16-pixel lattice
+  const int64_t blocks = (N / 16) * (N / 16);
+  EXPECT_GE(a.stats.byReason[corner], b.stats.byReason[corner] + blocks);
+  // The dot: exact with the probes (its centre is the probe of block
+  // [32,48]^2), interpolated over without them (error = its full depth).
+  const auto full = withProbes.FullRender();
+  const auto onDot = [&](int x, int y) { return dot(x, y); };
+  EXPECT_LT(MeanLuminanceError(a, full, onDot), 0.05);
+  EXPECT_NEAR(MeanLuminanceError(b, full, onDot), 0.45, 1e-3);
+}
+
+}  // namespace
+}  // namespace dcm::testing

@@ -146,9 +146,12 @@ TEST(PipeProvider, ReconstructsWithFewExactPixels) {
 TEST(PipeProvider, UnknownHandshakeKeysAndCapabilitiesAreIgnored) {
   std::unique_ptr<dcm::pipe::PipeProvider> p;
   ASSERT_TRUE(
-      Start("printf 'dcm-pipe 1 width=4 height=3 caps=object_id,hyperspectral colour=blue\\n'; cat >/dev/null", &p)
+      Start("printf 'dcm-pipe 1 width=4 height=3 caps=object_id,hyperspectral,hard_shadows_guided colour=blue\\n'; "
+            "cat >/dev/null",
+            &p)
           .ok());
   EXPECT_EQ(p->Capabilities().width, 4);
+  EXPECT_TRUE(p->Capabilities().hardShadowsGuided);
   EXPECT_EQ(p->Capabilities().height, 3);
   EXPECT_TRUE(p->Capabilities().objectId);
   EXPECT_FALSE(p->Capabilities().texture);

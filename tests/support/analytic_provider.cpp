@@ -21,6 +21,7 @@ ProviderCapabilities AnalyticProvider::Capabilities() const {
   c.texture = channels_.texture;
   c.splitRadiance = channels_.texture;
   c.normal = channels_.normals;
+  c.hardShadowsGuided = channels_.hardShadowsGuided;
   c.name = "analytic";
   return c;
 }

@@ -34,6 +34,7 @@ struct AnalyticChannels {
   bool shaders = true;
   bool texture = true;
   bool normals = false;  ///< advertise the normal guide
+  bool hardShadowsGuided = false;  ///< ProviderCapabilities::hardShadowsGuided
 };
 
 /// Serves a SceneFunction; counts how often each pixel is evaluated.

@@ -108,7 +108,7 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
         "pipe", DCM_VERSION, options,
         {{"provider_cmd", f.command}, {"provider_name", caps.name}, {"width", caps.width}, {"height", caps.height},
          {"object_id", caps.objectId}, {"shader_id", caps.shaderId}, {"texture", caps.texture},
-         {"split", caps.splitRadiance}, {"variance", caps.variance}});
+         {"split", caps.splitRadiance}, {"variance", caps.variance}, {"hard_shadows_guided", caps.hardShadowsGuided}});
     AddPartMetadata(tile, region, settings, rec, info, &meta);
     if (Status w = toolkit::WritePartExr(f.output, frame.x, frame.y, region, rec.image, meta); !w.ok())
       return Fail(w.message());

@@ -303,7 +303,7 @@ int RunReconstruct(const ReconstructFlags& f) {
   const auto caps = provider->Capabilities();
   stats["capabilities"] = {{"object_id", caps.objectId}, {"shader_id", caps.shaderId},
                            {"texture", caps.texture},    {"split_radiance", caps.splitRadiance},
-                           {"variance", caps.variance}};
+                           {"variance", caps.variance},  {"hard_shadows_guided", caps.hardShadowsGuided}};
   if (haveRef) stats["reference"] = ErrorJson(error);
 
   toolkit::Metadata meta = ProvenanceMetadata(f, *provider, options);

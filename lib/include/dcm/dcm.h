@@ -63,7 +63,12 @@ enum {
   DCM_SAMPLE_THREAD_SAFE = 1,
   /** The callback can fill the split radiance (L_i, L_c), L = L_i * tau + L_c
    *  (Scheel et al. 2001, 3.3); used together with a texture guide. */
-  DCM_SAMPLE_SPLIT = 2
+  DCM_SAMPLE_SPLIT = 2,
+  /** Every hard shadow of the scene shows in the guides: the scene has no
+   *  point or directional light, or the IDs set carry a shadow guide (lit and
+   *  unlit pixels of a surface have different IDs). Smooth blocks then get
+   *  no centre probe. */
+  DCM_SAMPLE_HARD_SHADOWS_GUIDED = 4
 };
 
 /** Why a pixel of the working image was evaluated exactly: the values of

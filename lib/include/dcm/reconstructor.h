@@ -82,6 +82,11 @@ struct Reconstruction {
 /// input whose samples are not noisy).
 bool UsesSupersampledRules(const ReconstructionOptions& options, const ProviderCapabilities& caps);
 
+/// The refinement of smooth blocks a reconstruction with `options` of a
+/// provider with `caps` uses: kCentreProbe becomes kNever where the guides
+/// show every hard shadow (ProviderCapabilities::hardShadowsGuided).
+SmoothRefinement UsedSmoothRefinement(const ReconstructionOptions& options, const ProviderCapabilities& caps);
+
 /// Reconstructs the provider's image with DCM. On error `out` is unspecified.
 /// With a provider that answers Status::Pending, returns that status and
 /// leaves the requested pixels in `pending`.

@@ -25,6 +25,13 @@ struct ProviderCapabilities {
   bool normal = false;         ///< guides carry the surface normal per pixel (creases inside one object)
   bool splitRadiance = false;  ///< samples carry (L_i, L_c) with L = L_i*tau + L_c
   bool variance = false;       ///< samples carry the variance of their estimate of L
+  /// Every hard shadow of the scene shows in the guides: the scene has no
+  /// point or directional light, or the guides mark where such a light's
+  /// visibility changes (a shadow guide folded into the IDs). Then a smooth
+  /// block needs no centre probe (SmoothRefinement::kCentreProbe): what the
+  /// probe finds between a block's corners is a shadow smaller than the
+  /// block, and the guides show those.
+  bool hardShadowsGuided = false;
   /// Evaluate() may be called concurrently from several threads on disjoint
   /// batches. Providers that are not thread safe are called from one thread.
   bool threadSafe = true;

@@ -1003,6 +1003,10 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
   c.splitRadiance = split;
   c.normal = !d->normal.empty();
   c.variance = !d->var.empty();
+  // The shadow guide folded into the IDs marks the hard shadows' edges (for
+  // a Cycles render, the sun's; renderers with several such lights give one
+  // guide of all of them).
+  c.hardShadowsGuided = roles[size_t(Role::kShadow)].has_value();
   c.threadSafe = true;
   c.name = "aov:" + inputs[0];
   if (!split) d->tau.clear();

@@ -205,6 +205,7 @@ Status PipeProvider::Handshake() {
         else if (c == "normal") caps_.normal = true;
         else if (c == "split") caps_.splitRadiance = true;
         else if (c == "variance") caps_.variance = true;
+        else if (c == "hard_shadows_guided") caps_.hardShadowsGuided = true;
         // Unknown capabilities are ignored (newer providers).
       }
     } else if (key == "name") {
