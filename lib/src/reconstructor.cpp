@@ -971,7 +971,9 @@ bool UsesSupersampledRules(const ReconstructionOptions& options, const ProviderC
 
 SmoothRefinement UsedSmoothRefinement(const ReconstructionOptions& options, const ProviderCapabilities& caps) {
   const SmoothRefinement r = options.smoothRefinement;
-  return r == SmoothRefinement::kCentreProbe && caps.hardShadowsGuided ? SmoothRefinement::kNever : r;
+  return r == SmoothRefinement::kCentreProbe && caps.hardShadowsGuided && !detail::NoisySamples(options, caps)
+             ? SmoothRefinement::kNever
+             : r;
 }
 
 Status Reconstruct(SampleProvider& provider, const ReconstructionOptions& options, Reconstruction* out,

@@ -80,9 +80,9 @@ std::string SettingsSummary(const ReconstructionOptions& o, const ProviderCapabi
   const std::string why = rules ? "supersampled rules: --downsample " + std::to_string(o.downsample)
                           : o.downsample >= 2 ? "noisy samples: the supersampled rules are off"
                                               : "final resolution";
-  std::string refine(ToString(UsedSmoothRefinement(o, caps)));
-  if (o.smoothRefinement == SmoothRefinement::kCentreProbe && caps.hardShadowsGuided)
-    refine += " (the guides show every hard shadow)";
+  const SmoothRefinement used = UsedSmoothRefinement(o, caps);
+  std::string refine(ToString(used));
+  if (used != o.smoothRefinement) refine += " (the guides show every hard shadow)";
   return std::string("contrast ") + std::string(ToString(o.ContrastMetricFor(rules))) + ", threshold " + threshold +
          ", thin-object test " + std::string(ToString(o.ThinObjectsFor(rules))) +
          ", crossing fill " + std::to_string(o.CrossingFillReachFor(rules)) + " (" + why +

@@ -39,10 +39,11 @@ enum class SmoothRefinement {
   kAlways,       ///< paper 2.1 as written: split it and classify the children again
   /// evaluate its centre; split only where the bilinear prediction misses
   /// it. Not where the provider's guides show every hard shadow
-  /// (ProviderCapabilities::hardShadowsGuided): there the probes found
-  /// nothing the guides miss (docs/AOV.md, session 10: on the Cycles views
-  /// 0.13-0.21 points fewer exact pixels at the same PSNR; on the tracer's
-  /// cactus, whose point lights' shadows no guide shows, they are worth 1.2 dB).
+  /// (ProviderCapabilities::hardShadowsGuided) and the samples are not
+  /// noisy (UsedSmoothRefinement): there the probes found nothing the guides
+  /// miss (docs/AOV.md, session 10: on the Cycles views 0.13-0.21 points
+  /// fewer exact pixels at the same PSNR; on the tracer's cactus, whose
+  /// point lights' shadows no guide shows, they are worth 1.2 dB).
   kCentreProbe,
   kNever,        ///< smooth blocks are final at the level where they are found
 };

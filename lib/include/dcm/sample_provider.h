@@ -28,9 +28,10 @@ struct ProviderCapabilities {
   /// Every hard shadow of the scene shows in the guides: the scene has no
   /// point or directional light, or the guides mark where such a light's
   /// visibility changes (a shadow guide folded into the IDs). Then a smooth
-  /// block needs no centre probe (SmoothRefinement::kCentreProbe): what the
-  /// probe finds between a block's corners is a shadow smaller than the
-  /// block, and the guides show those.
+  /// block of samples that are not noisy needs no centre probe
+  /// (SmoothRefinement::kCentreProbe, UsedSmoothRefinement): what the probe
+  /// finds between a block's corners is a shadow smaller than the block,
+  /// and the guides show those.
   bool hardShadowsGuided = false;
   /// Evaluate() may be called concurrently from several threads on disjoint
   /// batches. Providers that are not thread safe are called from one thread.
