@@ -397,6 +397,14 @@ SampleReason Engine::Resolve(Point2i q, Interpolant* in) const {
   return SampleReason::kInterpolated;
 }
 
+/// True when every pixel of the interpolant serves one border point: the
+/// other border point lay on another surface and was left out.
+bool OneEnded(const Interpolant& in) {
+  for (int k = 1; k < in.count; ++k)
+    if (in.end[k] != in.end[0]) return false;
+  return in.count > 0;
+}
+
 bool Engine::EndsAgree(const Interpolant& in) const {
   Interpolant end[2];
   for (int k = 0; k < in.count; ++k) {
@@ -478,7 +486,16 @@ void Engine::InterpolateOriented(const Leaf& leaf, OrientedPass pass) {
       Interpolant in;
       const bool found = InterpolantAlong(elements, b, {x, y}, leaf.direction, &in);
       SampleReason r = found ? Resolve({x, y}, &in) : SampleReason::kFallback;
-      if (r == SampleReason::kThinObject) r = ResolveAlongNeighbours(leaf, {x, y}, &in);
+      if (r == SampleReason::kThinObject) {
+        r = ResolveAlongNeighbours(leaf, {x, y}, &in);
+      } else if (r == SampleReason::kInterpolated && OneEnded(in)) {
+        // One border point on q's surface (the thin-object test lets it
+        // pass): its value would reach across the block unchanged. A
+        // neighbouring direction whose two ends lie on q's surface and agree
+        // interpolates instead, where there is one.
+        Interpolant alt;
+        if (ResolveAlongNeighbours(leaf, {x, y}, &alt) == SampleReason::kInterpolated) in = alt;
+      }
       if (r != SampleReason::kInterpolated) {
         if (pass != OrientedPass::kPreview) RequestOrDefer(x, y, r);
         continue;
