@@ -10,9 +10,11 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <string>
 #include <tuple>
@@ -170,6 +172,11 @@ class Engine {
   /// The interpolant's two border points, each on its own, do not differ
   /// significantly (false when one has no sample).
   bool EndsAgree(const Interpolant& in) const;
+  /// For interior pixel q of an oriented leaf whose interpolant serves one
+  /// border point only (OneEnded): the interpolant along the direction, of
+  /// all K, whose two border points lie on q's surface and differ least.
+  /// False when no direction has both on q's surface.
+  bool LeastDifferentTwoEnded(const Leaf& leaf, Point2i q, Interpolant* in) const;
   void WriteSmooth(const Leaf& leaf);
   /// The image as this level knows it, for progressive output: settled leaves,
   /// blocks split further interpolated bilinearly, edge blocks along their
@@ -405,19 +412,42 @@ bool OneEnded(const Interpolant& in) {
   return in.count > 0;
 }
 
-bool Engine::EndsAgree(const Interpolant& in) const {
+/// The values of the interpolant's two border points, each from its own
+/// pixels; false when one has none.
+bool EndValues(const SampleStore& store, const Interpolant& in, std::array<Value, 2>* values) {
   Interpolant end[2];
   for (int k = 0; k < in.count; ++k) {
     Interpolant& e = end[in.end[k]];
     e.index[e.count] = in.index[k], e.weight[e.count++] = in.weight[k];
   }
   if (end[0].count == 0 || end[1].count == 0) return false;
-  for (Interpolant& e : end) {
+  for (int i = 0; i < 2; ++i) {
+    Interpolant& e = end[i];
     double sum = 0;
     for (int k = 0; k < e.count; ++k) sum += e.weight[k];
     for (int k = 0; k < e.count; ++k) e.weight[k] /= sum;
+    (*values)[size_t(i)] = Evaluate(store, e);
   }
-  return !contrast_.Differ(Evaluate(store_, end[0]), Evaluate(store_, end[1]));
+  return true;
+}
+
+bool Engine::EndsAgree(const Interpolant& in) const {
+  std::array<Value, 2> ends;
+  return EndValues(store_, in, &ends) && !contrast_.Differ(ends[0], ends[1]);
+}
+
+bool Engine::LeastDifferentTwoEnded(const Leaf& leaf, Point2i q, Interpolant* in) const {
+  float least = std::numeric_limits<float>::infinity();
+  for (int k = 0; k < opt_.directions; ++k) {
+    Interpolant alt;
+    std::array<Value, 2> ends;
+    if (!InterpolantAlong(ElementsOf(leaf.block, k), leaf.block, q, k, &alt) ||
+        Resolve(q, &alt) != SampleReason::kInterpolated || !EndValues(store_, alt, &ends))
+      continue;
+    const float c = contrast_.Contrast(ends);
+    if (c < least) least = c, *in = alt;
+  }
+  return least < std::numeric_limits<float>::infinity();
 }
 
 SampleReason Engine::ResolveAlongNeighbours(const Leaf& leaf, Point2i q, Interpolant* in) const {
@@ -491,10 +521,9 @@ void Engine::InterpolateOriented(const Leaf& leaf, OrientedPass pass) {
       } else if (r == SampleReason::kInterpolated && OneEnded(in)) {
         // One border point on q's surface (the thin-object test lets it
         // pass): its value would reach across the block unchanged. A
-        // neighbouring direction whose two ends lie on q's surface and agree
-        // interpolates instead, where there is one.
-        Interpolant alt;
-        if (ResolveAlongNeighbours(leaf, {x, y}, &alt) == SampleReason::kInterpolated) in = alt;
+        // direction with two ends on q's surface interpolates instead,
+        // where there is one.
+        LeastDifferentTwoEnded(leaf, {x, y}, &in);
       }
       if (r != SampleReason::kInterpolated) {
         if (pass != OrientedPass::kPreview) RequestOrDefer(x, y, r);
