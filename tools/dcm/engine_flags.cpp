@@ -11,7 +11,7 @@ namespace dcm::cli {
 void AddEngineFlags(CLI::App* app, EngineFlags* f) {
   app->add_option("--method", f->method, "dcm (default), paper (Scheel et al. 2001) or guo (Guo 1998)")
       ->check(CLI::IsMember({"dcm", "paper", "guo"}));
-  app->add_option("--threshold", f->threshold, "contrast threshold of the smooth/edge test (default 0.14, 0.13 with --downsample 2 or more and samples that are "
+  app->add_option("--threshold", f->threshold, "contrast threshold of the smooth/edge test (default 0.14, 0.15 with --downsample 2 or more and samples that are "
                   "not noisy; paper|guo: 0.06)");
   app->add_option("--block", f->block, "elementary block size (power of two; default 16, 8 with noisy samples; --method paper|guo: 8)");
   app->add_option("--min-block", f->minBlock, "finest block size (power of two, default 4)");

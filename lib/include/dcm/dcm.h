@@ -177,7 +177,7 @@ DCM_API void dcmSetInt(DCMReconstructor r, const char* name, int value);
 
 /** Sets a float option: "contrast_threshold" (default 0.14),
  *  "contrast_threshold_supersampled" (used instead under the supersampled
- *  rules, default 0.13), "noise_significance" (with a
+ *  rules, default 0.15), "noise_significance" (with a
  *  provider that reports variance), "probe_lc_share" (a finest edge block
  *  whose border changes only at surface changes is probed only where L_c
  *  exceeds this share of L at some border pixel, default 0.5). Integer
