@@ -518,11 +518,12 @@ void Engine::InterpolateOriented(const Leaf& leaf, OrientedPass pass) {
       SampleReason r = found ? Resolve({x, y}, &in) : SampleReason::kFallback;
       if (r == SampleReason::kThinObject) {
         r = ResolveAlongNeighbours(leaf, {x, y}, &in);
-      } else if (r == SampleReason::kInterpolated && OneEnded(in)) {
+      } else if (r == SampleReason::kInterpolated && NeighbourSteps() > 0 && OneEnded(in)) {
         // One border point on q's surface (the thin-object test lets it
         // pass): its value would reach across the block unchanged. A
         // direction with two ends on q's surface interpolates instead,
-        // where there is one.
+        // where there is one (dcm's: the published methods try no other
+        // direction, neighbourDirections 0).
         LeastDifferentTwoEnded(leaf, {x, y}, &in);
       }
       if (r != SampleReason::kInterpolated) {

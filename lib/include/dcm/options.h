@@ -98,8 +98,8 @@ struct ReconstructionOptions {
   /// The threshold under the supersampled rules (SupersampledRules), where
   /// the reconstruction is judged after the box filter, with
   /// contrastMetricSupersampled: 0.15 is the largest tested that keeps every
-  /// Cycles view at 4x above 45 dB (issue 3's target there; view a at
-  /// 45.12, 0.155 leaves it at 44.99) with thinObjectsSupersampled and
+  /// Cycles view at 4x at or above 45 dB (issue 3's target there; view a at
+  /// 45.03, 0.155 leaves it at 44.99) with thinObjectsSupersampled and
   /// crossingFillReach (docs/AOV.md, session 10).
   float contrastThresholdSupersampled = 0.15f;
   /// The threshold in effect, with the supersampled rules or without.
