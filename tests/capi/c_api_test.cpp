@@ -368,9 +368,6 @@ TEST(CApi, RetainKeepsTheHandleAlive) {
   dcmReleaseReconstructor(r);
 }
 
-}  // namespace
-
-namespace {
 
 /// The two-surface scene with Gaussian noise of sd 0.03 per pixel (fixed by
 /// the pixel), reporting its variance when asked.

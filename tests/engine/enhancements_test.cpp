@@ -681,12 +681,6 @@ TEST(ObjectTest, NoIdsMeansContrastOnly) {
   EXPECT_GT(r.stats.exactPixels, 0);
 }
 
-}  // namespace
-}  // namespace dcm::testing
-
-namespace dcm::testing {
-namespace {
-
 // A provider whose guides show every hard shadow gets no centre probes of
 // smooth blocks: on a flat 64x64 image, the 16 probes of the level-0 blocks
 // (one per 16x16 block) are exactly what it saves. A shadow dot of 3 pixels
@@ -721,12 +715,6 @@ TEST(SmoothRefinement, NoCentreProbesWhereTheGuidesShowTheHardShadows) {
   EXPECT_LT(MeanLuminanceError(a, full, onDot), 0.05);
   EXPECT_NEAR(MeanLuminanceError(b, full, onDot), 0.45, 1e-3);
 }
-
-}  // namespace
-}  // namespace dcm::testing
-
-namespace dcm::testing {
-namespace {
 
 // Under the supersampled rules (none-matches) a pixel whose block direction
 // has one end on another surface used to take that one end's value, however
