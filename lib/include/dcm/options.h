@@ -160,7 +160,10 @@ struct ReconstructionOptions {
   /// Cycles views 0.25-0.53 points fewer exact pixels than one each side
   /// without the agreement, at -0.36 to +0.06 dB; on the POV-Ray scene
   /// -0.37 points for -1.35 dB, worse than the threshold's trade there).
-  /// 0: the block's direction only.
+  /// 0: the block's direction only. Above 0, also: a pixel that the
+  /// none-matches test passes with one border point on its surface takes,
+  /// of all K directions, the one whose two border points on its surface
+  /// differ least, where there is one (docs/AOV.md, session 10).
   int neighbourDirections = 4;
   /// An interior pixel interpolates only border samples on its own surface.
   bool surfaceAware = true;
