@@ -98,6 +98,9 @@ struct Point {
   double timeIllumS = 0, timeGuidesS = 0, timeEngineS = 0, timeTotalS = 0;
   toolkit::ImageError error;
   bool supersampledRules = false;  ///< the run used them (ReconstructionStats)
+  /// The smooth blocks' refinement the run used (UsedSmoothRefinement: no
+  /// centre probes where the provider's guides show every hard shadow).
+  SmoothRefinement smoothRefinement = SmoothRefinement::kCentreProbe;
 };
 
 /// An input: a scene file or a dense AOV EXR, with a provider factory.
@@ -459,7 +462,7 @@ std::string PointToCsv(const Point& p) {
   s << p.config.supersampling << ',';
   if (engine) {
     s << ToString(o.ThinObjectsFor(p.supersampledRules)) << ',' << ToString(o.objectTest) << ',' << int(o.textureSplit) << ','
-      << int(o.adaptiveBorders) << ',' << ToString(o.smoothRefinement) << ',' << int(o.finestCentreProbe) << ','
+      << int(o.adaptiveBorders) << ',' << ToString(p.smoothRefinement) << ',' << int(o.finestCentreProbe) << ','
       << int(o.lazyEvaluation) << ',';
   } else {
     s << ",,,,,,,";
@@ -679,6 +682,7 @@ int RunBench(const BenchFlags& f) {
         p->timeGuidesS = rec.stats.timeGuidesS;
         p->timeEngineS = rec.stats.timeEngineS;
         p->supersampledRules = rec.stats.usedSupersampledRules;
+        p->smoothRefinement = UsedSmoothRefinement(o, prov->Capabilities());
         ow = rec.width;
         oh = rec.height;
         *image = std::move(rec.image);

@@ -44,9 +44,11 @@ void AddEngineFlags(CLI::App* app, EngineFlags* flags);
 /// The options the flags select. The message names the flag at fault.
 Status ToOptions(const EngineFlags& flags, ReconstructionOptions* options);
 
-/// For -v: the settings that depend on the supersampling, as the engine will
-/// use them on a provider with `caps` ("threshold 0.08, thin-object test
-/// none-matches, crossing fill 2 (supersampled rules: --downsample 2)").
+/// For -v: the settings that depend on the supersampling and on the
+/// provider, as the engine will use them on a provider with `caps`
+/// ("contrast display-weighted, threshold 0.15, thin-object test
+/// none-matches, crossing fill 2 (supersampled rules: --downsample 2);
+/// smooth blocks: never (the guides show every hard shadow)").
 std::string SettingsSummary(const ReconstructionOptions& options, const ProviderCapabilities& caps);
 
 }  // namespace dcm::cli
