@@ -159,6 +159,7 @@ constexpr IntOption kIntOptions[] = {
     {"noisy_elementary_block", &Options::noisyElementaryBlock},
     {"min_block", &Options::minBlock},
     {"directions", &Options::directions},
+    {"directions_supersampled", &Options::directionsSupersampled},
     {"fallback_max_changes", &Options::fallbackMaxChanges},
     {"fallback_shading_changes", &Options::fallbackShadingChanges},
     {"simple_surface_changes", &Options::simpleSurfaceChanges},

@@ -13,6 +13,7 @@ ReconstructionOptions ReconstructionOptions::Guo() {
   o.noisyElementaryBlock = 0;
   o.SetContrastThreshold(0.06f);
   o.SetContrastMetric(ContrastMetric::kMitchell);
+  o.SetDirections(8);
   o.objectTest = ObjectTest::kObjectId;
   o.SetThinObjects(ThinObjectTest::kOff);
   o.neighbourDirections = 0;
@@ -111,6 +112,8 @@ Status ReconstructionOptions::Validate() const {
   if (!(contrastThresholdSupersampled >= 0) || !std::isfinite(contrastThresholdSupersampled))
     return bad("contrastThresholdSupersampled", "must be a finite number >= 0");
   if (directions < 1 || directions > 64) return bad("directions", "must be from 1 to 64, got " + std::to_string(directions));
+  if (directionsSupersampled < 1 || directionsSupersampled > 64)
+    return bad("directionsSupersampled", "must be from 1 to 64, got " + std::to_string(directionsSupersampled));
   if (!(creaseAngle >= 0 && creaseAngle <= 180)) return bad("creaseAngle", "must be from 0 to 180 degrees");
   if (!(noiseSignificance >= 0) || !std::isfinite(noiseSignificance))
     return bad("noiseSignificance", "must be a finite number >= 0");

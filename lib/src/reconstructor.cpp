@@ -103,6 +103,7 @@ class Engine {
         noisy_(NoisySamples(opt, caps)),
         block_(ElementaryBlock(opt, caps)),
         supersampledRules_(opt.SupersampledRules(noisy_)),
+        directions_(opt.DirectionsFor(supersampledRules_)),
         thinTest_(opt.ThinObjectsFor(supersampledRules_)),
         crossingFillReach_(opt.CrossingFillReachFor(supersampledRules_)),
         smoothRefinement_(UsedSmoothRefinement(opt, caps)),
@@ -132,7 +133,7 @@ class Engine {
   }
 
   Status LoadGuides();
-  Status EvaluateBordersAdaptively(const std::vector<Block>& edges, bool finest);
+  Status EvaluateBordersAdaptively(const std::vector<Block>& edges, bool belowElementary);
   void RequestCorners(const Block& b) {
     for (Point2i p : {Point2i{b.x0, b.y0}, Point2i{b.x1, b.y0}, Point2i{b.x0, b.y1}, Point2i{b.x1, b.y1}})
       store_.Request(p.x, p.y, SampleReason::kCorner);
@@ -201,6 +202,7 @@ class Engine {
   bool noisy_;  ///< samples carry their variance and the tests weigh it
   int block_;   ///< the elementary block (ReconstructionOptions::ElementaryBlockFor)
   bool supersampledRules_;   ///< ReconstructionOptions::SupersampledRules
+  int directions_;           ///< ReconstructionOptions::DirectionsFor the rules
   ThinObjectTest thinTest_;  ///< ReconstructionOptions::ThinObjectsFor the rules
   int crossingFillReach_;    ///< ReconstructionOptions::CrossingFillReachFor the rules
   SmoothRefinement smoothRefinement_;  ///< UsedSmoothRefinement: kNever where the guides show the hard shadows
@@ -238,7 +240,7 @@ class Engine {
   void PrepareBorderPairs(const std::vector<EdgeBlock>& blocks) {
     for (const EdgeBlock& e : blocks) {
       const auto shape = std::pair(e.block.width(), e.block.height());
-      if (!borderPairs_.contains(shape)) borderPairs_.try_emplace(shape, shape.first, shape.second, opt_.directions);
+      if (!borderPairs_.contains(shape)) borderPairs_.try_emplace(shape, shape.first, shape.second, directions_);
     }
   }
   /// The interpolants of interior pixels per (width, height, direction) of
@@ -251,15 +253,15 @@ class Engine {
         const int k = Turned(l.direction, step);
         const auto key = std::tuple(l.block.width(), l.block.height(), k);
         if (!elements_.contains(key))
-          elements_.try_emplace(key, l.block.width(), l.block.height(), Direction::Of(k, opt_.directions));
+          elements_.try_emplace(key, l.block.width(), l.block.height(), Direction::Of(k, directions_));
       }
   }
   /// The neighbouring directions tried each side: neighbourDirections, at
   /// most K/2 (every direction).
-  int NeighbourSteps() const { return std::min(opt_.neighbourDirections, opt_.directions / 2); }
+  int NeighbourSteps() const { return std::min(opt_.neighbourDirections, directions_ / 2); }
   /// Direction k turned by `step` directions (modulo the K directions).
   int Turned(int k, int step) const {
-    const int K = opt_.directions;
+    const int K = directions_;
     return ((k + step) % K + K) % K;
   }
   /// The prepared oriented elements of b's shape along direction k, or null.
@@ -271,7 +273,7 @@ class Engine {
   /// (ElementsOf(b, k), looked up once per leaf) when prepared.
   bool InterpolantAlong(const OrientedElements* elements, const Block& b, Point2i q, int k, Interpolant* in) const {
     return elements ? elements->At(store_, b, q, in)
-                    : OrientedInterpolant(store_, b, q, Direction::Of(k, opt_.directions), in);
+                    : OrientedInterpolant(store_, b, q, Direction::Of(k, directions_), in);
   }
 };
 
@@ -438,7 +440,7 @@ bool Engine::EndsAgree(const Interpolant& in) const {
 
 bool Engine::LeastDifferentTwoEnded(const Leaf& leaf, Point2i q, Interpolant* in) const {
   float least = std::numeric_limits<float>::infinity();
-  for (int k = 0; k < opt_.directions; ++k) {
+  for (int k = 0; k < directions_; ++k) {
     Interpolant alt;
     std::array<Value, 2> ends;
     if (!InterpolantAlong(ElementsOf(leaf.block, k), leaf.block, q, k, &alt) ||
@@ -454,7 +456,7 @@ SampleReason Engine::ResolveAlongNeighbours(const Leaf& leaf, Point2i q, Interpo
   const Block& b = leaf.block;
   for (int step = 1; step <= NeighbourSteps(); ++step)
     for (int sign : {1, -1}) {
-      if (sign < 0 && 2 * step == opt_.directions) continue;  // the perpendicular, tried once
+      if (sign < 0 && 2 * step == directions_) continue;  // the perpendicular, tried once
       const int k = Turned(leaf.direction, sign * step);
       Interpolant alt;
       if (InterpolantAlong(ElementsOf(b, k), b, q, k, &alt) && Resolve(q, &alt) == SampleReason::kInterpolated &&
@@ -558,7 +560,7 @@ void Engine::WritePreview(int level, std::vector<Block>& splitSmooth, std::vecto
   opt_.onLevel(level, store_.width(), store_.height(), store_.radiance());
 }
 
-Status Engine::EvaluateBordersAdaptively(const std::vector<Block>& edges, bool finest) {
+Status Engine::EvaluateBordersAdaptively(const std::vector<Block>& edges, bool belowElementary) {
   // The sides of all edge blocks of this level, each once: blocks of one level
   // sit on one lattice, so two sides are equal or share at most an end. A side
   // is a pure function of its own samples, whichever block it borders.
@@ -592,7 +594,7 @@ Status Engine::EvaluateBordersAdaptively(const std::vector<Block>& edges, bool f
   // Interleaved crossings (ReconstructionOptions::crossingFillReach): the
   // sides on the lattice lines this level adds, between two lines of the
   // level above, defer the pixels at their surface changes.
-  const bool interleave = finest && crossingFillReach_ > 0;
+  const bool interleave = belowElementary && crossingFillReach_ > 0;
   auto interleaved = [&](const Side& s) {
     const int across = s.step.y ? s.a.x : s.a.y;
     return interleave && across % (2 * s.length) == s.length;
@@ -775,7 +777,7 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
         if (!opt_.adaptiveBorders)
           for (Point2i p : eb[i].border) store_.Request(p.x, p.y, SampleReason::kBorder);
       });
-      if (opt_.adaptiveBorders) DCM_RETURN_IF_ERROR(EvaluateBordersAdaptively(edges, finest));
+      if (opt_.adaptiveBorders) DCM_RETURN_IF_ERROR(EvaluateBordersAdaptively(edges, size < block_));
       DCM_RETURN_IF_ERROR(Flush());
       PrepareBorderPairs(eb);
       ForEach(eb, [&](EdgeBlock& e, size_t) {
@@ -821,7 +823,7 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
           const Block& b = e.block;
           const Point2i c = b.Centre();
           Interpolant in;
-          if (!OrientedInterpolant(store_, b, c, Direction::Of(e.direction.index, opt_.directions), &in) ||
+          if (!OrientedInterpolant(store_, b, c, Direction::Of(e.direction.index, directions_), &in) ||
               Resolve(c, &in) != SampleReason::kInterpolated)
             return;
           const Value predicted = Evaluate(store_, in), exact = At(c);
@@ -879,7 +881,7 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
             if (!e.probe) return;
             const Point2i c = e.block.Centre();
             Interpolant in;
-            if (!OrientedInterpolant(store_, e.block, c, Direction::Of(e.direction.index, opt_.directions), &in))
+            if (!OrientedInterpolant(store_, e.block, c, Direction::Of(e.direction.index, directions_), &in))
               return;
             // A centre on another surface than its interpolants is the thin
             // object test's business, not a miss.

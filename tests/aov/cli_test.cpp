@@ -148,7 +148,7 @@ TEST(DcmReconstruct, DownsampleComparesAtOutputResolution) {
 }
 
 // Supersampled input whose samples are not noisy has its own threshold,
-// thin-object test and crossing fill (dcm/options.h): the stats record the
+// directions, thin-object test and crossing fill (dcm/options.h): the stats record the
 // settings and whether the run used those rules, -v says which it uses and
 // why, and the flags set them at every supersampling.
 TEST(DcmReconstruct, SupersampledInputHasItsOwnDefaults) {
@@ -169,7 +169,7 @@ TEST(DcmReconstruct, SupersampledInputHasItsOwnDefaults) {
   auto said = [](const ReconstructionOptions& o, bool rules, const std::string& why) {
     std::ostringstream s;
     s << "contrast " << ToString(o.ContrastMetricFor(rules)) << ", threshold " << o.ContrastThresholdFor(rules)
-      << ", thin-object test " << ToString(o.ThinObjectsFor(rules))
+      << ", " << o.DirectionsFor(rules) << " directions, thin-object test " << ToString(o.ThinObjectsFor(rules))
       << ", crossing fill " << o.CrossingFillReachFor(rules) << " (" << why << ")";
     return s.str();
   };
@@ -186,6 +186,8 @@ TEST(DcmReconstruct, SupersampledInputHasItsOwnDefaults) {
   EXPECT_EQ(x2["options"]["thin_objects_supersampled"], std::string(ToString(defaults.thinObjectsSupersampled)));
   EXPECT_EQ(x2["options"]["contrast_metric_supersampled"], std::string(ToString(defaults.contrastMetricSupersampled)));
   EXPECT_NE(defaults.contrastMetricSupersampled, defaults.contrastMetric);
+  EXPECT_EQ(x2["options"]["directions_supersampled"], defaults.directionsSupersampled);
+  EXPECT_NE(defaults.directionsSupersampled, defaults.directions);
   EXPECT_EQ(x2["options"]["crossing_fill_reach"], defaults.crossingFillReach);
   // Noisy samples (a variance channel): the noise regime's settings.
   const auto [noisy, noisyErr] = run("noisy.exr", {"--downsample", "2"});
@@ -195,11 +197,12 @@ TEST(DcmReconstruct, SupersampledInputHasItsOwnDefaults) {
   // The flags set both regimes.
   const auto [set, setErr] =
       run("in.exr", {"--downsample", "2", "--threshold", "0.1", "--thin-test", "any-differs", "--crossing-fill", "0",
-                     "--contrast", "display"});
+                     "--contrast", "display", "--directions", "4"});
   for (const char* f : {"contrast_threshold", "contrast_threshold_supersampled"})
     EXPECT_FLOAT_EQ(float(set["options"][f]), 0.1f) << f;
   for (const char* f : {"thin_objects", "thin_objects_supersampled"}) EXPECT_EQ(set["options"][f], "any-differs") << f;
   for (const char* f : {"contrast_metric", "contrast_metric_supersampled"}) EXPECT_EQ(set["options"][f], "display") << f;
+  for (const char* f : {"directions", "directions_supersampled"}) EXPECT_EQ(set["options"][f], 4) << f;
   EXPECT_EQ(set["options"]["crossing_fill_reach"], 0);
   EXPECT_EQ(set["crossings_filled"], 0);
 }

@@ -98,9 +98,10 @@ TEST(CApi, MethodPresetsResetEveryOption) {
   EXPECT_EQ(dcmGetBool(r, "checkerboard"), 1);
   EXPECT_GT(dcmGetInt(r, "simple_surface_changes"), 2);
   EXPECT_GE(dcmGetInt(r, "fallback_shading_changes"), 0);
-  // Supersampled input has its own threshold (of another metric) and fill
-  // (dcm only).
+  // Supersampled input has its own threshold (of another metric),
+  // directions and fill (dcm only).
   EXPECT_NE(dcmGetFloat(r, "contrast_threshold_supersampled"), threshold);
+  EXPECT_GT(dcmGetInt(r, "directions_supersampled"), dcmGetInt(r, "directions"));
   EXPECT_GT(dcmGetInt(r, "crossing_fill_reach"), 0);
   dcmSetString(r, "thin_objects_supersampled", "any-differs");
   dcmSetString(r, "thin_objects_supersampled", "sometimes");  // recorded as an error, taken below
@@ -116,6 +117,7 @@ TEST(CApi, MethodPresetsResetEveryOption) {
   EXPECT_EQ(dcmGetInt(r, "simple_surface_changes"), 2);
   EXPECT_EQ(dcmGetInt(r, "fallback_shading_changes"), -1);  // every change counts
   EXPECT_EQ(dcmGetFloat(r, "contrast_threshold_supersampled"), dcmGetFloat(r, "contrast_threshold"));
+  EXPECT_EQ(dcmGetInt(r, "directions_supersampled"), dcmGetInt(r, "directions"));
   EXPECT_EQ(dcmGetInt(r, "crossing_fill_reach"), 0);
   EXPECT_EQ(dcmGetBool(r, "surface_aware"), 0);
   EXPECT_EQ(dcmGetBool(r, "texture_split"), 1);

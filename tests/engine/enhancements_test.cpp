@@ -127,7 +127,7 @@ TEST(ThinObjects, ANeighbouringDirectionNeverBlendsAcrossAShadowEdge) {
   const auto full = provider.FullRender();
   ReconstructionOptions none, all;
   none.neighbourDirections = 0;
-  ASSERT_EQ(all.neighbourDirections * 2, all.directions);  // the default: every direction
+  ASSERT_GE(all.neighbourDirections * 2, all.directions);  // the default: every direction
   const Reconstruction rNone = ReconstructOrFail(provider, none), rAll = ReconstructOrFail(provider, all);
   const auto thin = [](const Reconstruction& r) { return r.stats.byReason[size_t(SampleReason::kThinObject)]; };
   // The wall's pixels: wrong by kLit - kShadow where light and shadow blend.
@@ -348,10 +348,13 @@ TEST(Checkerboard, ASpindleNeedsEveryOtherPixel) {
 // Interleaved crossings (supersampled input): spindles two pixels wide,
 // leaning 1 in 4, every 6 pixels, so that the finest level is reached. Each
 // surface is shaded linearly; a deferred pixel at a surface change on a line
-// the finest level adds takes the mean of its surface's exact pixels on the
-// neighbouring lines. On the right half, bands of shadow 8 rows high start
-// on the rows the finest level adds: there the rows above and below a
-// deferred pixel are one lit, one shadowed, and the pixel is evaluated.
+// a level below the elementary block adds takes the mean of its surface's
+// exact pixels on the neighbouring lines. On the right half, bands of shadow
+// 8 rows high start on the rows the finest level adds: there the rows above
+// and below a deferred pixel are one lit, one shadowed, and the pixel is
+// evaluated; the rows of the 8-pixel level run inside the bands, between lit
+// rows, and their pixels are evaluated when the finest level splits the
+// blocks at the bands' edges.
 TEST(CrossingFill, AnEdgeAcrossThreeLatticeLinesIsSampledOnTheOuterTwo) {
   const int N = 256;  // working pixels; 128 after the box filter
   constexpr double kGradient = 0.002;  ///< the gentle shading's slope, per pixel
@@ -372,13 +375,17 @@ TEST(CrossingFill, AnEdgeAcrossThreeLatticeLinesIsSampledOnTheOuterTwo) {
   ReconstructionOptions none = fill;
   none.crossingFillReach = 0;
   const Reconstruction r = ReconstructOrFail(provider, fill), e = ReconstructOrFail(provider, none);
-  // The candidates: pixels beside a surface change along a line the finest
-  // level adds (4 mod 8), not at a block corner.
+  // The candidates: pixels beside a surface change along a line a level
+  // below the elementary block adds (4 mod 8, the finest; 8 mod 16), not at
+  // a corner of that level's blocks.
   int64_t filledLeft = 0, filledRight = 0, candidatesRight = 0;  // right: the rows between shadow bands
   double worst = 0;
   for (int y = 0; y < N; ++y)
     for (int x = 0; x < N; ++x) {
-      const bool row = y % 8 == 4 && x % 4 != 0, column = x % 8 == 4 && y % 4 != 0;
+      auto added = [](int across, int along) {
+        return (across % 8 == 4 && along % 4 != 0) || (across % 16 == 8 && along % 8 != 0);
+      };
+      const bool row = added(y, x), column = added(x, y);
       auto change = [&](int dx, int dy) {
         const int u = x + dx, v = y + dy;
         return u >= 0 && v >= 0 && u < N && v < N && onSpindle(u, v) != onSpindle(x, y);
@@ -399,11 +406,13 @@ TEST(CrossingFill, AnEdgeAcrossThreeLatticeLinesIsSampledOnTheOuterTwo) {
               (long long)r.stats.crossingsFilled, (long long)filledLeft, (long long)filledRight,
               (long long)candidatesRight, worst, 100 * r.stats.exactFraction(), 100 * e.stats.exactFraction());
   ASSERT_GT(candidatesRight, 100) << "the shadow bands' rows must reach the finest level";
-  // Every filled crossing is a candidate (the count is exact), and where the
-  // shading is linear many are filled (measured: 734, and 1.1 points fewer
-  // exact pixels).
-  EXPECT_EQ(r.stats.crossingsFilled, filledLeft + filledRight);
-  EXPECT_GT(filledLeft, 200);
+  // Where the shading is linear many crossings are filled (measured: 1549
+  // still interpolated, and 2.0 points fewer exact pixels). The stats count
+  // every fill; a fill on a line of the 8-pixel level is evaluated after all
+  // where a finer level's side needs that pixel (an end, or beside a surface
+  // change on a side that is not interleaved there).
+  EXPECT_LE(filledLeft + filledRight, r.stats.crossingsFilled);
+  EXPECT_GT(filledLeft, 500);
   EXPECT_LT(r.stats.exactPixels, e.stats.exactPixels);
   // One neighbouring row lit, the other in shadow (contrast (1 - 0.4) /
   // (1 + 0.4) = 0.43, against the threshold 0.08): never filled.
@@ -752,6 +761,57 @@ TEST(OneEndedPixels, TakeTheDirectionWhoseTwoEndsOnTheirSurfaceDifferLeast) {
   // keeping the one end where there is none, 0.035; copying the far end
   // always, 0.092.
   EXPECT_LT(err / n, 0.05) << "mean error in the two rows under the crease";
+}
+
+// Under the supersampled rules the least-discrepancy search has 16
+// directions, 11.25 degrees apart. A shadow edge on one surface (no guide
+// marks it) at the angles only 16 directions hold, halfway between two of
+// the 8: along the block's nearest direction of 8, the line of a pixel
+// beside the edge crosses it within the block, and the pixel blends light
+// and shadow; along its own direction it stays on its side.
+TEST(Directions, SixteenUnderTheSupersampledRules) {
+  constexpr int N = 256;
+  constexpr double kPi = 3.14159265358979323846;
+  ReconstructionOptions sixteen;
+  sixteen.downsample = 2;
+  ASSERT_EQ(sixteen.DirectionsFor(true), 16);
+  ReconstructionOptions eight = sixteen;
+  eight.directionsSupersampled = 8;
+  double error8 = 0, error16 = 0;
+  int64_t exact8 = 0, exact16 = 0;
+  for (const double degrees : {11.25, 33.75, 56.25, 78.75}) {
+    const double nx = -std::sin(degrees * kPi / 180), ny = std::cos(degrees * kPi / 180);  // the edge's normal
+    auto side = [&](int x, int y) { return (x + 0.5 - N / 2) * nx + (y + 0.5 - N / 2) * ny; };
+    AnalyticProvider provider(N, N, [&](int x, int y) {
+      PixelTruth t;
+      t.Li = RGB::Gray(float((side(x, y) < 0 ? 0.6 : 0.2) + 0.001 * (x + y)));
+      return t;
+    });
+    const auto full = provider.FullRender();
+    const Reconstruction r8 = ReconstructOrFail(provider, eight), r16 = ReconstructOrFail(provider, sixteen);
+    ASSERT_TRUE(r16.stats.usedSupersampledRules);
+    auto nearEdge = [&](int x, int y) { return std::fabs(side(x, y)) < 4; };
+    const double e8 = MeanLuminanceError(r8, full, nearEdge), e16 = MeanLuminanceError(r16, full, nearEdge);
+    std::printf("shadow edge at %.2f degrees: mean error within 4 pixels %.5f with 8 directions (%.2f %% exact), "
+                "%.5f with 16 (%.2f %%)\n",
+                degrees, e8, 100 * r8.stats.exactFraction(), e16, 100 * r16.stats.exactFraction());
+    error8 += e8, error16 += e16;
+    exact8 += r8.stats.exactPixels, exact16 += r16.stats.exactPixels;
+  }
+  // Measured: 16 directions leave 0.46 of the error of 8 near the edges
+  // (0.011 against 0.025 at 11.25 degrees), with no more exact pixels; 0.6
+  // leaves room for a change of the probes around it, not for losing it.
+  EXPECT_LT(error16, 0.6 * error8);
+  EXPECT_LE(exact16, exact8);
+  // At final resolution the 8 directions hold, whatever the supersampled
+  // rules' number.
+  eight.downsample = sixteen.downsample = 1;
+  AnalyticProvider edge(N, N, [&](int x, int y) {
+    PixelTruth t;
+    t.Li = RGB::Gray(y < 0.2 * x + 50 ? 0.6f : 0.2f);
+    return t;
+  });
+  EXPECT_EQ(ReconstructOrFail(edge, eight).workImage, ReconstructOrFail(edge, sixteen).workImage);
 }
 
 }  // namespace

@@ -34,6 +34,7 @@ nlohmann::json OptionsToJson(const ReconstructionOptions& o) {
   j["contrast_metric"] = std::string(ToString(o.contrastMetric));
   j["contrast_metric_supersampled"] = std::string(ToString(o.contrastMetricSupersampled));
   j["directions"] = o.directions;
+  j["directions_supersampled"] = o.directionsSupersampled;
   j["object_test"] = std::string(ToString(o.objectTest));
   j["thin_objects"] = std::string(ToString(o.thinObjects));
   j["thin_objects_supersampled"] = std::string(ToString(o.thinObjectsSupersampled));

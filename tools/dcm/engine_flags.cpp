@@ -15,14 +15,15 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
                   "not noisy; paper|guo: 0.06)");
   app->add_option("--block", f->block, "elementary block size (power of two; default 16, 8 with noisy samples; --method paper|guo: 8)");
   app->add_option("--min-block", f->minBlock, "finest block size (power of two, default 4)");
-  app->add_option("--directions", f->directions, "candidate directions of the least-discrepancy search (default 8)");
+  app->add_option("--directions", f->directions, "candidate directions of the least-discrepancy search (default 8; 16 with --downsample 2 or more and samples "
+                  "that are not noisy; paper|guo: 8)");
   app->add_flag("--no-thin", f->noThin, "switch off the thin-object test (paper 3.1)");
   app->add_option("--thin-test", f->thinTest,
                   "off | none-matches | any-differs | end-differs (default; none-matches with --downsample 2 or more and samples "
                   "that are not noisy)");
   app->add_option("--neighbour-directions", f->neighbourDirections,
                   "directions each side of its block's that an interior pixel tries, where both ends agree, before the "
-                  "thin-object test makes it exact (default 4: every one of 8; paper|guo: 0)");
+                  "thin-object test makes it exact (default 8: every direction, of 8 or 16; paper|guo: 0)");
   app->add_option("--simple-surface-changes", f->simpleSurfaceChanges,
                   "a block of at most twice the finest size whose border changes only at surface changes, up to "
                   "N times, counts as simple (default 8; paper|guo: 2)");
@@ -84,7 +85,7 @@ std::string SettingsSummary(const ReconstructionOptions& o, const ProviderCapabi
   std::string refine(ToString(used));
   if (used != o.smoothRefinement) refine += " (the guides show every hard shadow)";
   return std::string("contrast ") + std::string(ToString(o.ContrastMetricFor(rules))) + ", threshold " + threshold +
-         ", thin-object test " + std::string(ToString(o.ThinObjectsFor(rules))) +
+         ", " + std::to_string(o.DirectionsFor(rules)) + " directions, thin-object test " + std::string(ToString(o.ThinObjectsFor(rules))) +
          ", crossing fill " + std::to_string(o.CrossingFillReachFor(rules)) + " (" + why +
          "); smooth blocks: " + refine;
 }
@@ -96,7 +97,7 @@ Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {
   if (f.threshold >= 0) o->SetContrastThreshold(f.threshold);
   if (f.block) o->elementaryBlock = f.block, o->noisyElementaryBlock = 0;  // with noisy samples too
   if (f.minBlock) o->minBlock = f.minBlock;
-  if (f.directions) o->directions = f.directions;
+  if (f.directions) o->SetDirections(f.directions);
   if (f.noThin) o->SetThinObjects(ThinObjectTest::kOff);
   if (!f.thinTest.empty()) {
     ThinObjectTest t;

@@ -46,7 +46,7 @@ Status ToOptions(const EngineFlags& flags, ReconstructionOptions* options);
 
 /// For -v: the settings that depend on the supersampling and on the
 /// provider, as the engine will use them on a provider with `caps`
-/// ("contrast display-weighted, threshold 0.15, thin-object test
+/// ("contrast display-weighted, threshold 0.15, 16 directions, thin-object test
 /// none-matches, crossing fill 2 (supersampled rules: --downsample 2);
 /// smooth blocks: never (the guides show every hard shadow)").
 std::string SettingsSummary(const ReconstructionOptions& options, const ProviderCapabilities& caps);

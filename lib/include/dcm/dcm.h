@@ -158,16 +158,17 @@ DCM_API void dcmSetString(DCMReconstructor r, const char* name, const char* valu
 
 /** Sets an integer option: "elementary_block", "noisy_elementary_block" (the
  *  elementary block with noisy samples, default 8; 0: elementary_block),
- *  "min_block", "directions", "fallback_max_changes",
+ *  "min_block", "directions", "directions_supersampled" (used instead
+ *  under the supersampled rules, default 16), "fallback_max_changes",
  *  "fallback_shading_changes" (a finest block over fallback_max_changes
  *  falls back only when more than this many of its changes are no surface
  *  change, default 2; -1: every such block), "simple_surface_changes"
  *  (a block of at most twice the finest size whose border changes only at
  *  surface changes, up to this many, counts as simple; 2: Guo's test),
  *  "neighbour_directions" (directions each side an interior pixel tries
- *  before the thin-object test makes it exact, default 4),
- *  "crossing_fill_reach" (under the supersampled rules: the finest sides between
- *  two lattice lines of the level above take their surface-change pixels
+ *  before the thin-object test makes it exact, default 8: every direction),
+ *  "crossing_fill_reach" (under the supersampled rules: the sides below the
+ *  elementary block between two lattice lines of the level above take their surface-change pixels
  *  from exact pixels of the same surface on both lines within this many
  *  pixels, where they agree; default 2, 0: off), "downsample",
  *  "threads" (0: all cores),

@@ -124,6 +124,20 @@ struct ReconstructionOptions {
   /// Sets the metric of every supersampling (a command line's --contrast).
   void SetContrastMetric(ContrastMetric m) { contrastMetric = contrastMetricSupersampled = m; }
   int directions = 8;        ///< candidate directions of the least-discrepancy search
+  /// The directions under the supersampled rules: 16, 11.25 degrees apart.
+  /// An edge there spans twice the working pixels per output pixel, so the
+  /// 8 directions' 22.5-degree steps leave more of its pixels beside it
+  /// whose line crosses it. With neighbourDirections covering all 16, on the
+  /// Cycles views at 4x 0.02-0.08 points fewer exact pixels for -0.15 to
+  /// +0.24 dB (c 5.95 % / 45.45 dB against 6.03 / 45.43), on the tracer's
+  /// scenes up to 0.02 points fewer for +0.02 to +0.14 dB. At final
+  /// resolution 16 costs the Cycles views 0.27-0.65 dB for 0.46-0.69 points,
+  /// less than the threshold trades (docs/AOV.md, session 11).
+  int directionsSupersampled = 16;
+  /// The directions in effect, with the supersampled rules or without.
+  int DirectionsFor(bool supersampledRules) const { return supersampledRules ? directionsSupersampled : directions; }
+  /// Sets the directions of every supersampling (a command line's --directions).
+  void SetDirections(int k) { directions = directionsSupersampled = k; }
 
   /// dcm: a surface is one material of one object. The paper's rule (a
   /// change only where object AND shader differ) joins objects of one
@@ -164,7 +178,7 @@ struct ReconstructionOptions {
   /// none-matches test passes with one border point on its surface takes,
   /// of all K directions, the one whose two border points on its surface
   /// differ least, where there is one (docs/AOV.md, session 10).
-  int neighbourDirections = 4;
+  int neighbourDirections = 8;  ///< every direction of 8 and of 16
   /// An interior pixel interpolates only border samples on its own surface.
   bool surfaceAware = true;
   /// Interpolate (L_i, L_c) and re-apply tau per pixel (paper 3.3).
@@ -186,13 +200,17 @@ struct ReconstructionOptions {
   /// from known pixels of the same surface. Off: every border pixel exactly
   /// (the paper).
   bool adaptiveBorders = true;
-  /// Adaptive borders under the supersampled rules, finest level: a side on
-  /// every other lattice line (the lines the finest level adds) takes the
-  /// pixels at its surface changes from the two neighbouring lines, a finest block away on either side, where each has an exact
-  /// pixel of the same surface within this many pixels along the line (inside
-  /// the side's extent) and the two agree; the others are evaluated. An edge
-  /// crossing three lattice lines is then sampled on the outer two and
-  /// interpolated on the middle one. docs/AOV.md (session 9): at the
+  /// Adaptive borders under the supersampled rules, every level below the
+  /// elementary block: a side on a lattice line the level adds (every other
+  /// line of the level) takes the pixels at its surface changes from the two
+  /// neighbouring lines, the parent's sides a block away on either side,
+  /// where each has an exact pixel of the same surface within this many
+  /// pixels along the line (inside the side's extent) and the two agree; the
+  /// others are evaluated. An edge crossing three lattice lines is then
+  /// sampled on the outer two and interpolated on the middle one. A finer
+  /// level evaluates a filled pixel its own sides need. Below the elementary
+  /// level and not only at the finest (session 11): 0.03-0.05 points fewer
+  /// on the Cycles views at 4x for -0.03 to 0 dB. docs/AOV.md (session 9): at the
   /// supersampled defaults, 0.20-0.32 points fewer exact pixels for 0.08-0.17
   /// dB on the Cycles views at 4x (0.13-0.26 points fewer at 45 dB), 0.03-0.08
   /// points for <= 0.11 dB on the bundled scenes; at final resolution it is
@@ -291,7 +309,7 @@ struct ReconstructionOptions {
 
   int downsample = 1;   ///< the working image is `downsample`x the output per axis
   /// Whether the supersampled rules (contrastThresholdSupersampled,
-  /// contrastMetricSupersampled, thinObjectsSupersampled, crossingFillReach) apply: supersampled input
+  /// contrastMetricSupersampled, directionsSupersampled, thinObjectsSupersampled, crossingFillReach) apply: supersampled input
   /// whose samples are not noisy. With noisy samples (a provider that
   /// reports variance, noiseSignificance > 0) the noise regime's settings
   /// hold at every supersampling: on the tracer's room at 2x with 16
