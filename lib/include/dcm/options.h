@@ -210,7 +210,7 @@ struct ReconstructionOptions {
   /// sampled on the outer two and interpolated on the middle one. A finer
   /// level evaluates a filled pixel its own sides need. Below the elementary
   /// level and not only at the finest (session 11): 0.03-0.05 points fewer
-  /// on the Cycles views at 4x for -0.03 to 0 dB. docs/AOV.md (session 9): at the
+  /// on the Cycles views at 4x for -0.01 dB. docs/AOV.md (session 9): at the
   /// supersampled defaults, 0.20-0.32 points fewer exact pixels for 0.08-0.17
   /// dB on the Cycles views at 4x (0.13-0.26 points fewer at 45 dB), 0.03-0.08
   /// points for <= 0.11 dB on the bundled scenes; at final resolution it is
