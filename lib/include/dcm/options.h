@@ -98,9 +98,9 @@ struct ReconstructionOptions {
   /// The threshold under the supersampled rules (SupersampledRules), where
   /// the reconstruction is judged after the box filter, with
   /// contrastMetricSupersampled: 0.15 is the largest tested that keeps every
-  /// Cycles view at 4x at or above 45 dB (issue 3's target there; view a at
-  /// 45.03, 0.155 leaves it at 44.99) with thinObjectsSupersampled and
-  /// crossingFillReach (docs/AOV.md, session 10).
+  /// Cycles view at 4x at or above 45 dB (issue 3's target there; view c at
+  /// 45.45, 0.155 leaves it at 44.95) with directionsSupersampled,
+  /// thinObjectsSupersampled and crossingFillReach (docs/AOV.md, session 11).
   float contrastThresholdSupersampled = 0.15f;
   /// The threshold in effect, with the supersampled rules or without.
   float ContrastThresholdFor(bool supersampledRules) const {
