@@ -15,9 +15,8 @@ float Mitchell(float lo, float hi) {
   return (hi - lo) / std::fabs(sum);
 }
 
-}  // namespace
-
-namespace {
+/// The display-weighted metric's unit: SrgbRelativeSlope at mid-grey.
+const float kMidGreySlope = SrgbRelativeSlope(0.18f);
 
 /// The range of one luminance over a set, with the variances of its extremes.
 struct Range {
@@ -65,8 +64,7 @@ float ContrastTest::Contrast(std::span<const Value> values) const {
     if (total > 1e-12f) c = std::max(c, (B.hi - B.lo) / total);
   }
   if (metric_ == ContrastMetric::kDisplayWeighted) {
-    static const float kMidGrey = SrgbRelativeSlope(0.18f);
-    c *= SrgbRelativeSlope(0.5f * (std::fabs(T.hi) + std::fabs(T.lo))) / kMidGrey;
+    c *= SrgbRelativeSlope(0.5f * (std::fabs(T.hi) + std::fabs(T.lo))) / kMidGreySlope;
   }
   return c;
 }

@@ -370,7 +370,6 @@ TEST(CApi, RetainKeepsTheHandleAlive) {
   dcmReleaseReconstructor(r);
 }
 
-
 /// The two-surface scene with Gaussian noise of sd 0.03 per pixel (fixed by
 /// the pixel), reporting its variance when asked.
 struct NoisyScene : Scene {
@@ -507,8 +506,8 @@ TEST(CApi, LevelFunctionGivesProgressiveImages) {
 namespace {
 
 // DCM_SAMPLE_HARD_SHADOWS_GUIDED: the host's guides show every hard shadow,
-// so the smooth blocks get no centre probes; fewer exact pixels on the same
-// two flat surfaces, none of them a probe's.
+// so the smooth blocks get no centre probes: fewer exact pixels on the same
+// two flat surfaces.
 TEST(CApi, HardShadowsGuidedSkipsTheCentreProbes) {
   Scene a, b;
   DCMReconstructor probed = Make(a), guided = Make(b, DCM_SAMPLE_THREAD_SAFE | DCM_SAMPLE_HARD_SHADOWS_GUIDED);

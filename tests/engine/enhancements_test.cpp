@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 
 #include "../../lib/src/contrast_test.h"
 
@@ -771,7 +772,7 @@ TEST(OneEndedPixels, TakeTheDirectionWhoseTwoEndsOnTheirSurfaceDifferLeast) {
 // and shadow; along its own direction it stays on its side.
 TEST(Directions, SixteenUnderTheSupersampledRules) {
   constexpr int N = 256;
-  constexpr double kPi = 3.14159265358979323846;
+  constexpr double kPi = std::numbers::pi;
   ReconstructionOptions sixteen;
   sixteen.downsample = 2;
   ASSERT_EQ(sixteen.DirectionsFor(true), 16);
