@@ -28,6 +28,7 @@ endif()
 execute_process(
   COMMAND ${CMAKE_COMMAND} -E env "PYTHONPATH=${_site}" "DCM_PREFIX=${_prefix}" "DCM_EXE=${_prefix}/bin/dcm"
           "DCM_MAKE_AOVS=${DCM_SOURCE_DIR}/examples/aov/make_aovs.py"
+          "DCM_EXAMPLE=${DCM_SOURCE_DIR}/examples/python/reconstruct.py"
           /usr/bin/python3 "${DCM_SOURCE_DIR}/tests/python/test_dcm.py"
   WORKING_DIRECTORY "${_tmp}" RESULT_VARIABLE _rc OUTPUT_VARIABLE _out ERROR_VARIABLE _err)
 message("${_out}${_err}")

@@ -3,7 +3,7 @@
 
 Environment (set by installed_module_test.cmake): PYTHONPATH=<prefix>/lib/python3/dist-packages,
 DCM_PREFIX (the prefix: the module must come from there), DCM_EXE (<prefix>/bin/dcm),
-DCM_MAKE_AOVS (examples/aov/make_aovs.py).
+DCM_MAKE_AOVS (examples/aov/make_aovs.py), DCM_EXAMPLE (examples/python/reconstruct.py).
 """
 import json
 import os
@@ -20,6 +20,7 @@ import dcm
 PREFIX = os.environ["DCM_PREFIX"]
 DCM = os.environ["DCM_EXE"]
 MAKE_AOVS = os.environ["DCM_MAKE_AOVS"]
+EXAMPLE = os.environ["DCM_EXAMPLE"]
 TIME_KEYS = {"time_s", "time_illum_s", "time_guides_s", "time_reconstruct_s"}
 
 
@@ -36,6 +37,10 @@ class Installed(unittest.TestCase):
         self.assertTrue(os.path.realpath(dcm.__file__).startswith(os.path.realpath(PREFIX)), dcm.__file__)
         out = subprocess.run([DCM, "--version"], capture_output=True, text=True, check=True).stdout
         self.assertEqual(out.strip(), "dcm " + dcm.__version__)
+
+    def test_example_runs(self):
+        out = subprocess.run([sys.executable, EXAMPLE], capture_output=True, text=True, check=True).stdout
+        self.assertRegex(out, r"rendered \d+ pixels \([0-9.]+ %\) in \d+ calls")
 
 
 class ReconstructExr(unittest.TestCase):
