@@ -140,7 +140,7 @@ bool CheckArgs(DCMReconstructor r, const char* name, const char* function) noexc
   }
 }
 
-// The option names are those of dcm/options.h (FindIntOption, ...): one
+// The option names are those of dcm/option_names.h (FindIntOption, ...): one
 // table, shared with the Python module.
 std::string UnknownOption(const char* kind, const char* name) {
   return std::string("unknown ") + kind + " option '" + name + "'";

@@ -440,7 +440,7 @@ PYBIND11_MODULE(_dcm, m) {
                ", exact fraction " + std::string(py::str(r.stats["exact_fraction"])) + ">";
       });
 
-  m.def("reconstruct_exr", &ReconstructExr, py::arg("inputs"), py::kw_only(), py::arg("preset") = "blender",
+  m.def("reconstruct_exr", &ReconstructExr, py::arg("inputs"), py::arg("preset") = "blender", py::kw_only(),
         py::arg("map") = py::none(), py::arg("texture") = py::none(), py::arg("layer") = "",
         py::arg("samples") = py::none(), py::arg("second_render") = py::none(),
         py::arg("estimate_variance") = false, py::arg("highlight_level") = py::none(),

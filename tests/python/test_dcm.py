@@ -82,7 +82,7 @@ class ReconstructExr(unittest.TestCase):
 
     def test_options_by_c_api_names_as_the_flags(self):
         image, stats = self.command("paper", "--method", "paper", "--threshold", "0.1", "--min-block", "2")
-        result = dcm.reconstruct_exr([self.aovs], preset="generic", method="paper", contrast_threshold=0.1,
+        result = dcm.reconstruct_exr([self.aovs], "generic", method="paper", contrast_threshold=0.1,
                                      contrast_threshold_supersampled=0.1, min_block=2)
         self.check_same(result, image, stats)
         self.assertEqual(result.stats["method"], "paper")
