@@ -150,19 +150,23 @@ std::vector<std::string> Pairs(py::handle value, const char* what) {
   return out;
 }
 
-/// A float32 array of shape (rows, 3) row-major, copied into RGB-like triples.
+/// "(a, b, c)": a shape as Python writes it.
+std::string ShapeText(const std::vector<py::ssize_t>& dims) {
+  std::string s = "(";
+  for (size_t i = 0; i < dims.size(); ++i) s += (i ? ", " : "") + std::to_string(dims[i]);
+  return s + (dims.size() == 1 ? ",)" : ")");
+}
+
+/// A float array of exactly the shape `dims` (last 3), as float32, copied
+/// into RGB-like triples in row-major order.
 template <typename Triple>
-std::vector<Triple> Triples(py::handle value, size_t rows, const std::string& what, const std::string& shape) {
+std::vector<Triple> Triples(py::handle value, const std::vector<py::ssize_t>& dims, const std::string& what) {
   auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(value);
-  if (!a) throw py::type_error(what + ": expected a float array of shape " + shape + ", got " + TypeName(value));
-  const size_t size = size_t(a.size());
-  const bool ok = (a.ndim() == 2 && size_t(a.shape(0)) == rows && a.shape(1) == 3) ||
-                  (a.ndim() == 3 && size == rows * 3 && a.shape(2) == 3);
-  if (!ok) {
-    std::string got = "(";
-    for (py::ssize_t i = 0; i < a.ndim(); ++i) got += (i ? ", " : "") + std::to_string(a.shape(i));
-    throw py::value_error(what + ": expected shape " + shape + ", got " + got + (a.ndim() == 1 ? ",)" : ")"));
-  }
+  if (!a)
+    throw py::type_error(what + ": expected a float array of shape " + ShapeText(dims) + ", got " + TypeName(value));
+  const std::vector<py::ssize_t> got(a.shape(), a.shape() + a.ndim());
+  if (got != dims) throw py::value_error(what + ": expected shape " + ShapeText(dims) + ", got " + ShapeText(got));
+  const size_t rows = size_t(a.size()) / 3;
   std::vector<Triple> out(rows);
   const float* v = a.data();
   for (size_t i = 0; i < rows; ++i) out[i] = {v[3 * i], v[3 * i + 1], v[3 * i + 2]};
@@ -257,24 +261,23 @@ class PythonProvider final : public SampleProvider {
   /// Reads the guides dict: "id", "shader" (H, W) integers; "tau", "normal" (H, W, 3) floats.
   void SetGuides(const py::dict& guides) {
     const size_t n = size_t(width_) * size_t(height_);
-    const std::string hw = "(" + std::to_string(height_) + ", " + std::to_string(width_) + ")";
-    const std::string hw3 = "(" + std::to_string(height_) + ", " + std::to_string(width_) + ", 3)";
+    const std::vector<py::ssize_t> hw = {height_, width_}, hw3 = {height_, width_, 3};
     for (const auto& [k, v] : guides) {
       const std::string key = py::str(k);
       const std::string what = "guides['" + key + "']";
       if (key == "id" || key == "shader") {
         py::array a = py::array::ensure(v);
         if (!a || (a.dtype().kind() != 'i' && a.dtype().kind() != 'u'))
-          throw py::type_error(what + ": expected an integer array of shape " + hw + ", got " +
+          throw py::type_error(what + ": expected an integer array of shape " + ShapeText(hw) + ", got " +
                                (a ? std::string(py::str(a.dtype())) : TypeName(v)));
-        if (a.ndim() != 2 || a.shape(0) != height_ || a.shape(1) != width_)
-          throw py::value_error(what + ": expected shape " + hw + ", got " + std::string(py::str(a.attr("shape"))));
+        const std::vector<py::ssize_t> got(a.shape(), a.shape() + a.ndim());
+        if (got != hw) throw py::value_error(what + ": expected shape " + ShapeText(hw) + ", got " + ShapeText(got));
         auto ids = py::array_t<uint32_t, py::array::c_style | py::array::forcecast>::ensure(a);
         (key == "id" ? objectIds_ : shaderIds_).assign(ids.data(), ids.data() + n);
       } else if (key == "tau") {
-        texture_ = Triples<RGB>(v, n, what, hw3);
+        texture_ = Triples<RGB>(v, hw3, what);
       } else if (key == "normal") {
-        normals_ = Triples<Vec3f>(v, n, what, hw3);
+        normals_ = Triples<Vec3f>(v, hw3, what);
       } else {
         throw py::value_error("unknown guide '" + key + "' (valid: id, shader, tau, normal)");
       }
@@ -340,7 +343,7 @@ class PythonProvider final : public SampleProvider {
     int32_t* p = xy.mutable_data();
     for (size_t i = 0; i < n; ++i) p[2 * i] = pixels[i].x, p[2 * i + 1] = pixels[i].y;
     const py::object result = evaluate_(xy);
-    const std::string shape = "(" + std::to_string(n) + ", 3)";
+    const std::vector<py::ssize_t> shape = {py::ssize_t(n), 3};
 
     std::vector<RGB> L, Li, Lc, var;
     if (py::isinstance<py::dict>(result)) {
@@ -348,14 +351,14 @@ class PythonProvider final : public SampleProvider {
       for (const auto& [k, v] : d) {
         const std::string key = py::str(k);
         const std::string name = "evaluate()['" + key + "']";
-        if (key == "L") L = Triples<RGB>(v, n, name, shape);
-        else if (key == "Li") Li = Triples<RGB>(v, n, name, shape);
-        else if (key == "Lc") Lc = Triples<RGB>(v, n, name, shape);
-        else if (key == "var") var = Triples<RGB>(v, n, name, shape);
+        if (key == "L") L = Triples<RGB>(v, shape, name);
+        else if (key == "Li") Li = Triples<RGB>(v, shape, name);
+        else if (key == "Lc") Lc = Triples<RGB>(v, shape, name);
+        else if (key == "var") var = Triples<RGB>(v, shape, name);
         else throw py::value_error("evaluate returned a dict with key '" + key + "' (valid: L, Li, Lc, var)");
       }
     } else {
-      L = Triples<RGB>(result, n, "evaluate()", shape);
+      L = Triples<RGB>(result, shape, "evaluate()");
     }
     if (Li.empty() != Lc.empty()) throw py::value_error("evaluate returned one of 'Li' and 'Lc' without the other");
     if (what.split && Li.empty())

@@ -214,6 +214,9 @@ class PythonProvider(unittest.TestCase):
         with self.assertRaises(ValueError) as e:
             dcm.reconstruct(32, 32, guides={"id": ids[:16]}, evaluate=wrong_shape)
         self.assertIn("guides['id']", str(e.exception))
+        with self.assertRaises(ValueError) as e:  # (W, H, 3) for (H, W, 3)
+            dcm.reconstruct(32, 16, guides={"tau": np.zeros((32, 16, 3), np.float32)}, evaluate=wrong_shape)
+        self.assertIn("guides['tau']: expected shape (16, 32, 3)", str(e.exception))
         with self.assertRaises(ValueError) as e:
             dcm.reconstruct(32, 32, guides={"albedo": ids}, evaluate=wrong_shape)
         self.assertIn("albedo", str(e.exception))
