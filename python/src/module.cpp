@@ -126,7 +126,7 @@ Settings ParseOptions(const py::dict& kwargs) {
   return s;
 }
 
-/// A list of str from a str or an iterable of str.
+/// File names from a str or os.PathLike, or an iterable of them.
 std::vector<std::string> StringList(py::handle value, const char* what) {
   if (value.is_none()) return {};
   auto fspath = py::module_::import("os").attr("fspath");
@@ -188,6 +188,7 @@ struct Result {
   py::object stats;       ///< dict: the statistics JSON
 };
 
+/// The result's numpy arrays and the statistics as a dict.
 Result MakeResult(const Reconstruction& r, const nlohmann::json& stats) {
   Result out;
   out.image = ImageArray(r.image, r.width, r.height);
@@ -202,6 +203,8 @@ Result MakeResult(const Reconstruction& r, const nlohmann::json& stats) {
   return out;
 }
 
+/// dcm.reconstruct_exr: the AOV flags as keyword arguments, then the code of
+/// `dcm reconstruct` (ToAovOptions, AovProvider::Open, ReconstructWholeExr).
 Result ReconstructExr(py::object inputs, const std::string& preset, py::object map, py::object texture,
                       const std::string& layer, py::object samples, py::object secondRender, bool estimateVariance,
                       std::optional<float> highlightLevel, py::object reference, bool warn, py::kwargs kwargs) {
@@ -390,6 +393,7 @@ class PythonProvider final : public SampleProvider {
   std::exception_ptr error_;
 };
 
+/// dcm.reconstruct: the engine on a PythonProvider.
 Result ReconstructPython(int width, int height, py::object guides, py::object evaluate, bool split, bool variance,
                          bool hardShadowsGuided, py::kwargs kwargs) {
   Settings s = ParseOptions(kwargs);
