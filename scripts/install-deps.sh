@@ -11,6 +11,8 @@ packages=(
   libopenimageio-dev openimageio-tools libopenexr-dev libimath-dev
   libopencolorio-dev libembree-dev libtbb-dev
   libcli11-dev nlohmann-json3-dev libassimp-dev
+  # the Python module (python/, for /usr/bin/python3)
+  pybind11-dev python3-pybind11
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
   # tests/tiles/slurm_test.sh: a single-node Slurm cluster on loopback

@@ -14,6 +14,7 @@
 #include <string_view>
 #include <vector>
 
+#include "dcm/option_names.h"
 #include "dcm/reconstructor.h"
 
 #ifndef DCM_VERSION_STRING
@@ -139,78 +140,8 @@ bool CheckArgs(DCMReconstructor r, const char* name, const char* function) noexc
   }
 }
 
-using Options = dcm::ReconstructionOptions;
-
-struct IntOption {
-  const char* name;
-  int Options::*member;
-};
-struct FloatOption {
-  const char* name;
-  float Options::*member;
-};
-struct BoolOption {
-  const char* name;
-  bool Options::*member;
-};
-
-constexpr IntOption kIntOptions[] = {
-    {"elementary_block", &Options::elementaryBlock},
-    {"noisy_elementary_block", &Options::noisyElementaryBlock},
-    {"min_block", &Options::minBlock},
-    {"directions", &Options::directions},
-    {"directions_supersampled", &Options::directionsSupersampled},
-    {"fallback_max_changes", &Options::fallbackMaxChanges},
-    {"fallback_shading_changes", &Options::fallbackShadingChanges},
-    {"simple_surface_changes", &Options::simpleSurfaceChanges},
-    {"neighbour_directions", &Options::neighbourDirections},
-    {"crossing_fill_reach", &Options::crossingFillReach},
-    {"downsample", &Options::downsample},
-    {"threads", &Options::threads},
-    {"tile_size", &Options::tileSize},
-    {"batch_size", &Options::batchSize},
-};
-constexpr FloatOption kFloatOptions[] = {
-    {"contrast_threshold", &Options::contrastThreshold},
-    {"contrast_threshold_supersampled", &Options::contrastThresholdSupersampled},
-    {"noise_significance", &Options::noiseSignificance},
-    {"probe_lc_share", &Options::probeLcShare},
-    {"crease_angle", &Options::creaseAngle},
-};
-constexpr BoolOption kBoolOptions[] = {
-    {"surface_aware", &Options::surfaceAware},
-    {"texture_split", &Options::textureSplit},
-    {"adaptive_borders", &Options::adaptiveBorders},
-    {"zero_order_test", &Options::zeroOrderTest},
-    {"gradient_blocks_simple", &Options::gradientBlocksSimple},
-    {"first_order_test", &Options::firstOrderTest},
-    {"first_order_from_guides", &Options::firstOrderFromGuides},
-    {"lazy_evaluation", &Options::lazyEvaluation},
-    {"fallback", &Options::fallback},
-    {"fallback_filled_borders", &Options::fallbackFilledBorders},
-    {"finest_centre_probe", &Options::finestCentreProbe},
-    {"checkerboard", &Options::checkerboard},
-    {"full_evaluation", &Options::fullEvaluation},
-    {"denoise_samples", &Options::denoiseSamples},
-};
-
-float* FindFloat(Options& o, std::string_view name) {
-  for (const auto& e : kFloatOptions)
-    if (name == e.name) return &(o.*e.member);
-  return nullptr;
-}
-
-int* FindInt(Options& o, std::string_view name) {
-  for (const auto& e : kIntOptions)
-    if (name == e.name) return &(o.*e.member);
-  return nullptr;
-}
-bool* FindBool(Options& o, std::string_view name) {
-  for (const auto& e : kBoolOptions)
-    if (name == e.name) return &(o.*e.member);
-  return nullptr;
-}
-
+// The option names are those of dcm/option_names.h (FindIntOption, ...): one
+// table, shared with the Python module.
 std::string UnknownOption(const char* kind, const char* name) {
   return std::string("unknown ") + kind + " option '" + name + "'";
 }
@@ -408,28 +339,7 @@ DCM_API void dcmSetString(DCMReconstructor r, const char* name, const char* valu
   if (!CheckArgs(r, name, "dcmSetString")) return;
   Guard(r, [&] {
     if (!value) return SetError(r, DCM_ERROR_INVALID_ARGUMENT, std::string("option ") + name + ": NULL value");
-    const std::string_view n(name), v(value);
-    dcm::Status st;
-    if (n == "method") {
-      if (v == "dcm") r->options = Options{};
-      else if (v == "paper") r->options = Options::Paper();
-      else if (v == "guo") r->options = Options::Guo();
-      else st = dcm::Status::Error("method: unknown value '" + std::string(v) + "' (valid: dcm, paper, guo)");
-    } else if (n == "object_test") {
-      st = dcm::Parse(v, &r->options.objectTest);
-    } else if (n == "thin_objects") {
-      st = dcm::Parse(v, &r->options.thinObjects);
-    } else if (n == "thin_objects_supersampled") {
-      st = dcm::Parse(v, &r->options.thinObjectsSupersampled);
-    } else if (n == "contrast_metric") {
-      st = dcm::Parse(v, &r->options.contrastMetric);
-    } else if (n == "contrast_metric_supersampled") {
-      st = dcm::Parse(v, &r->options.contrastMetricSupersampled);
-    } else if (n == "smooth_refinement") {
-      st = dcm::Parse(v, &r->options.smoothRefinement);
-    } else {
-      st = dcm::Status::Error(UnknownOption("string", name));
-    }
+    const dcm::Status st = dcm::SetStringOption(&r->options, name, value);
     if (!st.ok()) SetError(r, DCM_ERROR_INVALID_ARGUMENT, st.message());
   });
 }
@@ -437,8 +347,8 @@ DCM_API void dcmSetString(DCMReconstructor r, const char* name, const char* valu
 DCM_API void dcmSetInt(DCMReconstructor r, const char* name, int value) {
   if (!CheckArgs(r, name, "dcmSetInt")) return;
   Guard(r, [&] {
-    if (int* p = FindInt(r->options, name)) *p = value;
-    else if (bool* b = FindBool(r->options, name)) *b = value != 0;
+    if (int* p = dcm::FindIntOption(r->options, name)) *p = value;
+    else if (bool* b = dcm::FindBoolOption(r->options, name)) *b = value != 0;
     else SetError(r, DCM_ERROR_INVALID_ARGUMENT, UnknownOption("integer", name));
   });
 }
@@ -446,9 +356,9 @@ DCM_API void dcmSetInt(DCMReconstructor r, const char* name, int value) {
 DCM_API void dcmSetFloat(DCMReconstructor r, const char* name, float value) {
   if (!CheckArgs(r, name, "dcmSetFloat")) return;
   Guard(r, [&] {
-    if (float* f = FindFloat(r->options, name)) {
+    if (float* f = dcm::FindFloatOption(r->options, name)) {
       *f = value;
-    } else if (int* p = FindInt(r->options, name)) {
+    } else if (int* p = dcm::FindIntOption(r->options, name)) {
       if (!(std::nearbyint(value) == value) || std::fabs(value) > 1e9f)
         return SetError(r, DCM_ERROR_INVALID_ARGUMENT,
                         std::string("option ") + name + ": expected a whole number, got " + std::to_string(value));
@@ -462,7 +372,7 @@ DCM_API void dcmSetFloat(DCMReconstructor r, const char* name, float value) {
 DCM_API void dcmSetBool(DCMReconstructor r, const char* name, int value) {
   if (!CheckArgs(r, name, "dcmSetBool")) return;
   Guard(r, [&] {
-    if (bool* b = FindBool(r->options, name)) *b = value != 0;
+    if (bool* b = dcm::FindBoolOption(r->options, name)) *b = value != 0;
     else SetError(r, DCM_ERROR_INVALID_ARGUMENT, UnknownOption("bool", name));
   });
 }
@@ -471,8 +381,8 @@ DCM_API int dcmGetInt(DCMReconstructor r, const char* name) {
   if (!CheckArgs(r, name, "dcmGetInt")) return 0;
   int result = 0;
   Guard(r, [&] {
-    if (int* p = FindInt(r->options, name)) result = *p;
-    else if (bool* b = FindBool(r->options, name)) result = *b ? 1 : 0;
+    if (int* p = dcm::FindIntOption(r->options, name)) result = *p;
+    else if (bool* b = dcm::FindBoolOption(r->options, name)) result = *b ? 1 : 0;
     else SetError(r, DCM_ERROR_INVALID_ARGUMENT, UnknownOption("integer", name));
   });
   return result;
@@ -482,8 +392,8 @@ DCM_API float dcmGetFloat(DCMReconstructor r, const char* name) {
   if (!CheckArgs(r, name, "dcmGetFloat")) return 0.f;
   float result = 0.f;
   Guard(r, [&] {
-    if (float* f = FindFloat(r->options, name)) result = *f;
-    else if (int* p = FindInt(r->options, name)) result = float(*p);
+    if (float* f = dcm::FindFloatOption(r->options, name)) result = *f;
+    else if (int* p = dcm::FindIntOption(r->options, name)) result = float(*p);
     else SetError(r, DCM_ERROR_INVALID_ARGUMENT, UnknownOption("float", name));
   });
   return result;
@@ -493,7 +403,7 @@ DCM_API int dcmGetBool(DCMReconstructor r, const char* name) {
   if (!CheckArgs(r, name, "dcmGetBool")) return 0;
   int result = 0;
   Guard(r, [&] {
-    if (bool* b = FindBool(r->options, name)) result = *b ? 1 : 0;
+    if (bool* b = dcm::FindBoolOption(r->options, name)) result = *b ? 1 : 0;
     else SetError(r, DCM_ERROR_INVALID_ARGUMENT, UnknownOption("bool", name));
   });
   return result;

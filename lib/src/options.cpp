@@ -1,9 +1,11 @@
 #include <array>
 #include <cmath>
+#include <iterator>
 #include <string>
 #include <utility>
 
 #include "dcm/options.h"
+#include "dcm/option_names.h"
 
 namespace dcm {
 
@@ -134,6 +136,116 @@ Status ReconstructionOptions::Validate() const {
   if (tileSize < 1) return bad("tileSize", "must be >= 1");
   if (batchSize < 1) return bad("batchSize", "must be >= 1");
   return Status::Ok();
+}
+
+namespace {
+using Options = ReconstructionOptions;
+
+template <typename T>
+struct NamedField {
+  std::string_view name;
+  T Options::*member;
+};
+
+constexpr NamedField<int> kIntOptions[] = {
+    {"elementary_block", &Options::elementaryBlock},
+    {"noisy_elementary_block", &Options::noisyElementaryBlock},
+    {"min_block", &Options::minBlock},
+    {"directions", &Options::directions},
+    {"directions_supersampled", &Options::directionsSupersampled},
+    {"fallback_max_changes", &Options::fallbackMaxChanges},
+    {"fallback_shading_changes", &Options::fallbackShadingChanges},
+    {"simple_surface_changes", &Options::simpleSurfaceChanges},
+    {"neighbour_directions", &Options::neighbourDirections},
+    {"crossing_fill_reach", &Options::crossingFillReach},
+    {"downsample", &Options::downsample},
+    {"threads", &Options::threads},
+    {"tile_size", &Options::tileSize},
+    {"batch_size", &Options::batchSize},
+};
+constexpr NamedField<float> kFloatOptions[] = {
+    {"contrast_threshold", &Options::contrastThreshold},
+    {"contrast_threshold_supersampled", &Options::contrastThresholdSupersampled},
+    {"noise_significance", &Options::noiseSignificance},
+    {"probe_lc_share", &Options::probeLcShare},
+    {"crease_angle", &Options::creaseAngle},
+};
+constexpr NamedField<bool> kBoolOptions[] = {
+    {"surface_aware", &Options::surfaceAware},
+    {"texture_split", &Options::textureSplit},
+    {"adaptive_borders", &Options::adaptiveBorders},
+    {"zero_order_test", &Options::zeroOrderTest},
+    {"gradient_blocks_simple", &Options::gradientBlocksSimple},
+    {"first_order_test", &Options::firstOrderTest},
+    {"first_order_from_guides", &Options::firstOrderFromGuides},
+    {"lazy_evaluation", &Options::lazyEvaluation},
+    {"fallback", &Options::fallback},
+    {"fallback_filled_borders", &Options::fallbackFilledBorders},
+    {"finest_centre_probe", &Options::finestCentreProbe},
+    {"checkerboard", &Options::checkerboard},
+    {"full_evaluation", &Options::fullEvaluation},
+    {"denoise_samples", &Options::denoiseSamples},
+};
+constexpr std::string_view kStringOptions[] = {
+    "method", "object_test", "thin_objects", "thin_objects_supersampled",
+    "contrast_metric", "contrast_metric_supersampled", "smooth_refinement",
+};
+
+template <typename T, size_t N>
+T* FindField(const NamedField<T> (&table)[N], Options& o, std::string_view name) {
+  for (const auto& e : table)
+    if (name == e.name) return &(o.*e.member);
+  return nullptr;
+}
+
+template <typename T, size_t N>
+bool Has(const NamedField<T> (&table)[N], std::string_view name) {
+  for (const auto& e : table)
+    if (name == e.name) return true;
+  return false;
+}
+}  // namespace
+
+OptionKind KindOfOption(std::string_view name) {
+  for (std::string_view s : kStringOptions)
+    if (name == s) return OptionKind::kString;
+  if (Has(kIntOptions, name)) return OptionKind::kInt;
+  if (Has(kFloatOptions, name)) return OptionKind::kFloat;
+  if (Has(kBoolOptions, name)) return OptionKind::kBool;
+  return OptionKind::kUnknown;
+}
+
+int* FindIntOption(Options& o, std::string_view name) { return FindField(kIntOptions, o, name); }
+float* FindFloatOption(Options& o, std::string_view name) { return FindField(kFloatOptions, o, name); }
+bool* FindBoolOption(Options& o, std::string_view name) { return FindField(kBoolOptions, o, name); }
+
+Status SetStringOption(Options* o, std::string_view name, std::string_view value) {
+  if (name == "method") {
+    if (value == "dcm") *o = Options{};
+    else if (value == "paper") *o = Options::Paper();
+    else if (value == "guo") *o = Options::Guo();
+    else return Status::Error("method: unknown value '" + std::string(value) + "' (valid: dcm, paper, guo)");
+    return Status::Ok();
+  }
+  if (name == "object_test") return Parse(value, &o->objectTest);
+  if (name == "thin_objects") return Parse(value, &o->thinObjects);
+  if (name == "thin_objects_supersampled") return Parse(value, &o->thinObjectsSupersampled);
+  if (name == "contrast_metric") return Parse(value, &o->contrastMetric);
+  if (name == "contrast_metric_supersampled") return Parse(value, &o->contrastMetricSupersampled);
+  if (name == "smooth_refinement") return Parse(value, &o->smoothRefinement);
+  return Status::Error("unknown string option '" + std::string(name) + "'");
+}
+
+std::vector<std::string_view> OptionNames(OptionKind kind) {
+  std::vector<std::string_view> names;
+  switch (kind) {
+    case OptionKind::kString: names.assign(std::begin(kStringOptions), std::end(kStringOptions)); break;
+    case OptionKind::kInt: for (const auto& e : kIntOptions) names.push_back(e.name); break;
+    case OptionKind::kFloat: for (const auto& e : kFloatOptions) names.push_back(e.name); break;
+    case OptionKind::kBool: for (const auto& e : kBoolOptions) names.push_back(e.name); break;
+    case OptionKind::kUnknown: break;
+  }
+  return names;
 }
 
 }  // namespace dcm

@@ -1,9 +1,13 @@
 # Installs the build tree into a fresh temporary prefix, builds examples/c-api
 # against it as a separate CMake project (find_package(dcm)) and again with
 # pkg-config only, outside the source tree, runs both and checks their output.
+# Builds cxx_consumer (dcm::engine + dcm::aov, no CMAKE_CXX_STANDARD) and runs
+# it on AOVs of examples/aov/make_aovs.py. Checks that every command answers
+# --version and that libdcm.so needs at run time only what its comments say.
 #
-#   cmake -DDCM_BUILD_DIR=... -DDCM_EXAMPLE_DIR=... -DDCM_GENERATOR=... -P installed_package_test.cmake
-foreach(_v DCM_BUILD_DIR DCM_EXAMPLE_DIR DCM_GENERATOR)
+#   cmake -DDCM_BUILD_DIR=... -DDCM_EXAMPLE_DIR=... -DDCM_CXX_CONSUMER_DIR=... -DDCM_MAKE_AOVS=...
+#         -DDCM_GENERATOR=... -P installed_package_test.cmake
+foreach(_v DCM_BUILD_DIR DCM_EXAMPLE_DIR DCM_CXX_CONSUMER_DIR DCM_MAKE_AOVS DCM_GENERATOR)
   if(NOT DEFINED ${_v})
     message(FATAL_ERROR "${_v} not set")
   endif()
@@ -68,6 +72,36 @@ run("installed dcm --version" "${_prefix}/bin/dcm" --version)
 if(NOT run_output MATCHES "^dcm [0-9]")
   message(FATAL_ERROR "installed dcm --version printed: ${run_output}")
 endif()
+set(_version "${run_output}")
+# Every command listed by --help answers --version alike.
+run("installed dcm --help" "${_prefix}/bin/dcm" --help)
+string(REGEX MATCH "Subcommands:.*" _subs "${run_output}")
+string(REGEX MATCHALL "\n +[a-z]+ " _subs "${_subs}")
+list(LENGTH _subs _nsubs)
+if(_nsubs LESS 3)
+  message(FATAL_ERROR "dcm --help lists ${_nsubs} commands:\n${run_output}")
+endif()
+foreach(_sub IN LISTS _subs)
+  string(STRIP "${_sub}" _sub)
+  run("dcm ${_sub} --version" "${_prefix}/bin/dcm" ${_sub} --version)
+  if(NOT run_output STREQUAL _version)
+    message(FATAL_ERROR "dcm ${_sub} --version printed '${run_output}', dcm --version '${_version}'")
+  endif()
+endforeach()
+
+# libdcm.so needs, besides the C++ runtime, oneTBB's libtbb.so.12 (as
+# dcm.pc and dcmConfig.cmake say) and nothing else.
+find_program(_readelf readelf REQUIRED)
+run("readelf libdcm.so" ${_readelf} -d "${_prefix}/lib/libdcm.so")
+string(REGEX MATCHALL "Shared library: \\[[^]]+\\]" _needed "${run_output}")
+foreach(_lib IN LISTS _needed)
+  if(NOT _lib MATCHES "\\[(libtbb\\.so\\.12|libstdc\\+\\+\\.so\\.6|libm\\.so\\.6|libgcc_s\\.so\\.1|libc\\.so\\.6|ld-linux-x86-64\\.so\\.2)\\]")
+    message(FATAL_ERROR "libdcm.so needs ${_lib}, which dcm.pc and dcmConfig.cmake do not mention")
+  endif()
+endforeach()
+if(NOT _needed MATCHES "libtbb")
+  message(FATAL_ERROR "libdcm.so no longer needs libtbb: update dcm.pc.in and dcmConfig.cmake.in")
+endif()
 
 # 1. find_package(dcm) in a separate project.
 run("configure the example" ${CMAKE_COMMAND} -S "${DCM_EXAMPLE_DIR}" -B "${_build}" -G "${DCM_GENERATOR}"
@@ -91,5 +125,28 @@ if(_pkgconfig AND _cc)
 else()
   message(FATAL_ERROR "pkg-config or a C compiler is missing")
 endif()
+
+# 3. C++: dcm::engine and dcm::aov at the compiler's default standard.
+run("configure the C++ consumer" ${CMAKE_COMMAND} -S "${DCM_CXX_CONSUMER_DIR}" -B "${_tmp}/build-cxx"
+    -G "${DCM_GENERATOR}" -DCMAKE_PREFIX_PATH=${_prefix} -DCMAKE_BUILD_TYPE=Release)
+run("build the C++ consumer" ${CMAKE_COMMAND} --build "${_tmp}/build-cxx")
+run("make AOVs" /usr/bin/python3 "${DCM_MAKE_AOVS}" "${_tmp}/aovs.exr" 64)
+run("run the C++ consumer" "${_tmp}/build-cxx/dcm_cxx_consumer" "${_tmp}/aovs.exr")
+if(NOT run_output MATCHES "missing file: [^\n]*no-such-file\\.exr")
+  message(FATAL_ERROR "C++ consumer: the missing file is not named:\n${run_output}")
+endif()
+# A dense 64x64 input: a few hundred exact pixels, an error at the scale of
+# the scene's texture steps on its edge pixels (the mean over the image
+# stays below 1 %).
+if(NOT run_output MATCHES "size 64x64" OR NOT run_output MATCHES "exact fraction ([0-9.]+)")
+  message(FATAL_ERROR "C++ consumer:\n${run_output}")
+endif()
+if(NOT CMAKE_MATCH_1 GREATER 0 OR NOT CMAKE_MATCH_1 LESS 0.6)
+  message(FATAL_ERROR "C++ consumer: exact fraction ${CMAKE_MATCH_1} not in (0, 0.6)")
+endif()
+if(NOT run_output MATCHES "mean abs error ([0-9.]+)" OR NOT CMAKE_MATCH_1 LESS 0.01 OR NOT run_output MATCHES "\nOK\n")
+  message(FATAL_ERROR "C++ consumer: error too large or missing:\n${run_output}")
+endif()
+message(STATUS "C++ consumer (dcm::engine, dcm::aov): ${run_output}")
 
 file(REMOVE_RECURSE "${_tmp}")

@@ -17,6 +17,7 @@
 
 #include "dcm/downsample.h"
 #include "aov_common.h"
+#include "reconstruct_exr.h"
 #include "common/image_io.h"
 #include "common/metrics.h"
 #include "common/preview.h"
@@ -38,41 +39,11 @@ struct ReconstructFlags {
   PipeFlags pipe;  ///< --provider-cmd: a renderer in a child process instead of EXR inputs
 };
 
-nlohmann::json ErrorJson(const toolkit::ImageError& e) {
-  nlohmann::json j;
-  auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
-  j["psnr"] = num(e.psnr);  // null: identical images (infinite PSNR)
-  j["rmse"] = num(e.rmse);
-  j["relmse"] = num(e.relmse);
-  j["ssim"] = num(e.ssim);
-  j["non_finite_pixels"] = e.nonFinite;
-  return j;
-}
-
 std::string PsnrText(double psnr) {
   if (std::isinf(psnr)) return "inf (identical)";
   std::ostringstream s;
   s << std::fixed << std::setprecision(2) << psnr << " dB";
   return s.str();
-}
-
-/// The statistics of a whole reconstruction and of a part alike.
-nlohmann::json StatsJson(const std::string& cmd, const ReconstructFlags& f, const aov::AovProvider& provider,
-                         const Reconstruction& r, const ReconstructionOptions& options, double wallS) {
-  nlohmann::json stats = toolkit::StatsToJson(r.stats);
-  stats["command"] = cmd;
-  stats["inputs"] = f.aov.inputs;
-  if (!f.aov.samples.empty()) stats["samples"] = f.aov.samples;
-  stats["mode"] = provider.dense() ? "dense" : "sparse";
-  stats["method"] = f.engine.method;
-  stats["width"] = r.width;
-  stats["height"] = r.height;
-  stats["work_width"] = r.workWidth;
-  stats["work_height"] = r.workHeight;
-  stats["time_reconstruct_s"] = wallS;
-  stats["options"] = toolkit::OptionsToJson(options);
-  stats["warnings"] = provider.Warnings();
-  return stats;
 }
 
 /// The provenance every output EXR carries in its metadata.
@@ -87,43 +58,6 @@ toolkit::Metadata ProvenanceMetadata(const ReconstructFlags& f, const aov::AovPr
   for (const auto& in : f.aov.inputs) inputs += (inputs.empty() ? "" : " ") + in;
   meta.strings.push_back({"dcm:inputs", inputs});
   return meta;
-}
-
-/// The sparse round trip ran out of samples: how many of the pixels the
-/// engine asked for (`forWhat`: " for this part" or "") were not rendered.
-int FailMissingSamples(const aov::AovProvider& provider, const std::vector<Point2i>& pending,
-                       const std::string& forWhat) {
-  int64_t missing = 0;
-  for (const auto& p : pending) missing += provider.HasSample(p) ? 0 : 1;
-  return aov_common::Fail("reconstruct", "the samples lack " + std::to_string(missing) +
-                                             " pixels the engine needs" + forWhat +
-                                             "; run `dcm plan` with the same inputs, flags and samples, render what "
-                                             "it asks for, and repeat");
-}
-
-/// The output's place in the frame: the inputs' data and display windows (a
-/// render region stays a region of its frame, overscan stays overscan), at
-/// the output resolution of --downsample N.
-Status OutputWindows(const aov::AovProvider& provider, int n, Bounds2i* display, Bounds2i* data) {
-  *display = provider.DisplayWindow();
-  *data = provider.DataWindow();
-  if (n <= 1) return Status::Ok();
-  const bool whole = *display == *data;
-  // A region must sit on the N-pixel lattice of its frame; a whole frame
-  // only needs its origin there (its size is rounded as the image's is).
-  std::vector<int> onLattice = {display->min.x, display->min.y, data->min.x, data->min.y};
-  if (!whole) onLattice.insert(onLattice.end(), {display->max.x, display->max.y, data->max.x, data->max.y});
-  for (int v : onLattice)
-    if (v % n != 0)
-      return Status::Error("--downsample " + std::to_string(n) + ": the inputs' data window (" +
-                           toolkit::RegionText(*data) + ") or display window (" + toolkit::RegionText(*display) +
-                           ") does not lie on a multiple of " + std::to_string(n) + " pixels");
-  const Point2i size = OutputSize(data->width(), data->height(), n);
-  *data = {{data->min.x / n, data->min.y / n}, {data->min.x / n + size.x, data->min.y / n + size.y}};
-  *display = whole ? *data
-                   : Bounds2i{{display->min.x / n, display->min.y / n},
-                              {display->max.x / n, display->max.y / n}};
-  return Status::Ok();
 }
 
 /// --tile / --region: the region of the frame, written as a part for `dcm merge`.
@@ -169,7 +103,7 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
   st = aov_common::Run(provider, options, f.engine, &r, &pending, &region, &info);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (st.pending()) {
-    return FailMissingSamples(provider, pending, " for this part");
+    return aov_common::Fail(cmd, MissingSamplesMessage(provider, pending, " for this part"));
   }
   if (!st.ok()) return aov_common::Fail(cmd, st.message());
 
@@ -190,7 +124,7 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
     }
   }
 
-  nlohmann::json stats = StatsJson(cmd, f, provider, r, options, wall);
+  nlohmann::json stats = ExrStatsJson(cmd, f.aov, f.engine, provider, r, options, wall);
   stats["part"] = PartJson(tile, info);
   if (haveRef) stats["reference"] = ErrorJson(error);
 
@@ -259,52 +193,13 @@ int RunReconstruct(const ReconstructFlags& f) {
   st = aov_common::OpenProvider(cmd, f.aov, aovOptions, f.engine, options, &provider);
   if (!st.ok()) return aov_common::Fail(cmd, st.message());
   if (IsPartial(f.tiles)) return RunReconstructPart(f, options, *provider);
-  Bounds2i display, data;
-  st = OutputWindows(*provider, options.downsample, &display, &data);
-  if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
-
-  // An explicit reference is read (and checked) before the work starts.
-  std::vector<RGB> reference;
-  int refW = 0, refH = 0;
-  if (!f.reference.empty()) {
-    st = toolkit::ReadRgb(f.reference, &refW, &refH, &reference);
-    if (!st.ok()) return aov_common::Fail(cmd, st.message());
-  }
-
-  Reconstruction r;
-  std::vector<Point2i> pending;
-  const auto t0 = std::chrono::steady_clock::now();
-  st = aov_common::Run(*provider, options, f.engine, &r, &pending);
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  if (st.pending()) {
-    return FailMissingSamples(*provider, pending, "");
-  }
-  if (!st.ok()) return aov_common::Fail(cmd, st.message());
-
-  // The error against the full input (dense mode) or an explicit reference,
-  // at the output resolution.
-  bool haveRef = false;
-  if (!reference.empty()) {
-    if (refW != r.width || refH != r.height)
-      return aov_common::Fail(cmd, "reference '" + f.reference + "' is " + std::to_string(refW) + "x" +
-                                       std::to_string(refH) + ", the output is " +
-                                       std::to_string(r.width) + "x" + std::to_string(r.height));
-    haveRef = true;
-  } else if (provider->dense()) {
-    int w = 0, h = 0;
-    reference = dcm::BoxDownsample(provider->Beauty(), provider->width(), provider->height(),
-                                       options.downsample, &w, &h);
-    haveRef = (w == r.width && h == r.height);
-  }
-  toolkit::ImageError error;
-  if (haveRef) error = toolkit::Compare(r.image, reference, r.width, r.height);
-
-  nlohmann::json stats = StatsJson(cmd, f, *provider, r, options, wall);
-  const auto caps = provider->Capabilities();
-  stats["capabilities"] = {{"object_id", caps.objectId}, {"shader_id", caps.shaderId},
-                           {"texture", caps.texture},    {"split_radiance", caps.splitRadiance},
-                           {"variance", caps.variance},  {"hard_shadows_guided", caps.hardShadowsGuided}};
-  if (haveRef) stats["reference"] = ErrorJson(error);
+  ExrReconstruction run;
+  bool usage = false;
+  st = ReconstructWholeExr(cmd, *provider, f.aov, f.engine, options, f.reference, &run, &usage);
+  if (!st.ok()) return aov_common::Fail(cmd, st.message(), usage ? kExitUsage : kExitFailure);
+  const Reconstruction& r = run.result;
+  const bool haveRef = run.haveReference;
+  const toolkit::ImageError& error = run.error;
 
   toolkit::Metadata meta = ProvenanceMetadata(f, *provider, options);
   meta.floats.push_back({"dcm:exact_fraction", float(r.stats.exactFraction())});
@@ -313,16 +208,16 @@ int RunReconstruct(const ReconstructFlags& f) {
   // Every output is atomic; if a later one fails, the earlier ones go too.
   aov_common::Outputs outputs(cmd);
   auto write = [&outputs](const std::string& path, Status s) { return outputs.Write(path, std::move(s)); };
-  int rc = write(f.output, toolkit::WriteRgbExr(f.output, display, data, r.image, meta, f.alpha));
+  int rc = write(f.output, toolkit::WriteRgbExr(f.output, run.display, run.data, r.image, meta, f.alpha));
   if (rc) return rc;
   if (!f.sampleMap.empty() && (rc = write(f.sampleMap, toolkit::WriteSampleMap(f.sampleMap, r)))) return rc;
   if (!f.preview.empty() &&
       (rc = write(f.preview, toolkit::WritePreview(f.preview, r.width, r.height, r.image))))
     return rc;
   if (!f.errorMap.empty() &&
-      (rc = write(f.errorMap, toolkit::WriteErrorMap(f.errorMap, r.image, reference, r.width, r.height))))
+      (rc = write(f.errorMap, toolkit::WriteErrorMap(f.errorMap, r.image, run.reference, r.width, r.height))))
     return rc;
-  if (!f.stats.empty() && (rc = write(f.stats, toolkit::WriteJson(f.stats, stats)))) return rc;
+  if (!f.stats.empty() && (rc = write(f.stats, toolkit::WriteJson(f.stats, run.stats)))) return rc;
 
   if (!f.engine.quiet) {
     std::ostringstream s;

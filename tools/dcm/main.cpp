@@ -15,7 +15,8 @@ std::vector<CommandEntry>& CommandRegistry() {
 int main(int argc, char** argv) {
   using namespace dcm::cli;
   CLI::App app{"dcm: image reconstruction with Directional Coherence Maps (Guo 1998, Scheel et al. 2001)"};
-  app.set_version_flag("--version", std::string("dcm ") + DCM_VERSION);
+  const std::string version = std::string("dcm ") + DCM_VERSION;
+  app.set_version_flag("--version", version);
   app.require_subcommand(1, 1);
 
   auto& registry = CommandRegistry();
@@ -24,6 +25,7 @@ int main(int argc, char** argv) {
   std::vector<std::pair<CLI::App*, std::function<int()>>> commands;
   for (const auto& entry : registry) {
     CLI::App* sub = app.add_subcommand(entry.name, entry.description);
+    sub->set_version_flag("--version", version);  // `dcm COMMAND --version` too, for scripts that wrap one command
     commands.emplace_back(sub, entry.setup(sub));
   }
   try {
