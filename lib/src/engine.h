@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdint>
 #include <map>
 #include <span>
@@ -77,6 +78,24 @@ class Engine {
     if (opt_.progress) opt_.progress(f, stage);
   }
   Value At(Point2i p) const { return store_.ValueAt(store_.Index(p.x, p.y)); }
+  /// Runs stage `f` (returning Status or nothing) and adds its wall time,
+  /// the provider's excluded, to `*slot` (ReconstructionStats::stageTimes).
+  template <typename F>
+  auto Timed(double* slot, F&& f) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const double provider0 = stats_.timeProviderS + stats_.timeGuidesS;
+    struct Add {
+      double* slot;
+      std::chrono::steady_clock::time_point t0;
+      double provider0;
+      const ReconstructionStats& stats;
+      ~Add() {
+        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        *slot += std::max(0.0, wall - (stats.timeProviderS + stats.timeGuidesS - provider0));
+      }
+    } add{slot, t0, provider0, stats_};
+    return f();
+  }
 
   // Object/shader surface test (surface_test.cpp, paper 2.2, 3.2).
   Status LoadGuides();

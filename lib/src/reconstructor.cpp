@@ -67,7 +67,8 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
   const auto tStart = Clock::now();
   const int W = caps_.width, H = caps_.height;
   // The baseline needs no guides: it evaluates every pixel.
-  if (!opt_.fullEvaluation) DCM_RETURN_IF_ERROR(LoadGuides());
+  StageTimes& t = stats_.stageTimes;
+  if (!opt_.fullEvaluation) DCM_RETURN_IF_ERROR(Timed(&t.surfaces, [&] { return LoadGuides(); }));
   if (opt_.checkerboard && !opt_.fullEvaluation) deferred_.assign(size_t(W) * size_t(H), SampleReason::kInterpolated);
 
   if (opt_.fullEvaluation) {
@@ -88,39 +89,45 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
       std::vector<Block> nextClassify, nextEdges, splitSmooth;  // splitSmooth: for progressive previews
 
       Progress(f0, "corners");
-      DCM_RETURN_IF_ERROR(ClassifySmoothOrEdge(classify, size, finest, &edges, &nextClassify, &splitSmooth));
+      DCM_RETURN_IF_ERROR(Timed(&t.refinement, [&] {
+        return ClassifySmoothOrEdge(classify, size, finest, &edges, &nextClassify, &splitSmooth);
+      }));
       Progress(f0 + 0.4f * df, "edge borders");
       std::vector<EdgeBlock> eb;
-      DCM_RETURN_IF_ERROR(EvaluateBorders(edges, size < block_, &eb));
-      OrientEdgeBlocks(eb);
+      DCM_RETURN_IF_ERROR(Timed(&t.borders, [&] { return EvaluateBorders(edges, size < block_, &eb); }));
+      Timed(&t.directions, [&] { OrientEdgeBlocks(eb); });
       if (!finest) {
-        DCM_RETURN_IF_ERROR(ClassifySimpleOrComplex(eb));
-        DCM_RETURN_IF_ERROR(EvaluateLazily(eb, size, &nextEdges));
+        DCM_RETURN_IF_ERROR(Timed(&t.simpleComplex, [&] { return ClassifySimpleOrComplex(eb); }));
+        DCM_RETURN_IF_ERROR(Timed(&t.lazy, [&] { return EvaluateLazily(eb, size, &nextEdges); }));
       } else {
-        DCM_RETURN_IF_ERROR(SettleFinest(eb));
+        DCM_RETURN_IF_ERROR(Timed(&t.finest, [&] { return SettleFinest(eb); }));
       }
       if (opt_.onLevel && !finest) WritePreview(level, splitSmooth, eb);
       classify = std::move(nextClassify);
       edges = std::move(nextEdges);
     }
 
-    RequestFallbackInteriors();
-    // Flushed before the thin-object pass: a fallback block's border is also
-    // its neighbours' border, and what the pass decides depends on it.
-    DCM_RETURN_IF_ERROR(Flush());
-    DCM_RETURN_IF_ERROR(InterpolateLeaves());
+    DCM_RETURN_IF_ERROR(Timed(&t.interpolation, [&] {
+      RequestFallbackInteriors();
+      // Flushed before the thin-object pass: a fallback block's border is
+      // also its neighbours' border, and what the pass decides depends on it.
+      const Status flushed = Flush();
+      return flushed.ok() ? InterpolateLeaves() : flushed;
+    }));
     if (opt_.onLevel) opt_.onLevel(levels - 1, W, H, store_.radiance());
     stats_.smoothBlocks = int64_t(smoothLeaves_.size());
     stats_.fallbackBlocks = int64_t(fallbackLeaves_.size());
   }
 
   // Outputs.
-  out->workWidth = W;
-  out->workHeight = H;
-  out->workImage = store_.TakeRadiance();
-  out->sampleMap = store_.TakeReasons();
-  out->image = BoxDownsample(out->workImage, W, H, opt_.downsample, &out->width, &out->height);
-  RecordLeaves(out);
+  Timed(&t.output, [&] {
+    out->workWidth = W;
+    out->workHeight = H;
+    out->workImage = store_.TakeRadiance();
+    out->sampleMap = store_.TakeReasons();
+    out->image = BoxDownsample(out->workImage, W, H, opt_.downsample, &out->width, &out->height);
+    RecordLeaves(out);
+  });
   stats_.totalPixels = int64_t(W) * H;
   // Flush() counted the exact pixels by reason as it made them exact.
   stats_.exactPixels = 0;
