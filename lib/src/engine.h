@@ -186,7 +186,7 @@ class Engine {
     kFinal,       ///< write what it can, request the rest
   };
   /// Interpolates the pixels of an oriented leaf that are not exact along
-  /// the leaf's direction (2.3), the thin-object test (3.1) deciding which
+  /// the leaf's direction (2.1), the thin-object test (3.1) deciding which
   /// ones must be exact instead.
   void InterpolateOriented(const Leaf& leaf, OrientedPass pass);
   /// The final interpolation of every leaf: thin objects first, then (after

@@ -66,8 +66,8 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
   pending_ = pending;
   const auto tStart = Clock::now();
   const int W = caps_.width, H = caps_.height;
-  // The baseline needs no guides: it evaluates every pixel.
   StageTimes& t = stats_.stageTimes;
+  // The baseline needs no guides: it evaluates every pixel.
   if (!opt_.fullEvaluation) DCM_RETURN_IF_ERROR(Timed(&t.surfaces, [&] { return LoadGuides(); }));
   if (opt_.checkerboard && !opt_.fullEvaluation) deferred_.assign(size_t(W) * size_t(H), SampleReason::kInterpolated);
 
