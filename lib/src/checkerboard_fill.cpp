@@ -1,5 +1,9 @@
+// dcm's checkerboard refinement: of the pixels the thin-object test or a
+// fallback wants exact, one colour first; the other filled where its exact
+// neighbours agree.
 #include "checkerboard_fill.h"
 
+#include "engine.h"
 #include "oriented_interpolation.h"
 
 namespace dcm::detail {
@@ -40,6 +44,45 @@ bool NeighbourEstimate(const SampleStore& store, const ContrastTest& contrast, P
       if (usable[k] && contrast.Misses(v[k], estimate)) return false;
   *out = estimate;
   return true;
+}
+
+void Engine::RequestOrDefer(int x, int y, SampleReason reason) {
+  const int64_t i = store_.Index(x, y);
+  if (store_.IsExact(i)) return;  // a probe inside a fallback block, say
+  if (opt_.checkerboard && !EvaluatedFirst(x, y)) deferred_[size_t(i)] = reason;
+  else store_.Request(x, y, reason);
+}
+
+Status Engine::ResolveDeferred(bool write) {
+  std::vector<int64_t> deferred;
+  for (size_t i = 0; i < deferred_.size(); ++i)
+    if (deferred_[i] != SampleReason::kInterpolated) deferred.push_back(int64_t(i));
+  std::vector<uint8_t> filled(deferred.size(), 0);
+  // The decisions read the exact samples of the first colour only (requests
+  // take effect at the flush), so they do not depend on the order.
+  ForEach(deferred, [&](int64_t& i, size_t k) {
+    const int x = int(i % store_.width()), y = int(i / store_.width());
+    Value v;
+    if (NeighbourEstimate(store_, contrast_, {x, y}, true, &v)) {
+      filled[k] = 1;
+      if (write) store_.SetInterpolated(i, v);
+    } else {
+      store_.Request(x, y, deferred_[size_t(i)]);
+    }
+  });
+  filledDeferred_.clear();
+  for (size_t k = 0; k < deferred.size(); ++k)
+    if (filled[k]) filledDeferred_.push_back(deferred[k]);
+  stats_.checkerboardFilled = int64_t(filledDeferred_.size());
+  return Flush();
+}
+
+void Engine::WriteFilledDeferred() {
+  ForEach(filledDeferred_, [&](int64_t& i, size_t) {
+    Value v;
+    if (NeighbourEstimate(store_, contrast_, {int(i % store_.width()), int(i / store_.width())}, false, &v))
+      store_.SetInterpolated(i, v);
+  });
 }
 
 }  // namespace dcm::detail

@@ -1,7 +1,11 @@
+// The least-discrepancy direction of each edge block (paper 2.1, Figure 2).
 #include "least_discrepancy_direction.h"
 
 #include <cmath>
 #include <limits>
+
+#include "engine.h"
+#include "simple_complex_classification.h"
 
 namespace dcm::detail {
 
@@ -114,6 +118,19 @@ DirectionChoice LeastDiscrepancyDirection(const SampleStore& store, std::span<co
   const std::span<const Value> v(value);
   const std::span<const uint8_t> f(finite);
   return store.split() || store.hasVariance() ? Search<false>(v, f, allFinite, pairs) : Search<true>(v, f, allFinite, pairs);
+}
+
+void Engine::OrientEdgeBlocks(std::vector<EdgeBlock>& eb) {
+  // The geometry per block shape, built before the blocks run in parallel.
+  for (const EdgeBlock& e : eb) {
+    const auto shape = std::pair(e.block.width(), e.block.height());
+    if (!borderPairs_.contains(shape)) borderPairs_.try_emplace(shape, shape.first, shape.second, settings_.directions);
+  }
+  ForEach(eb, [&](EdgeBlock& e, size_t) {
+    e.direction = LeastDiscrepancyDirection(store_, e.border,
+                                            borderPairs_.at(std::pair(e.block.width(), e.block.height())));
+    e.crossings = SignificantChanges(store_, contrast_, e.border);
+  });
 }
 
 }  // namespace dcm::detail

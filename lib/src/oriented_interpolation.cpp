@@ -142,4 +142,10 @@ Value Bilinear(const SampleStore& store, const Block& b, Point2i q) {
   return Evaluate(store, in);
 }
 
+bool OneEnded(const Interpolant& in) {
+  for (int k = 1; k < in.count; ++k)
+    if (in.end[k] != in.end[0]) return false;
+  return in.count > 0;
+}
+
 }  // namespace dcm::detail

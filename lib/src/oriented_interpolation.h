@@ -69,6 +69,10 @@ class OrientedElements {
   std::vector<Element> elements_;  ///< interior pixels, row-major
 };
 
+/// True when every pixel of the interpolant serves one border point: the
+/// other border point lay on another surface and was left out.
+bool OneEnded(const Interpolant& in);
+
 /// The weighted sum of the interpolant's values.
 Value Evaluate(const SampleStore& store, const Interpolant& in);
 

@@ -1,7 +1,5 @@
 #include "sample_store.h"
 
-#include <unordered_map>
-
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 #include <tbb/task_arena.h>
@@ -10,6 +8,8 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+
+#include "texture_split.h"
 
 namespace dcm::detail {
 
@@ -25,106 +25,6 @@ SampleStore::SampleStore(int width, int height, bool split, bool variance)
   finite_.assign(n, 1);
   filled_.assign(n, 0);
   if (variance) var_.assign(n, {0.f, 0.f});
-}
-
-void SampleStore::SetGuides(GuideImage guides, ObjectTest test, float creaseAngle, int regionCell) {
-  guides_ = std::move(guides);
-  if (split_) tau_ = std::move(guides_.texture);
-  if (test == ObjectTest::kObjectOrShader && !guides_.objectId.empty() &&
-      guides_.shaderId.size() == guides_.objectId.size()) {
-    // A surface is an (object, shader) pair: one label per pair, numbered in
-    // the order of first appearance (deterministic), instead of the object ID.
-    // Neighbours mostly repeat the last pair: look up only the changes.
-    std::unordered_map<uint64_t, uint32_t> labels;
-    uint64_t lastPair = 0;
-    uint32_t lastLabel = 0;
-    for (size_t i = 0; i < guides_.objectId.size(); ++i) {
-      const uint64_t pair = (uint64_t(guides_.objectId[i]) << 32) | guides_.shaderId[i];
-      if (i == 0 || pair != lastPair) {
-        lastPair = pair;
-        lastLabel = labels.try_emplace(pair, uint32_t(labels.size())).first->second;
-      }
-      guides_.objectId[i] = lastLabel;
-    }
-  }
-  const uint32_t* obj = (test != ObjectTest::kNone && !guides_.objectId.empty()) ? guides_.objectId.data() : nullptr;
-  const uint32_t* shader = (obj && test == ObjectTest::kObjectAndShader && !guides_.shaderId.empty())
-                               ? guides_.shaderId.data() : nullptr;
-  crease_.clear();
-  const std::vector<Vec3f>& normal = guides_.normal;
-  if (creaseAngle > 0.f && normal.size() == size_t(width_) * size_t(height_)) {
-    // A crease where the angle between unit normals exceeds creaseAngle;
-    // a zero or non-finite normal (background, no data) marks none.
-    const double cosMax = std::cos(double(creaseAngle) * 3.14159265358979323846 / 180.0);
-    auto dot = [&](size_t i, size_t j, double* out) {
-      const Vec3f a = normal[i], b = normal[j];
-      const double la = std::sqrt(double(a.x) * a.x + double(a.y) * a.y + double(a.z) * a.z);
-      const double lb = std::sqrt(double(b.x) * b.x + double(b.y) * b.y + double(b.z) * b.z);
-      if (!(la > 1e-12 && lb > 1e-12 && std::isfinite(la) && std::isfinite(lb))) return false;
-      *out = (double(a.x) * b.x + double(a.y) * b.y + double(a.z) * b.z) / (la * lb);
-      return true;
-    };
-    crease_.assign(normal.size(), 0);
-    for (int y = 0; y < height_; ++y)
-      for (int x = 0; x < width_; ++x) {
-        const size_t i = size_t(Index(x, y));
-        double d = 0;
-        if (x + 1 < width_ && dot(i, i + 1, &d) && d < cosMax) crease_[i] |= 1;
-        if (y + 1 < height_ && dot(i, i + size_t(width_), &d) && d < cosMax) crease_[i] |= 2;
-      }
-  }
-  tauZero_.clear();
-  if (split_ && tau_.size() == size_t(width_) * size_t(height_)) {
-    tauZero_.resize(tau_.size());
-    for (size_t i = 0; i < tau_.size(); ++i) tauZero_[i] = TauZero(tau_[i]) ? 1 : 0;
-  }
-  regions_ = CellRegions{};
-  if (!crease_.empty()) {
-    // Per cell: union-find over 4-neighbours of one object (and one tau = 0
-    // class) that no crease separates.
-    const int e = std::max(1, regionCell);
-    regions_.size = e;
-    regions_.cellsX = (width_ + e - 1) / e;
-    const int cellsY = (height_ + e - 1) / e;
-    const size_t perCell = size_t(e + 1) * size_t(e + 1);
-    regions_.labels.assign(size_t(regions_.cellsX) * size_t(cellsY) * perCell, 0u);
-    tbb::parallel_for(0, cellsY, [&](int cy) {
-      for (int cx = 0; cx < regions_.cellsX; ++cx) {
-        uint32_t* label = regions_.labels.data() + (size_t(cy) * size_t(regions_.cellsX) + size_t(cx)) * perCell;
-        for (size_t k = 0; k < perCell; ++k) label[k] = uint32_t(k);
-        auto find = [&](uint32_t k) {
-          while (label[k] != k) k = label[k] = label[label[k]];
-          return k;
-        };
-        const int x0 = cx * e, y0 = cy * e;
-        const int x1 = std::min(x0 + e, width_ - 1), y1 = std::min(y0 + e, height_ - 1);
-        auto join = [&](size_t i, size_t j, uint32_t a, uint32_t b) {
-          if (obj && obj[i] != obj[j]) return;
-          if (!tauZero_.empty() && tauZero_[i] != tauZero_[j]) return;
-          a = find(a), b = find(b);
-          if (a != b) label[std::max(a, b)] = std::min(a, b);
-        };
-        for (int y = y0; y <= y1; ++y)
-          for (int x = x0; x <= x1; ++x) {
-            const size_t i = size_t(Index(x, y));
-            const uint32_t k = uint32_t((y - y0) * (e + 1) + (x - x0));
-            if (x < x1 && !(crease_[i] & 1)) join(i, i + 1, k, k + 1);
-            if (y < y1 && !(crease_[i] & 2)) join(i, i + size_t(width_), k, k + uint32_t(e + 1));
-          }
-        for (size_t k = 0; k < perCell; ++k) label[k] = find(uint32_t(k));
-      }
-    });
-  }
-  surfaces_ = SurfaceTest(obj, shader, crease_.empty() ? nullptr : crease_.data(), width_,
-                          tauZero_.empty() ? nullptr : tauZero_.data(), regions_.labels.empty() ? nullptr : &regions_);
-}
-
-bool SampleStore::TauZero(RGB tau) { return tau.r == 0.f && tau.g == 0.f && tau.b == 0.f; }
-
-bool SampleStore::TauRecoverable(RGB tau) {
-  for (int c = 0; c < 3; ++c)
-    if (!std::isfinite(tau[c]) || std::fabs(tau[c]) < std::numeric_limits<float>::min()) return false;
-  return true;
 }
 
 std::array<float, 2> SampleStore::LuminanceVariances(RGB varL, RGB tau) {

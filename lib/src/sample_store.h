@@ -13,6 +13,7 @@
 #include "dcm/options.h"
 #include "dcm/reconstructor.h"
 #include "dcm/sample_provider.h"
+#include "surface_test.h"
 
 namespace dcm::detail {
 
@@ -37,80 +38,6 @@ inline Value Lerp(const Value& p, const Value& q, float t) {
           (1 - t) * (1 - t) * p.varA + t * t * q.varA, (1 - t) * (1 - t) * p.varB + t * t * q.varB};
 }
 
-/// Regions of one object that creases cut off, found inside each cell of
-/// `size` x `size` pixels of the lattice, its far border included (the
-/// elementary block: every leaf block and its border lie in one cell). Local
-/// to the cell, so that a window of the frame on the lattice decides as the
-/// whole frame does (docs/TILES.md), and a crease that closes only far away
-/// does not cut.
-struct CellRegions {
-  int size = 0;    ///< cell side, in pixels (its far border is size + 1)
-  int cellsX = 0;  ///< cells per row
-  /// Per cell, (size + 1)^2 labels, row-major from the cell's origin: equal
-  /// labels are one region.
-  std::vector<uint32_t> labels;
-};
-
-/// Which pairs of pixels lie on the same surface (paper 2.2 and 3.2).
-class SurfaceTest {
- public:
-  SurfaceTest() = default;
-  /// `crease`: per pixel, bit 1 when a crease separates it from its right
-  /// neighbour, bit 2 from the one below (from normal guides); may be null.
-  /// `tauZero`: per pixel, 1 where tau is exactly zero (with the texture
-  /// split); such pixels are another surface than those with tau != 0, since
-  /// their L_i is unknown. May be null.
-  /// `regions`: the regions of each cell (from normal guides; may be null):
-  /// two pixels of one object that share a cell are one surface only when a
-  /// path inside the cell joins them without crossing a crease.
-  SurfaceTest(const uint32_t* objectId, const uint32_t* shaderId, const uint8_t* crease = nullptr, int width = 0,
-              const uint8_t* tauZero = nullptr, const CellRegions* regions = nullptr)
-      : objectId_(objectId), shaderId_(shaderId), crease_(crease), tauZero_(tauZero), width_(width) {
-    if (regions && !regions->labels.empty())
-      regionLabels_ = regions->labels.data(), regionSize_ = regions->size, regionCellsX_ = regions->cellsX;
-  }
-  bool enabled() const { return objectId_ != nullptr || crease_ != nullptr || tauZero_ != nullptr; }
-  /// Without IDs everything is one surface; with object IDs only, equal IDs;
-  /// with object and shader IDs, a surface changes where both differ.
-  bool Same(int64_t i, int64_t j) const {
-    if (tauZero_ && tauZero_[i] != tauZero_[j]) return false;
-    if (!objectId_ || objectId_[i] == objectId_[j]) return !regionLabels_ || SameRegion(i, j);
-    return shaderId_ && shaderId_[i] == shaderId_[j];
-  }
-  /// For 4-neighbours i and j: Same(), and no crease between them. A crease
-  /// that does not close a region (a fold that fades out) still marks where
-  /// a block has a surface change and where its border needs samples.
-  bool SameAdjacent(int64_t i, int64_t j) const {
-    if (!Same(i, j)) return false;
-    if (!crease_) return true;
-    const int64_t lo = std::min(i, j), hi = std::max(i, j);
-    if (hi - lo == width_) return !(crease_[lo] & 2);
-    if (hi - lo == 1) return !(crease_[lo] & 1);
-    return true;  // not neighbours (the wrap of a degenerate block's loop)
-  }
-
- private:
-  bool SameRegion(int64_t i, int64_t j) const;
-
-  const uint32_t* objectId_ = nullptr;
-  const uint32_t* shaderId_ = nullptr;
-  const uint8_t* crease_ = nullptr;
-  const uint8_t* tauZero_ = nullptr;
-  const uint32_t* regionLabels_ = nullptr;  ///< CellRegions::labels (its buffer outlives moves)
-  int regionSize_ = 0, regionCellsX_ = 0;
-  int width_ = 0;
-};
-
-inline bool SurfaceTest::SameRegion(int64_t i, int64_t j) const {
-  const int64_t w = width_, e = regionSize_;
-  const int64_t xi = i % w, yi = i / w, xj = j % w, yj = j / w;
-  const int64_t cx = std::min(xi, xj) / e, cy = std::min(yi, yj) / e;
-  // No cell holds both: the IDs alone decide.
-  if (std::max(xi, xj) > cx * e + e || std::max(yi, yj) > cy * e + e) return true;
-  const uint32_t* cell = regionLabels_ + size_t(cy * regionCellsX_ + cx) * size_t((e + 1) * (e + 1));
-  return cell[(yi - cy * e) * (e + 1) + (xi - cx * e)] == cell[(yj - cy * e) * (e + 1) + (xj - cx * e)];
-}
-
 class SampleStore {
  public:
   /// `variance`: exact samples carry the variance of their estimate.
@@ -126,12 +53,9 @@ class SampleStore {
   /// finite and, with the split, its tau is neither zero, denormal nor
   /// non-finite (L_i = L_t / tau is meaningless there).
   bool IsFinite(int64_t i) const { return finite_[i] != 0; }
-  static bool TauRecoverable(RGB tau);
   /// Exact sample i can give L_i to pixel q: not when i has tau = 0 (its L_i
   /// is unknown) and q has not. Holds whatever the surface-aware switch.
   bool LiKnownFor(int64_t i, int64_t q) const { return tauZero_.empty() || !tauZero_[i] || tauZero_[q]; }
-  /// tau is exactly zero in all three channels (L = L_c).
-  static bool TauZero(RGB tau);
   /// (varA, varB) of a sample whose L has per-channel variance `varL`.
   static std::array<float, 2> LuminanceVariances(RGB varL, RGB tau);
   /// Without the split the interpolated quantity is L itself, stored once.
@@ -178,7 +102,7 @@ class SampleStore {
   const SurfaceTest& surfaces() const { return surfaces_; }
   /// `creaseAngle` (degrees, 0: off) turns the normal guides, if any, into
   /// crease marks between neighbouring pixels, and into the regions of each
-  /// `regionCell` cell (the elementary block).
+  /// `regionCell` cell (the elementary block). Defined in surface_test.cpp.
   void SetGuides(GuideImage guides, ObjectTest test, float creaseAngle = 0.f, int regionCell = 16);
 
   /// The radiance of every pixel: exact L where exact, a*tau+b elsewhere.

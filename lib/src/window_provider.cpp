@@ -7,7 +7,7 @@
 #include <string>
 
 #include "dcm/downsample.h"
-#include "sample_denoising.h"
+#include "settings.h"
 
 namespace dcm {
 
@@ -92,9 +92,10 @@ int RegionHaloBlocks(const ReconstructionOptions& options, const ProviderCapabil
   // samples reach further: a sample on a side depends on the exact samples
   // within the denoising radius, whose state depends on the blocks they lie
   // in: as many more blocks as the radius spans.
-  if (!detail::DenoisesSamples(options, caps)) return 1;
-  const int block = std::max(1, detail::ElementaryBlock(options, caps));
-  return 1 + (detail::DenoiseRadius(options, caps) + block - 1) / block;
+  const detail::Settings settings = detail::Resolve(options, caps);
+  if (!settings.denoise) return 1;
+  const int block = std::max(1, settings.elementaryBlock);
+  return 1 + (settings.denoiseRadius + block - 1) / block;
 }
 
 Point2i OutputSize(int workWidth, int workHeight, int downsample) {
@@ -140,7 +141,7 @@ Status ReconstructRegion(SampleProvider& provider, const ReconstructionOptions& 
   const Bounds2i work = WorkRegion(outputRegion, caps.width, caps.height, s);
   if (haloBlocks < 0) haloBlocks = RegionHaloBlocks(options, caps);
   const Bounds2i window =
-      RegionWindow(outputRegion, caps.width, caps.height, s, detail::ElementaryBlock(options, caps), haloBlocks);
+      RegionWindow(outputRegion, caps.width, caps.height, s, detail::Resolve(options, caps).elementaryBlock, haloBlocks);
 
   if (info) {
     info->output = outputRegion;

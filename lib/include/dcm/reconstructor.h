@@ -47,6 +47,22 @@ struct BlockRecord {
   int8_t direction = -1;  ///< index of the least-discrepancy direction, -1 for none
 };
 
+/// The engine's time per stage of one reconstruction: wall seconds, the
+/// provider's time (Evaluate, Guides) excluded; they add up to about
+/// ReconstructionStats::timeEngineS.
+struct StageTimes {
+  double surfaces = 0;       ///< the guides turned into the surface test (creases, regions)
+  double refinement = 0;     ///< corners, smooth/edge classification, smooth refinement (paper 2.1, 2.2)
+  double borders = 0;        ///< edge-block borders, adaptive or in full
+  double directions = 0;     ///< least-discrepancy directions and border changes (2.1)
+  double simpleComplex = 0;  ///< simple/complex classification (2.3)
+  double lazy = 0;           ///< lazy boundary evaluation (2.1)
+  double finest = 0;         ///< finest fallback and centre probes
+  double interpolation = 0;  ///< fallback interiors, thin objects (3.1), checkerboard, final interpolation
+  double denoising = 0;      ///< fits of noisy samples
+  double output = 0;         ///< downsampling and the record of leaves
+};
+
 struct ReconstructionStats {
   int64_t totalPixels = 0;   ///< working-image pixels
   int64_t exactPixels = 0;
@@ -61,6 +77,7 @@ struct ReconstructionStats {
   double timeGuidesS = 0;    ///< in the provider's Guides()
   double timeProviderS = 0;  ///< in the provider's Evaluate() (the illumination)
   double timeEngineS = 0;    ///< everything else
+  StageTimes stageTimes;     ///< timeEngineS per stage
   bool usedSplit = false, usedObjectId = false, usedShaderId = false, usedNormals = false;
   bool usedSupersampledRules = false;  ///< ReconstructionOptions::SupersampledRules
   double exactFraction() const { return totalPixels ? double(exactPixels) / double(totalPixels) : 0.0; }

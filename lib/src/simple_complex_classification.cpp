@@ -1,6 +1,12 @@
-#include "edge_classification.h"
+// Simple/complex classification of edge blocks (paper 2.3): the zero-order,
+// first-order and object tests, and dcm's rule for small blocks whose border
+// changes only at surface changes.
+#include "simple_complex_classification.h"
 
+#include <algorithm>
 #include <cmath>
+
+#include "engine.h"
 
 namespace dcm::detail {
 
@@ -111,6 +117,31 @@ bool FirstOrderConsistent(const SampleStore& store, const ContrastTest& contrast
   if (chord > 1.5 && (!parallel(ex[0], ey[0], chx, chy) || !parallel(ex[1], ey[1], chx, chy)))
     return false;
   return true;
+}
+
+Status Engine::ClassifySimpleOrComplex(std::vector<EdgeBlock>& eb) {
+  ForEach(eb, [&](EdgeBlock& e, size_t) {
+    const size_t n = e.crossings.size();
+    const bool zeroOrder = !opt_.zeroOrderTest || n == 2 || (n == 0 && opt_.gradientBlocksSimple);
+    const int surfaceChanges = SurfaceChanges(store_, e.border);
+    // Every significant change a surface change (crossings include them all).
+    const bool onlySurfaces = int(n) == surfaceChanges;
+    const bool small = std::max(e.block.width(), e.block.height()) <= 2 * opt_.minBlock;
+    e.simple = e.block.HasInterior() &&
+               ((zeroOrder && surfaceChanges <= 2) ||
+                (small && onlySurfaces && n > 2 && int(n) <= opt_.simpleSurfaceChanges));
+    if (e.simple && opt_.firstOrderTest && n == 2)
+      for (Point2i p : FirstOrderProbes(store_, e.block, e.border, e.crossings, opt_.firstOrderFromGuides))
+        store_.Request(p.x, p.y, SampleReason::kFirstOrderProbe);
+  });
+  if (opt_.firstOrderTest) {
+    DCM_RETURN_IF_ERROR(Flush());
+    ForEach(eb, [&](EdgeBlock& e, size_t) {
+      if (e.simple && e.crossings.size() == 2)
+        e.simple = FirstOrderConsistent(store_, contrast_, e.block, e.border, e.crossings, opt_.firstOrderFromGuides);
+    });
+  }
+  return Status::Ok();
 }
 
 }  // namespace dcm::detail
