@@ -105,7 +105,7 @@ std::string HelpFormatter::make_help(const CLI::App* app, std::string name, CLI:
     const std::vector<const CLI::Option*> opts = app->get_options([&](const CLI::Option* o) {
       return o->get_group() == group && o->nonpositional() && !group.empty();
     });
-    if (!opts.empty()) out << make_group(group, false, opts) << "\n";
+    if (!opts.empty()) out << make_group(group, false, opts);
   }
   out << make_subcommands(app, mode) << '\n' << make_footer(app);
   return out.str();
