@@ -79,7 +79,7 @@ inline void AddAovFlags(CLI::App* app, AovFlags* f, bool samplesHelpForPlan) {
       ->allow_extra_args(false);
   app->add_flag("--estimate-variance", f->estimateVariance,
                 "noisy renders without a variance channel: estimate the noise from the data (docs/NOISE.md)");
-  app->option_defaults()->group("Options");
+  app->option_defaults()->group(kGroupGeneral);
 }
 
 /// The bindings of a --texture MAP.json: {"SHADER": "FILE", ...}; relative

@@ -1018,7 +1018,7 @@ Registration reg(
       app->add_option("--threads", f->threads, "worker threads (0: all cores)")
           ->transform(Integer(0, kMaxThreads))
           ->capture_default_str();
-      app->option_defaults()->group("Options");
+      app->option_defaults()->group(kGroupGeneral);
       app->add_flag("-v,--verbose", f->verbose, "per point: the time split, pixel counts and SSIM");
       app->add_flag("-q,--quiet", f->quiet, "no progress on stderr, no summary on stdout");
       return [f] { return RunBench(*f); };

@@ -119,7 +119,7 @@ Registration reg("merge", "Assemble the parts of --tile/--region runs into the f
                        ->required();
                    app->add_option("-o,--output", f->output, "the frame (EXR)")->required();
                    app->add_option("--stats", f->stats, "write the counts summed over the parts (JSON)");
-                   app->option_defaults()->group("Options");
+                   app->option_defaults()->group(kGroupGeneral);
                    AddFramesFlag(app, &f->frames.frames,
                                  "N or A-B: replace '#' runs in the part and output names by the frame number");
                    app->add_flag("-q,--quiet", f->quiet, "no summary on stdout");

@@ -155,7 +155,7 @@ Registration reg("pipe", "Reconstruct with an external renderer as a child proce
                    app->add_option("-o,--output", f->output, "output image (EXR)")->required();
                    app->add_option("--stats", f->stats, "write statistics (JSON)");
                    app->add_option("--sample-map", f->sampleMap, "write the sample map (PNG): which pixels were exact, why");
-                   app->option_defaults()->group("Options");
+                   app->option_defaults()->group(kGroupGeneral);
                    AddProviderTimeoutFlags(app, f.get());
                    AddEngineFlags(app, &f->engine);
                    AddTileFlags(app, &f->tiles);

@@ -185,7 +185,7 @@ Registration reg("plan", "Plan the next round of a file-based round trip (pixels
                    app->add_option("--mask", f->mask, "output EXR mask of the pixels to render");
                    app->add_option("--list", f->list, "output text list of the pixels to render ('x y' lines)");
                    app->add_option("--stats", f->stats, "round summary as JSON");
-                   app->option_defaults()->group("Options");
+                   app->option_defaults()->group(kGroupGeneral);
                    AddEngineFlags(app, &f->engine);
                    app->get_option("--quiet")->description(
                        "no progress, warnings or notes on stderr (stdout still says \"pending N\" or \"done\")");

@@ -373,7 +373,7 @@ Registration reg("reconstruct", "Reconstruct an image from a renderer's EXR AOVs
 #ifdef DCM_HAVE_PIPE
                    AddProviderTimeoutFlags(app, &f->pipe);
 #endif
-                   app->option_defaults()->group("Options");
+                   app->option_defaults()->group(kGroupGeneral);
                    AddEngineFlags(app, &f->engine);
                    app->get_option("--quiet")->description("no progress or warnings on stderr, no summary on stdout");
                    AddTileFlags(app, &f->tiles);

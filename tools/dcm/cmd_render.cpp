@@ -371,7 +371,7 @@ Registration reg("render", "Ray trace a scene file (Embree) with DCM: a few perc
                                    "from 2 on, samples carry their variance)")
                        ->transform(Integer(1, 1 << 20))
                        ->group(kGroupNoise);
-                   app->option_defaults()->group("Options");
+                   app->option_defaults()->group(kGroupGeneral);
                    AddEngineFlags(app, &f->engine);
                    AddTileFlags(app, &f->tiles);
                    return [f, app] { return RunRenderFrames(*f, app); };

@@ -17,7 +17,9 @@
 
 namespace dcm::cli {
 
-/// The help groups, in the order `--help` lists them (HelpFormatter).
+/// The help groups, in the order `--help` lists them (HelpFormatter): first
+/// CLI11's own (--help, -v, -q), then the command's.
+inline constexpr const char* kGroupGeneral = "Options";
 inline constexpr const char* kGroupIo = "Inputs and outputs";
 inline constexpr const char* kGroupQuality = "Quality";
 inline constexpr const char* kGroupGuides = "Guides";
