@@ -235,4 +235,32 @@ TEST(BenchNoise, UsageErrors) {
   fs::remove_all(dir);
 }
 
+// A value out of a flag's range is refused at parse time (exit 2, the flag
+// named as typed), before the output folder is made; never replaced by the
+// default.
+TEST(BenchFlags, HostileValuesAreRefused) {
+  const std::string scene = std::string(DCM_SOURCE_DIR) + "/examples/scenes/room.json";
+  const fs::path dir = fs::temp_directory_path() / ("dcm_bench_flags_" + std::to_string(::getpid()));
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--threads", "10000000"}, {"--threads", "-1"},     {"--scale", "nan"},
+      {"--scale", "0"},          {"--thresholds", "0.1,nan"}, {"--thresholds", "-0.1"},
+      {"--spp", "1"},            {"--reference-spp", "0"},  {"--jbu-spatial-sigma", "nan"},
+      {"--jbu-range-sigma", "inf"},
+  };
+  for (const auto& [flag, value] : cases) {
+    const std::string cmd = ShellQuote(DCM_BINARY) + " bench " + ShellQuote(scene) + " --quick --no-plots " + flag +
+                            " " + ShellQuote(value) + " --out " + ShellQuote(dir.string()) + " 2>&1";
+    FILE* p = popen(cmd.c_str(), "r");
+    ASSERT_NE(p, nullptr);
+    std::string out;
+    char buf[512];
+    while (size_t n = fread(buf, 1, sizeof buf, p)) out.append(buf, n);
+    const int status = pclose(p);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 2) << flag << " " << value << ": " << out;
+    EXPECT_NE(out.find("dcm bench: error: " + flag + ": "), std::string::npos) << out;
+    EXPECT_NE(out.find(value.substr(value.find(',') + 1)), std::string::npos) << "the value as typed: " << out;
+    EXPECT_FALSE(fs::exists(dir)) << flag << " " << value;
+  }
+}
+
 }  // namespace

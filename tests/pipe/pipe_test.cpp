@@ -539,8 +539,48 @@ TEST(DcmPipe, UsageErrors) {
                 &log),
             2)
       << log;
-  EXPECT_TRUE(Contains(log, "not a multiple of --downsample 5")) << log;
+  EXPECT_TRUE(Contains(log, "dcm pipe: error: --downsample 5: the provider's image 32x32 is not a multiple")) << log;
   EXPECT_TRUE(dir.empty());
+}
+
+// A value out of a flag's range is refused before the provider starts (exit
+// 2, the flag named as typed, no output), for `dcm pipe` and for `dcm
+// reconstruct --provider-cmd` alike; a timeout of 1e10 s no longer overflows
+// the deadline, 10 million threads no longer reach TBB.
+TEST(DcmPipe, HostileFlagsAreRefused) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--provider-timeout", "1e10"},        {"--provider-timeout", "-1"},
+      {"--provider-timeout", "nan"},         {"--provider-timeout", "0"},
+      {"--provider-startup-timeout", "inf"}, {"--threads", "10000000"},
+      {"--threads", "-1"},                   {"--threshold", "nan"},
+      {"--block", "3"},                      {"--tile-size", "0"},
+  };
+  const std::string provider = Quoted(Analytic("--width 32 --height 32"));
+  for (const std::string command : {"pipe", "reconstruct"}) {
+    for (const auto& [flag, value] : cases) {
+      TempDir dir;
+      std::string log;
+      EXPECT_EQ(RunShell(std::string(DCM_BINARY) + " " + command + " --provider-cmd " + provider + " " + flag + " " +
+                             value + " -o " + (dir / "o.exr") + " --stats " + (dir / "s.json"),
+                         &log),
+                2)
+          << command << " " << flag << " " << value << ": " << log;
+      EXPECT_TRUE(Contains(log, "dcm " + command + ": error: " + flag + ": ")) << log;
+      EXPECT_TRUE(Contains(log, value)) << "the value as typed: " << log;
+      EXPECT_TRUE(dir.empty()) << command << " " << flag << " " << value;
+    }
+  }
+  // The largest timeout is used as given (the run succeeds), and so is one thread.
+  TempDir dir;
+  std::string log;
+  EXPECT_EQ(RunShell(std::string(DCM_BINARY) + " pipe -q --provider-cmd " + provider +
+                         " --provider-timeout 1e6 --provider-startup-timeout 1e6 --threads 1 -o " + (dir / "o.exr") +
+                         " --stats " + (dir / "s.json"),
+                     &log),
+            0)
+      << log;
+  std::ifstream in(dir / "s.json");
+  EXPECT_EQ(nlohmann::json::parse(in)["options"]["threads"], 1);
 }
 
 }  // namespace

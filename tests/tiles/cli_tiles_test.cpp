@@ -6,12 +6,14 @@
 #include <OpenImageIO/imageio.h>
 
 #include <cstring>
+#include <map>
 #include <fstream>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "dcm/options.h"
 #include "test_util.h"
 
 namespace dcm::aov::test {
@@ -262,6 +264,163 @@ TEST_F(MergeErrors, NotAPartAndBadTileFlags) {
   EXPECT_EQ(r.exitCode, 2);
   EXPECT_NE(r.err.find("beyond"), std::string::npos) << r.err;
   EXPECT_FALSE(std::ifstream(dir_ / "bad.exr").good());
+}
+
+// Hostile flag values (issue 25): each is refused by every command that takes
+// the flag, with exit 2, a message naming the flag as typed and the value,
+// and no file written; none is replaced by the default.
+struct Hostile {
+  std::vector<std::string> commands;
+  std::string flag, value;
+};
+
+TEST(HostileFlags, RefusedWithTheFlagNamed) {
+  ScratchDir dir;
+  Scene s;  // 64x64: --downsample 3 does not divide it
+  WriteExr(dir / "in.exr", s.width, s.height, s.GenericChannels(true));
+  WriteExr(dir / "guides.exr", s.width, s.height, s.GenericChannels(true, /*guidesOnly=*/true));
+  const std::map<std::string, std::vector<std::string>> base = {
+      {"render", {"render", kRoom, "-o", dir / "out.exr", "--stats", dir / "s.json"}},
+      {"reconstruct", {"reconstruct", dir / "in.exr", "-o", dir / "out.exr", "--stats", dir / "s.json"}},
+      {"plan", {"plan", dir / "guides.exr", "--list", dir / "next.txt", "--stats", dir / "s.json"}},
+      {"merge", {"merge", dir / "in.exr", "-o", dir / "out.exr"}}};
+  const std::vector<std::string> engine = {"render", "reconstruct", "plan"};
+  const std::vector<Hostile> cases = {
+      {engine, "--threshold", "-1"},
+      {engine, "--threshold", "nan"},
+      {engine, "--threshold", "inf"},
+      {engine, "--threshold", "1e39"},  // finite as a double, not as a float
+      {engine, "--block", "0"},
+      {engine, "--block", "3"},
+      {engine, "--block", "-8"},
+      {engine, "--block", "512"},
+      {engine, "--min-block", "0"},
+      {engine, "--directions", "0"},
+      {engine, "--directions", "7"},
+      {engine, "--tile-size", "0"},
+      {engine, "--threads", "10000000"},
+      {engine, "--threads", "-1"},
+      {engine, "--threads", "2.5"},
+      {engine, "--crease-angle", "nan"},
+      {engine, "--crease-angle", "181"},
+      {engine, "--noise-significance", "-1"},
+      {engine, "--probe-lc-share", "1.5"},
+      {engine, "--neighbour-directions", "-1"},
+      {engine, "--simple-surface-changes", "0"},
+      {engine, "--fallback-shading-changes", "-2"},
+      {engine, "--crossing-fill", "-1"},
+      {engine, "--downsample", "0"},
+      {engine, "--thin-test", "sometimes"},
+      {engine, "--tile", "4/4"},
+      {engine, "--tile", "0/99999999999"},
+      {engine, "--region", "0,0,0,8"},
+      {{"render", "reconstruct", "plan", "merge"}, "--frames", "5-3"},
+      // Checked once the other flags or the input are known.
+      {{"reconstruct", "plan"}, "--block", "2"},       // below the default --min-block 4
+      {{"reconstruct", "plan"}, "--min-block", "32"},  // above the default --block 16
+      {{"reconstruct", "plan"}, "--downsample", "3"},
+      {{"reconstruct", "plan"}, "--highlight-level", "nan"},
+      {{"reconstruct", "plan"}, "--highlight-level", "-1"},
+      {{"render"}, "--scale", "nan"},
+      {{"render"}, "--supersampling", "0"},
+      {{"render"}, "--spp", "0"},
+      {{"render"}, "--seed", "-1"},
+      {{"render"}, "--size", "0x10"},
+  };
+  const std::vector<std::string> before = dir.Files();
+  for (const Hostile& c : cases) {
+    for (const std::string& command : c.commands) {
+      std::vector<std::string> args = base.at(command);
+      args.insert(args.end(), {c.flag, c.value});
+      const RunResult r = RunDcm(args, dir);
+      const std::string what = command + " " + c.flag + " " + c.value;
+      EXPECT_EQ(r.exitCode, 2) << what << "\nstderr: " << r.err;
+      EXPECT_NE(r.err.find("dcm " + command + ": "), std::string::npos) << what << ": " << r.err;
+      EXPECT_NE(r.err.find(c.flag), std::string::npos) << what << ": " << r.err;
+      EXPECT_NE(r.err.find(c.value), std::string::npos) << what << ": " << r.err;
+      EXPECT_EQ(dir.Files(), before) << what << ": a file was written";
+    }
+  }
+}
+
+// The edge values the old "0 or negative: the default" rules swallowed are
+// used as typed.
+TEST(HostileFlags, EdgeValuesAreUsedAsGiven) {
+  ScratchDir dir;
+  Scene s;
+  WriteExr(dir / "in.exr", s.width, s.height, s.GenericChannels(true));
+  const RunResult r = RunDcm({"reconstruct", dir / "in.exr", "-o", dir / "out.exr", "--stats", dir / "s.json", "-q",
+                              "--threshold", "0", "--threads", "1", "--tile-size", "1", "--crease-angle", "0",
+                              "--noise-significance", "0", "--probe-lc-share", "0", "--neighbour-directions", "0",
+                              "--crossing-fill", "0", "--fallback-shading-changes", "-1", "--simple-surface-changes",
+                              "2", "--block", "4", "--min-block", "2", "--directions", "4"},
+                             dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(r.out, "") << "-q: no summary";
+  EXPECT_EQ(r.err, "") << "-q: no progress";
+  const nlohmann::json o = ReadJson(dir / "s.json")["options"];
+  EXPECT_EQ(o["contrast_threshold"], 0.0);
+  EXPECT_EQ(o["contrast_threshold_supersampled"], 0.0);
+  EXPECT_EQ(o["threads"], 1);
+  EXPECT_EQ(o["tile_size"], 1);
+  EXPECT_EQ(o["crease_angle"], 0.0);
+  EXPECT_EQ(o["noise_significance"], 0.0);
+  EXPECT_EQ(o["probe_lc_share"], 0.0);
+  EXPECT_EQ(o["neighbour_directions"], 0);
+  EXPECT_EQ(o["crossing_fill_reach"], 0);
+  EXPECT_EQ(o["fallback_shading_changes"], -1);
+  EXPECT_EQ(o["simple_surface_changes"], 2);
+  EXPECT_EQ(o["elementary_block"], 4);
+  EXPECT_EQ(o["min_block"], 2);
+  EXPECT_EQ(o["directions"], 4);
+  EXPECT_EQ(o["directions_supersampled"], 4);
+}
+
+// --help: the groups in order, the defaults the parser shows, -q and the exit
+// codes; the summary of a run on stdout, not stderr.
+TEST(HostileFlags, HelpGroupsQuietAndSummaryOnStdout) {
+  ScratchDir dir;
+  const ReconstructionOptions d;
+  for (const std::string command : {"render", "reconstruct", "plan"}) {
+    const RunResult r = RunDcm({command, "--help"}, dir);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    size_t at = 0;
+    for (const char* group :
+         {"Inputs and outputs:", "Quality:", "Guides:", "Tiles and frames:", "Noise:", "Engine internals:"}) {
+      const size_t next = r.out.find(std::string("\n") + group + "\n");
+      ASSERT_NE(next, std::string::npos) << command << ": no group " << group << "\n" << r.out;
+      EXPECT_GT(next, at) << command << ": " << group << " out of order";
+      at = next;
+    }
+    // Expert switches come after the input and output flags, with the internals.
+    EXPECT_GT(r.out.find("--probe-lc-share"), r.out.find("Engine internals:")) << r.out;
+    const size_t minBlock = r.out.find("--min-block");
+    ASSERT_NE(minBlock, std::string::npos);
+    // The parser shows the engine's default at the end of the flag's entry.
+    std::string shown("(default: ");
+    shown.append(std::to_string(d.minBlock)).append(")");
+    EXPECT_LT(r.out.find(shown, minBlock), r.out.find("--directions", minBlock)) << r.out;
+    EXPECT_NE(r.out.find("-q,--quiet"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("Exit codes: 0"), std::string::npos) << r.out;
+  }
+  const RunResult merge = RunDcm({"merge", "--help"}, dir);
+  EXPECT_NE(merge.out.find("-q,--quiet"), std::string::npos) << merge.out;
+
+  Scene s;
+  WriteExr(dir / "in.exr", s.width, s.height, s.GenericChannels(true));
+  RunResult r = RunDcm({"reconstruct", dir / "in.exr", "-o", dir / "out.exr"}, dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("exact pixels"), std::string::npos) << r.out;
+  EXPECT_EQ(r.err.find("exact pixels"), std::string::npos) << r.err;
+  r = RunDcm({"reconstruct", dir / "in.exr", "--tile", "0/2", "-o", dir / "t0.exr"}, dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("tile 0/2"), std::string::npos) << r.out;
+  r = RunDcm({"reconstruct", dir / "in.exr", "--tile", "1/2", "-o", dir / "t1.exr", "-q"}, dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  r = RunDcm({"merge", dir / "t0.exr", dir / "t1.exr", "-o", dir / "merged.exr"}, dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("2 parts -> "), std::string::npos) << r.out;
+  EXPECT_EQ(r.err, "");
 }
 
 }  // namespace

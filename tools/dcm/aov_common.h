@@ -21,6 +21,7 @@
 #include "dcm/reconstructor.h"
 #include "dcm/window_provider.h"
 #include "engine_flags.h"
+#include "flag_checks.h"
 #include "tile_flags.h"
 
 namespace dcm::cli::aov_common {
@@ -42,11 +43,13 @@ struct AovFlags {
 /// `dcm plan` needs its inputs; `dcm reconstruct` may take --provider-cmd
 /// instead (and checks that one of the two is given).
 inline void AddAovFlags(CLI::App* app, AovFlags* f, bool samplesHelpForPlan) {
+  app->option_defaults()->group(kGroupIo);
   auto* inputs =
       app->add_option("inputs", f->inputs, "input EXR files (one multilayer EXR or several EXRs of one size)");
   if (samplesHelpForPlan) inputs->required();
-  app->add_option("--preset", f->preset, "channel names: generic (default) or blender (Cycles passes)")
-      ->check(CLI::IsMember({"generic", "blender"}));
+  app->add_option("--preset", f->preset, "channel names: generic or blender (Cycles passes)")
+      ->check(CLI::IsMember({"generic", "blender"}))
+      ->capture_default_str();
   app->add_option("--map", f->maps,
                   "ROLE=CHANNEL: override a role (id, shader, u, v, tau, N, shadow, highlight, Li, Lc, L, var, mask or one "
                   "component like tau.R); CHANNEL may be A+B, A*B or cryptomatte:LAYER")
@@ -56,9 +59,6 @@ inline void AddAovFlags(CLI::App* app, AovFlags* f, bool samplesHelpForPlan) {
                   "from a texture file; or MAP.json, an object {\"SHADER\": \"FILE\", ...} (relative files "
                   "from the JSON's folder)")
       ->allow_extra_args(false);
-  app->add_option("--highlight-level", f->highlightLevel,
-                  "highlight guide: a pixel whose guide (R+G+B of direct glossy light with --preset blender) "
-                  "exceeds this is a highlight, a surface of its own (default 1.5)");
   app->add_option("--layer", f->layer, "Blender view layer (default: the only one in the file)");
   app->add_option("--samples", f->samples,
                   samplesHelpForPlan
@@ -66,12 +66,20 @@ inline void AddAovFlags(CLI::App* app, AovFlags* f, bool samplesHelpForPlan) {
                       : "sparse round trip: samples EXRs rendered for `dcm plan` (repeatable); the "
                         "inputs then carry the guides only")
       ->allow_extra_args(false);
+  app->add_option("--highlight-level", f->highlightLevel,
+                  "highlight guide: a pixel whose guide (R+G+B of direct glossy light with --preset blender) "
+                  "exceeds this is a highlight, a surface of its own")
+      ->transform(FiniteNumber(0))
+      ->capture_default_str()
+      ->group(kGroupGuides);
+  app->option_defaults()->group(kGroupNoise);
   app->add_option("--second-render", f->secondRender,
                   "noisy renders: an independent render of the same frame (another seed, same channels); the "
                   "samples are the mean of both and their difference gives the variance (repeatable, as the inputs)")
       ->allow_extra_args(false);
   app->add_flag("--estimate-variance", f->estimateVariance,
                 "noisy renders without a variance channel: estimate the noise from the data (docs/NOISE.md)");
+  app->option_defaults()->group(kGroupGeneral);
 }
 
 /// The bindings of a --texture MAP.json: {"SHADER": "FILE", ...}; relative

@@ -39,6 +39,8 @@
 #include "dcm/reconstructor.h"
 #include "embree/embree_provider.h"
 #include "embree/scene_file.h"
+#include "engine_flags.h"
+#include "flag_checks.h"
 
 #if __has_include("dcm/aov/aov_provider.h")
 #include "dcm/aov/aov_provider.h"
@@ -56,7 +58,7 @@ struct BenchFlags {
   std::vector<std::string> inputs;
   std::string out;
   bool quick = false;
-  float scale = 0.f;
+  std::optional<float> scale;
   std::vector<float> thresholds;
   int threads = 0;
   bool noPlots = false;
@@ -67,12 +69,12 @@ struct BenchFlags {
   std::string preset = "generic";
   std::vector<std::string> maps;
   int downsample = 1;
-  float highlightLevel = -1;  ///< < 0: the AOV provider's default
+  std::optional<float> highlightLevel;  ///< empty: the AOV provider's default
   bench::JbuParams jbu;
   // Scenes: scene overrides and the noise sweep.
   std::vector<std::string> overrides;
   std::vector<int> spp;
-  int referenceSpp = 0;
+  std::optional<int> referenceSpp;
 };
 
 /// The settings of one point of the sweep.
@@ -160,7 +162,8 @@ Status GetProvider(Subject& s, int ss, SampleProvider** out, int spp = 0) {
   return Status::Ok();
 }
 
-Status OpenSubject(const BenchFlags& f, const std::string& input, Subject* s) {
+/// `usage`: set when the flags do not fit the input (exit 2).
+Status OpenSubject(const BenchFlags& f, const std::string& input, Subject* s, bool* usage) {
   s->input = input;
   s->name = fs::path(input).stem().string();
   if (EndsWith(input, ".exr")) {
@@ -169,13 +172,17 @@ Status OpenSubject(const BenchFlags& f, const std::string& input, Subject* s) {
     aov::AovOptions o;
     DCM_RETURN_IF_ERROR(aov::ParsePreset(f.preset, &o.preset));
     for (const auto& m : f.maps) DCM_RETURN_IF_ERROR(aov::ParseMapping(m, &o.mappings));
-    if (f.highlightLevel >= 0) o.highlightLevel = f.highlightLevel;
+    if (f.highlightLevel) o.highlightLevel = *f.highlightLevel;
     o.sparse = false;
     o.split = true;
     std::unique_ptr<aov::AovProvider> p;
     DCM_RETURN_IF_ERROR(aov::AovProvider::Open({input}, o, &p));
     if (!p->dense()) return Status::Error(input + ": dcm bench needs a dense AOV input (every pixel has a sample)");
     const auto caps = p->Capabilities();
+    if (Status st = CheckDownsample(caps.width, caps.height, f.downsample, input + ":"); !st.ok()) {
+      *usage = true;
+      return st;
+    }
     s->defaultSs = f.downsample;
     s->width = (caps.width + f.downsample - 1) / f.downsample;
     s->height = (caps.height + f.downsample - 1) / f.downsample;
@@ -189,7 +196,7 @@ Status OpenSubject(const BenchFlags& f, const std::string& input, Subject* s) {
   }
   s->kind = "scene";
   DCM_RETURN_IF_ERROR(embree::LoadSceneFile(input, &s->scene, f.overrides));
-  const float scale = f.scale > 0.f ? f.scale : (f.quick ? 0.125f : 1.f);
+  const float scale = f.scale ? *f.scale : (f.quick ? 0.125f : 1.f);
   s->scene.camera.width = std::max(8, int(std::lround(float(s->scene.camera.width) * scale)));
   s->scene.camera.height = std::max(8, int(std::lround(float(s->scene.camera.height) * scale)));
   s->width = s->scene.camera.width;
@@ -571,9 +578,9 @@ std::string ShellQuote(const std::string& s) {
   return q + "'";
 }
 
-int Fail(const Status& st) {
+int Fail(const Status& st, int code = kExitFailure) {
   std::cerr << "dcm bench: error: " << st.message() << "\n";
-  return kExitFailure;
+  return code;
 }
 
 int RunBench(const BenchFlags& f) {
@@ -593,7 +600,8 @@ int RunBench(const BenchFlags& f) {
 
   for (const std::string& input : f.inputs) {
     Subject s;
-    if (Status st = OpenSubject(f, input, &s); !st.ok()) return Fail(st);
+    bool usage = false;
+    if (Status st = OpenSubject(f, input, &s, &usage); !st.ok()) return Fail(st, usage ? kExitUsage : kExitFailure);
     if (talk) {
       std::cerr << "dcm bench: " << input << ": " << s.width << "x" << s.height << " (supersampling " << s.defaultSs
                 << "), effects " << Join(s.effects) << "\n";
@@ -603,7 +611,7 @@ int RunBench(const BenchFlags& f) {
     int referenceSpp = 0;
     if (noise) {
       if (s.kind != "scene") return Fail(Status::Error(input + ": --spp applies to scene files only"));
-      referenceSpp = f.referenceSpp > 0 ? f.referenceSpp : 16 * *std::max_element(f.spp.begin(), f.spp.end());
+      referenceSpp = f.referenceSpp ? *f.referenceSpp : 16 * *std::max_element(f.spp.begin(), f.spp.end());
       if (std::find(f.spp.begin(), f.spp.end(), referenceSpp) != f.spp.end())
         return Fail(Status::Error("--reference-spp " + std::to_string(referenceSpp) + " is also in --spp"));
     }
@@ -932,7 +940,7 @@ int RunBench(const BenchFlags& f) {
 
   nlohmann::json j = {{"tool", "dcm bench"},
                       {"quick", f.quick},
-                      {"scale", f.scale > 0.f ? double(f.scale) : (f.quick ? 0.125 : 1.0)},
+                      {"scale", f.scale ? double(*f.scale) : (f.quick ? 0.125 : 1.0)},
                       {"machine", {{"cpu", CpuName()}, {"hardware_threads", std::thread::hardware_concurrency()}}},
                       {"threads", f.threads},
                       {"inputs", inputsJson},
@@ -944,7 +952,7 @@ int RunBench(const BenchFlags& f) {
   if (Status st = WriteText((fs::path(f.out) / "summary.md").string(), summary.str()); !st.ok()) return Fail(st);
   if (!f.quiet) std::cout << summary.str();
   if (talk) {
-    std::cerr << "dcm bench: " << all.size() << " points in " << Fmt("%.1f", Seconds(tBench)) << " s; wrote "
+    std::cout << "dcm bench: " << all.size() << " points in " << Fmt("%.1f", Seconds(tBench)) << " s; wrote "
               << f.out << "/{bench.csv,bench.json,summary.md}\n";
   }
   return kExitOk;
@@ -954,48 +962,65 @@ Registration reg(
     "bench", "What accuracy costs in time: sweeps, rivals at equal budget, the paper's tables, plots",
     [](CLI::App* app) -> std::function<int()> {
       auto f = std::make_shared<BenchFlags>();
+      app->option_defaults()->group(kGroupIo);
       app->add_option("inputs", f->inputs,
                       DCM_BENCH_HAVE_AOV ? "scene files (JSON) or dense AOV EXRs" : "scene files (JSON)")
           ->required();
       app->add_option("--out", f->out, "output folder (bench.csv, bench.json, summary.md, PNGs)")->required();
-      app->add_flag("--quick", f->quick, "tiny size (scale 0.125) and few sweep points: a smoke test");
       app->add_option("--scale", f->scale, "scale the scenes' resolution (default 1, 0.125 with --quick)")
-          ->check(CLI::Range(1e-3f, 4.f));
-      app->add_option("--thresholds", f->thresholds, "contrast thresholds of the sweep")->delimiter(',');
-      app->add_option("--threads", f->threads, "worker threads (0: all cores)")->check(CLI::Range(0, 1024));
-      app->add_option("--jbu-spatial-sigma", f->jbu.spatialSigma,
-                      "joint bilateral rival: spatial Gaussian sigma in grid spacings (default 0.5, Kopf et al.)")
-          ->check(CLI::Range(0.05, 10.0));
-      app->add_option("--jbu-range-sigma", f->jbu.tauSigma,
-                      "joint bilateral rival: range Gaussian sigma on the texture guide tau (default 0.05)")
-          ->check(CLI::Range(1e-4, 100.0));
-      app->add_flag("--no-plots", f->noPlots, "do not run the plot script");
-      app->add_option("--python", f->python, "Python with matplotlib (default /usr/bin/python3)");
-      app->add_option("--plot-script", f->plotScript, "the plot script (default tools/bench/plot_tradeoff.py)");
-#if DCM_BENCH_HAVE_AOV
-      app->add_option("--preset", f->preset, "AOV inputs: channel names, generic or blender")
-          ->check(CLI::IsMember({"generic", "blender"}));
-      app->add_option("--map", f->maps, "AOV inputs: ROLE=CHANNEL (as dcm reconstruct)");
-      app->add_option("--downsample", f->downsample, "AOV inputs: supersampled N times per axis")
-          ->check(CLI::Range(1, 16));
-      app->add_option("--highlight-level", f->highlightLevel,
-                      "AOV inputs: a pixel whose highlight guide exceeds this is a highlight (as dcm reconstruct; "
-                      "default 1.5)")
-          ->check(CLI::NonNegativeNumber);
-#endif
+          ->transform(FiniteNumber(1e-3, 4));
       app->add_option("--set", f->overrides,
                       "scenes: override a setting before the scene is read, KEY.PATH=JSON (repeatable; as dcm render)")
           ->allow_extra_args(false);
+      app->add_flag("--no-plots", f->noPlots, "do not run the plot script");
+      app->add_option("--python", f->python, "Python with matplotlib")->capture_default_str();
+      app->add_option("--plot-script", f->plotScript, "the plot script (default tools/bench/plot_tradeoff.py)");
+#if DCM_BENCH_HAVE_AOV
+      app->add_option("--preset", f->preset, "AOV inputs: channel names, generic or blender")
+          ->check(CLI::IsMember({"generic", "blender"}))
+          ->capture_default_str();
+      app->add_option("--map", f->maps, "AOV inputs: ROLE=CHANNEL (as dcm reconstruct)");
+      app->add_option("--downsample", f->downsample,
+                      "AOV inputs: supersampled N times per axis (their size a multiple of N)")
+          ->transform(Integer(1, 16))
+          ->capture_default_str();
+#endif
+      app->option_defaults()->group(kGroupQuality);
+      app->add_flag("--quick", f->quick, "tiny size (scale 0.125) and few sweep points: a smoke test");
+      app->add_option("--thresholds", f->thresholds, "contrast thresholds of the sweep")
+          ->delimiter(',')
+          ->transform(FiniteNumber(0));
+      app->add_option("--jbu-spatial-sigma", f->jbu.spatialSigma,
+                      "joint bilateral rival: spatial Gaussian sigma in grid spacings (Kopf et al.)")
+          ->transform(FiniteNumber(0.05, 10.0))
+          ->capture_default_str();
+      app->add_option("--jbu-range-sigma", f->jbu.tauSigma,
+                      "joint bilateral rival: range Gaussian sigma on the texture guide tau")
+          ->transform(FiniteNumber(1e-4, 100.0))
+          ->capture_default_str();
+#if DCM_BENCH_HAVE_AOV
+      app->add_option("--highlight-level", f->highlightLevel,
+                      "AOV inputs: a pixel whose highlight guide exceeds this is a highlight (as dcm reconstruct)")
+          ->transform(FiniteNumber(0))
+          ->default_str(Fmt("%g", aov::AovOptions{}.highlightLevel))
+          ->group(kGroupGuides);
+#endif
+      app->option_defaults()->group(kGroupNoise);
       app->add_option("--spp", f->spp,
                       "scenes: the noise sweep instead of the accuracy sweeps: at each number of estimates per "
                       "pixel (render.samples_per_pixel), full noisy render, dcm, dcm with the noise ignored, paper")
           ->delimiter(',')
-          ->check(CLI::Range(2, 1 << 20));
+          ->transform(Integer(2, 1 << 20));
       app->add_option("--reference-spp", f->referenceSpp,
                       "--spp: estimates per pixel of the reference (default 16x the largest --spp)")
-          ->check(CLI::Range(2, 1 << 20));
+          ->transform(Integer(2, 1 << 20));
+      app->option_defaults()->group(kGroupInternals);
+      app->add_option("--threads", f->threads, "worker threads (0: all cores)")
+          ->transform(Integer(0, kMaxThreads))
+          ->capture_default_str();
+      app->option_defaults()->group(kGroupGeneral);
       app->add_flag("-v,--verbose", f->verbose, "per point: the time split, pixel counts and SSIM");
-      app->add_flag("--quiet", f->quiet, "no progress on stderr, no summary on stdout");
+      app->add_flag("-q,--quiet", f->quiet, "no progress on stderr, no summary on stdout");
       return [f] { return RunBench(*f); };
     });
 

@@ -20,6 +20,7 @@
 #include "commands.h"
 #include "common/stats_json.h"
 #include "common/tiles.h"
+#include "flag_checks.h"
 #include "tile_flags.h"
 
 namespace dcm::cli {
@@ -91,7 +92,7 @@ int MergeOne(const std::vector<std::string>& patterns, const std::string& output
     }
   }
   if (!quiet)
-    std::cerr << "dcm merge: " << parts.size() << " parts -> " << output << " (" << frame.width << "x"
+    std::cout << "dcm merge: " << parts.size() << " parts -> " << output << " (" << frame.width << "x"
               << frame.height << ")\n";
   return kExitOk;
 }
@@ -112,14 +113,16 @@ int RunMerge(const MergeFlags& f) {
 Registration reg("merge", "Assemble the parts of --tile/--region runs into the frame (checks coverage and settings)",
                  [](CLI::App* app) -> std::function<int()> {
                    auto f = std::make_shared<MergeFlags>();
+                   app->option_defaults()->group(kGroupIo);
                    app->add_option("parts", f->parts,
                                    "part EXRs (a pattern with * ? [ is expanded here, sorted)")
                        ->required();
                    app->add_option("-o,--output", f->output, "the frame (EXR)")->required();
                    app->add_option("--stats", f->stats, "write the counts summed over the parts (JSON)");
-                   app->add_option("--frames", f->frames.frames,
-                                   "N or A-B: replace '#' runs in the part and output names by the frame number");
-                   app->add_flag("--quiet", f->quiet, "no summary on stderr");
+                   app->option_defaults()->group(kGroupGeneral);
+                   AddFramesFlag(app, &f->frames.frames,
+                                 "N or A-B: replace '#' runs in the part and output names by the frame number");
+                   app->add_flag("-q,--quiet", f->quiet, "no summary on stdout");
                    return [f] { return RunMerge(*f); };
                  });
 

@@ -23,17 +23,21 @@
 #include "dcm/reconstructor.h"
 #include "dcm/window_provider.h"
 #include "engine_flags.h"
+#include "flag_checks.h"
 #include "pipe_run.h"
 
 namespace dcm::cli {
 
 void AddProviderTimeoutFlags(CLI::App* app, PipeFlags* f) {
   app->add_option("--provider-timeout", f->timeout,
-                  "seconds to wait for any later answer of the provider and for its exit (default 600)")
-      ->check(CLI::PositiveNumber);
-  app->add_option("--provider-startup-timeout", f->startupTimeout,
-                  "seconds to wait for the provider's handshake (default 600)")
-      ->check(CLI::PositiveNumber);
+                  "seconds to wait for any later answer of the provider and for its exit")
+      ->transform(FiniteNumber(0, kMaxTimeoutSeconds, /*above=*/true))
+      ->capture_default_str()
+      ->group(kGroupIo);
+  app->add_option("--provider-startup-timeout", f->startupTimeout, "seconds to wait for the provider's handshake")
+      ->transform(FiniteNumber(0, kMaxTimeoutSeconds, /*above=*/true))
+      ->capture_default_str()
+      ->group(kGroupIo);
 }
 
 int RunPipe(const std::string& cmd, const PipeFlags& f) {
@@ -64,11 +68,8 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
               << (caps.splitRadiance ? ", split radiance" : "") << "\n"
               << "engine settings: " << SettingsSummary(options, caps) << "\n";
   }
-  if (caps.width % options.downsample != 0 || caps.height % options.downsample != 0) {
-    return Fail("the provider's image " + std::to_string(caps.width) + "x" + std::to_string(caps.height) +
-                    " is not a multiple of --downsample " + std::to_string(options.downsample),
-                kExitUsage);
-  }
+  if (Status st = CheckDownsample(caps.width, caps.height, options.downsample, "the provider's image"); !st.ok())
+    return Fail(st.message(), kExitUsage);
 
   // --tile / --region: the part of the frame, its window asked of the child.
   const Point2i frame = OutputSize(caps.width, caps.height, options.downsample);
@@ -147,12 +148,14 @@ namespace {
 Registration reg("pipe", "Reconstruct with an external renderer as a child process (dcm-pipe protocol)",
                  [](CLI::App* app) -> std::function<int()> {
                    auto f = std::make_shared<PipeFlags>();
+                   app->option_defaults()->group(kGroupIo);
                    app->add_option("--provider-cmd", f->command,
                                    "shell command of the provider (run with /bin/sh -c; see plugins/pipe/PROTOCOL.md)")
                        ->required();
                    app->add_option("-o,--output", f->output, "output image (EXR)")->required();
                    app->add_option("--stats", f->stats, "write statistics (JSON)");
                    app->add_option("--sample-map", f->sampleMap, "write the sample map (PNG): which pixels were exact, why");
+                   app->option_defaults()->group(kGroupGeneral);
                    AddProviderTimeoutFlags(app, f.get());
                    AddEngineFlags(app, &f->engine);
                    AddTileFlags(app, &f->tiles);

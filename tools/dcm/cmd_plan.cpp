@@ -31,6 +31,7 @@
 #include "common/stats_json.h"
 #include "common/tiles.h"
 #include "dcm/window_provider.h"
+#include "flag_checks.h"
 #include "tile_flags.h"
 
 namespace dcm::cli {
@@ -91,6 +92,8 @@ int RunPlan(const PlanFlags& f) {
   std::unique_ptr<aov::AovProvider> provider;
   st = aov_common::OpenProvider(cmd, f.aov, aovOptions, f.engine, options, &provider);
   if (!st.ok()) return aov_common::Fail(cmd, st.message());
+  st = CheckDownsample(provider->width(), provider->height(), options.downsample, "the guides' data window");
+  if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
 
   Reconstruction r;
   std::vector<Point2i> pending;
@@ -178,10 +181,14 @@ Registration reg("plan", "Plan the next round of a file-based round trip (pixels
                  [](CLI::App* app) -> std::function<int()> {
                    auto f = std::make_shared<PlanFlags>();
                    aov_common::AddAovFlags(app, &f->aov, true);
+                   app->option_defaults()->group(kGroupIo);
                    app->add_option("--mask", f->mask, "output EXR mask of the pixels to render");
                    app->add_option("--list", f->list, "output text list of the pixels to render ('x y' lines)");
                    app->add_option("--stats", f->stats, "round summary as JSON");
+                   app->option_defaults()->group(kGroupGeneral);
                    AddEngineFlags(app, &f->engine);
+                   app->get_option("--quiet")->description(
+                       "no progress, warnings or notes on stderr (stdout still says \"pending N\" or \"done\")");
                    AddTileFlags(app, &f->tiles, /*plans=*/true);
                    return [f] { return RunPlanFrames(*f); };
                  });

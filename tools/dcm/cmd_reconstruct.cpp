@@ -24,6 +24,7 @@
 #include "common/sample_map.h"
 #include "common/stats_json.h"
 #include "common/tiles.h"
+#include "flag_checks.h"
 #include "pipe_run.h"
 #include "tile_flags.h"
 
@@ -148,7 +149,7 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
       << 100.0 * r.stats.exactFraction() << " %)";
     if (haveRef) s << ", PSNR " << PsnrText(error.psnr);
     s << " -> " << f.output;
-    std::cerr << s.str() << "\n";
+    std::cout << s.str() << "\n";
   }
   return kExitOk;
 }
@@ -192,6 +193,8 @@ int RunReconstruct(const ReconstructFlags& f) {
   std::unique_ptr<aov::AovProvider> provider;
   st = aov_common::OpenProvider(cmd, f.aov, aovOptions, f.engine, options, &provider);
   if (!st.ok()) return aov_common::Fail(cmd, st.message());
+  st = CheckDownsample(provider->width(), provider->height(), options.downsample, "the inputs' data window");
+  if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
   if (IsPartial(f.tiles)) return RunReconstructPart(f, options, *provider);
   ExrReconstruction run;
   bool usage = false;
@@ -226,7 +229,7 @@ int RunReconstruct(const ReconstructFlags& f) {
       << " %)";
     if (haveRef) s << ", PSNR " << PsnrText(error.psnr) << ", RMSE " << std::setprecision(5) << error.rmse;
     s << ", engine " << std::setprecision(3) << r.stats.timeEngineS << " s -> " << f.output;
-    std::cerr << s.str() << "\n";
+    std::cout << s.str() << "\n";
     if (r.stats.nonFiniteSamples)
       std::cerr << "dcm " << cmd << ": warning: " << r.stats.nonFiniteSamples
                 << " exact samples are NaN/Inf (kept to their pixels)\n";
@@ -251,6 +254,7 @@ Registration reg("reconstruct", "Reconstruct an image from a renderer's EXR AOVs
                  [](CLI::App* app) -> std::function<int()> {
                    auto f = std::make_shared<ReconstructFlags>();
                    aov_common::AddAovFlags(app, &f->aov, false);
+                   app->option_defaults()->group(kGroupIo);
                    app->add_option("-o,--output", f->output, "output EXR (float RGB)")->required();
                    app->add_option("--stats", f->stats, "statistics as JSON");
                    app->add_option("--sample-map", f->sampleMap, "PNG: which pixels were exact and why");
@@ -258,14 +262,16 @@ Registration reg("reconstruct", "Reconstruct an image from a renderer's EXR AOVs
                    app->add_option("--error-map", f->errorMap, "PNG heat map of the error (dense or --reference)");
                    app->add_option("--reference", f->reference, "compare with this EXR instead of the full input");
                    app->add_flag("--alpha", f->alpha, "write RGBA with A = 1");
-                   AddEngineFlags(app, &f->engine);
-                   AddTileFlags(app, &f->tiles);
                    app->add_option("--provider-cmd", f->pipe.command,
                                    "instead of input files: a renderer started as a child process that speaks the "
                                    "dcm-pipe protocol (plugins/pipe/PROTOCOL.md; as dcm pipe)");
 #ifdef DCM_HAVE_PIPE
                    AddProviderTimeoutFlags(app, &f->pipe);
 #endif
+                   app->option_defaults()->group(kGroupGeneral);
+                   AddEngineFlags(app, &f->engine);
+                   app->get_option("--quiet")->description("no progress or warnings on stderr, no summary on stdout");
+                   AddTileFlags(app, &f->tiles);
                    return [f] { return RunReconstructFrames(*f); };
                  });
 

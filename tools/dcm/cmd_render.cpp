@@ -2,6 +2,7 @@
 // evaluating only a few percent of the pixels exactly and reconstructing the
 // rest with DCM; optionally also the full (baseline) render, for the speed-up
 // and the error.
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -22,6 +23,7 @@
 #include "embree/embree_provider.h"
 #include "embree/scene_file.h"
 #include "engine_flags.h"
+#include "flag_checks.h"
 #include "tile_flags.h"
 
 namespace dcm::cli {
@@ -35,24 +37,27 @@ struct RenderFlags {
   std::string sampleMap;
   std::string preview;
   std::string size;
-  float scale = 0.f;
-  int supersampling = 0;
-  int spp = 0;
+  std::optional<float> scale;
+  std::optional<int> supersampling, spp;
   std::vector<std::string> overrides;
-  int64_t seed = -1;
+  std::optional<int64_t> seed;
   bool withReference = false;
   std::string referenceOut;
   EngineFlags engine;
   TileFlags tiles;
 };
 
+/// --size WIDTHxHEIGHT, each from 1 to 16384.
 Status ParseSize(const std::string& s, int* w, int* h) {
+  const size_t x = s.find_first_of("xX");
   int a = 0, b = 0;
-  char x = 0, extra = 0;
-  if (std::sscanf(s.c_str(), "%d%c%d%c", &a, &x, &b, &extra) != 3 || (x != 'x' && x != 'X') || a < 1 ||
-      b < 1 || a > 16384 || b > 16384) {
-    return Status::Error("--size: expected WIDTHxHEIGHT (e.g. 256x256), got '" + s + "'");
-  }
+  auto whole = [](const char* first, const char* last, int* v) {
+    const auto [end, ec] = std::from_chars(first, last, *v);
+    return first != last && ec == std::errc() && end == last;
+  };
+  if (x == std::string::npos || !whole(s.data(), s.data() + x, &a) ||
+      !whole(s.data() + x + 1, s.data() + s.size(), &b) || a < 1 || b < 1 || a > 16384 || b > 16384)
+    return Status::Error("expected WIDTHxHEIGHT, each from 1 to 16384 (e.g. 256x256), got '" + s + "'");
   *w = a;
   *h = b;
   return Status::Ok();
@@ -179,16 +184,16 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
   if (Status st = embree::LoadSceneFile(f.scene, &scene, f.overrides); !st.ok()) return Fail(st);
   if (!f.size.empty()) {
     if (Status st = ParseSize(f.size, &scene.camera.width, &scene.camera.height); !st.ok()) {
-      std::cerr << "dcm render: " << st.message() << "\n";
+      std::cerr << "dcm render: --size: " << st.message() << "\n";
       return kExitUsage;
     }
-  } else if (f.scale > 0.f) {
-    scene.camera.width = std::max(1, int(std::lround(float(scene.camera.width) * f.scale)));
-    scene.camera.height = std::max(1, int(std::lround(float(scene.camera.height) * f.scale)));
+  } else if (f.scale) {
+    scene.camera.width = std::max(1, int(std::lround(float(scene.camera.width) * *f.scale)));
+    scene.camera.height = std::max(1, int(std::lround(float(scene.camera.height) * *f.scale)));
   }
-  if (f.supersampling > 0) scene.render.supersampling = f.supersampling;
-  if (f.spp > 0) scene.render.samplesPerPixel = f.spp;
-  if (f.seed >= 0) scene.render.seed = uint32_t(f.seed);
+  if (f.supersampling) scene.render.supersampling = *f.supersampling;
+  if (f.spp) scene.render.samplesPerPixel = *f.spp;
+  if (f.seed) scene.render.seed = uint32_t(*f.seed);
 
   ReconstructionOptions options;
   if (Status st = ToOptions(f.engine, &options); !st.ok()) {
@@ -331,6 +336,7 @@ int RunRenderFrames(const RenderFlags& f, CLI::App* app) {
 Registration reg("render", "Ray trace a scene file (Embree) with DCM: a few percent of the pixels exact",
                  [](CLI::App* app) -> std::function<int()> {
                    auto f = std::make_shared<RenderFlags>();
+                   app->option_defaults()->group(kGroupIo);
                    app->add_option("scene", f->scene, "scene file (JSON, see plugins/embree/SCENE-FORMAT.md)")
                        ->required();
                    app->add_option("-o,--output", f->output, "output image (EXR)")->required();
@@ -338,27 +344,34 @@ Registration reg("render", "Ray trace a scene file (Embree) with DCM: a few perc
                    app->add_option("--stats", f->stats, "write statistics (JSON)");
                    app->add_option("--sample-map", f->sampleMap, "write the sample map (PNG): which pixels were exact, why");
                    app->add_option("--preview", f->preview, "write a display image (PNG) through OpenColorIO");
-                   auto* size = app->add_option("--size", f->size, "override the resolution, WIDTHxHEIGHT");
+                   app->add_flag("--with-reference", f->withReference,
+                                 "also render the full image in this run: prints the speed-up and the error");
+                   app->add_option("--reference-out", f->referenceOut,
+                                   "write the full render (EXR); implies --with-reference");
+                   auto* size = app->add_option("--size", f->size, "override the resolution, WIDTHxHEIGHT (1 to 16384 each)")
+                                    ->check(Parsed("", [](const std::string& s) {
+                                      int w = 0, h = 0;
+                                      return ParseSize(s, &w, &h);
+                                    }));
                    app->add_option("--scale", f->scale, "scale the scene's resolution (e.g. 0.25 for a quick preview)")
-                       ->check(CLI::Range(1e-3f, 16.f))
+                       ->transform(FiniteNumber(1e-3, 16))
                        ->excludes(size);
-                   app->add_option("--supersampling", f->supersampling,
-                                   "override render.supersampling (samples per output pixel per axis)")
-                       ->check(CLI::Range(1, 16));
-                   app->add_option("--spp", f->spp,
-                                   "override render.samples_per_pixel (independent estimates per exact pixel; "
-                                   "from 2 on, samples carry their variance)")
-                       ->check(CLI::Range(1, 1 << 20));
                    app->add_option("--set", f->overrides,
                                    "override a scene setting before it is read, KEY.PATH=JSON (repeatable), "
                                    "e.g. --set render.shadow_rays=1 --set 'render.indirect={\"bounces\":2,\"rays\":1}'")
                        ->allow_extra_args(false);
                    app->add_option("--seed", f->seed, "override render.seed (an independent render of the same scene)")
-                       ->check(CLI::Range(int64_t(0), int64_t(UINT32_MAX)));
-                   app->add_flag("--with-reference", f->withReference,
-                                 "also render the full image in this run: prints the speed-up and the error");
-                   app->add_option("--reference-out", f->referenceOut,
-                                   "write the full render (EXR); implies --with-reference");
+                       ->transform(Integer(0, UINT32_MAX));
+                   app->add_option("--supersampling", f->supersampling,
+                                   "override render.supersampling (samples per output pixel per axis)")
+                       ->transform(Integer(1, 16))
+                       ->group(kGroupQuality);
+                   app->add_option("--spp", f->spp,
+                                   "override render.samples_per_pixel (independent estimates per exact pixel; "
+                                   "from 2 on, samples carry their variance)")
+                       ->transform(Integer(1, 1 << 20))
+                       ->group(kGroupNoise);
+                   app->option_defaults()->group(kGroupGeneral);
                    AddEngineFlags(app, &f->engine);
                    AddTileFlags(app, &f->tiles);
                    return [f, app] { return RunRenderFrames(*f, app); };

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <optional>
 #include <string>
 
 #include "dcm/options.h"
@@ -11,17 +12,14 @@
 namespace dcm::cli {
 
 /// Flag values as parsed; turned into ReconstructionOptions by ToOptions().
+/// An empty optional: the flag was not given, the method's default applies.
 struct EngineFlags {
   std::string method = "dcm";  ///< dcm | paper | guo
-  float threshold = -1;        ///< <0: the method's default
-  float noiseSignificance = -1;  ///< <0: the method's default
-  float creaseAngle = -1;        ///< <0: the method's default
-  float probeLcShare = -1;       ///< <0: the method's default
-  int block = 0, minBlock = 0, directions = 0, downsample = 1, threads = 0, tile = 0;
-  int neighbourDirections = -1;  ///< <0: the method's default
-  int fallbackShadingChanges = -2;  ///< < -1: the method's default
-  int crossingFill = -1;            ///< < 0: the method's default
-  int simpleSurfaceChanges = 0;  ///< 0: the method's default
+  std::optional<float> threshold, noiseSignificance, creaseAngle, probeLcShare;
+  std::optional<int> block, minBlock, directions, tile;
+  std::optional<int> neighbourDirections, fallbackShadingChanges, crossingFill, simpleSurfaceChanges;
+  int downsample = 1;
+  int threads = 0;  ///< 0: all cores
   bool noThin = false, noTextureSplit = false, noLazy = false, noFallback = false;
   bool noSurfaceAware = false, full = false;
   bool noAdaptiveBorders = false, noCentreProbe = false, noDenoise = false, fallbackFilledBorders = false;
@@ -34,12 +32,19 @@ struct EngineFlags {
   bool verbose = false, quiet = false;
 };
 
-/// Adds --method, --threshold, --block, --min-block, --directions, --no-thin,
-/// --thin-test, --neighbour-directions, --no-texture-split, --object-test, --contrast, --no-lazy,
-/// --no-fallback, --no-surface-aware, --downsample, --threads, --tile-size,
-/// --noise-significance, --no-denoise-samples, --crease-angle,
-/// --progressive, -v, --quiet.
+/// Adds the engine's flags in their help groups (flag_checks.h): quality
+/// (--method, --threshold, --block, --min-block, --directions, --contrast,
+/// --full, ...), guides (--object-test, --crease-angle, --no-surface-aware,
+/// ...), noise (--noise-significance, --no-denoise-samples), engine
+/// internals (--threads, --tile-size, the expert switches), and
+/// --downsample, --progressive, -v, -q. Every numeric flag is checked at parse
+/// time (exit 2, the flag named).
 void AddEngineFlags(CLI::App* app, EngineFlags* flags);
+
+/// --downsample `n` on an input of `width` x `height` pixels: both must be
+/// multiples of n (a partial box at the edge would average fewer samples).
+/// `what` names the input ("the provider's image", "the inputs").
+Status CheckDownsample(int width, int height, int n, const std::string& what);
 
 /// The options the flags select. The message names the flag at fault.
 Status ToOptions(const EngineFlags& flags, ReconstructionOptions* options);

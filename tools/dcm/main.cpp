@@ -2,8 +2,10 @@
 // Directional Coherence Maps.
 #include <algorithm>
 #include <iostream>
+#include <memory>
 
 #include "commands.h"
+#include "flag_checks.h"
 
 namespace dcm::cli {
 std::vector<CommandEntry>& CommandRegistry() {
@@ -18,6 +20,9 @@ int main(int argc, char** argv) {
   const std::string version = std::string("dcm ") + DCM_VERSION;
   app.set_version_flag("--version", version);
   app.require_subcommand(1, 1);
+  // Set before the subcommands are added: they copy both.
+  app.formatter(std::make_shared<HelpFormatter>());
+  app.footer(ExitCodesHelp());
 
   auto& registry = CommandRegistry();
   std::sort(registry.begin(), registry.end(),
@@ -31,8 +36,9 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    int code = app.exit(e);
-    return code == 0 ? kExitOk : kExitUsage;
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    std::cerr << UsageErrorMessage(app, e);
+    return kExitUsage;
   }
   for (auto& [sub, run] : commands) {
     if (sub->parsed()) {

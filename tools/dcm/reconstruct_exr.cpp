@@ -54,7 +54,7 @@ Status OutputWindows(const aov::AovProvider& provider, int n, Bounds2i* display,
   if (n <= 1) return Status::Ok();
   const bool whole = *display == *data;
   // A region must sit on the N-pixel lattice of its frame; a whole frame
-  // only needs its origin there (its size is rounded as the image's is).
+  // only needs its origin there (CheckDownsample checked its size).
   std::vector<int> onLattice = {display->min.x, display->min.y, data->min.x, data->min.y};
   if (!whole) onLattice.insert(onLattice.end(), {display->max.x, display->max.y, data->max.x, data->max.y});
   for (int v : onLattice)

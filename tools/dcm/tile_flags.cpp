@@ -1,11 +1,79 @@
 #include "tile_flags.h"
 
+#include <charconv>
+#include <cstdint>
 #include <cstdio>
 
 #include "common/stats_json.h"
 #include "common/tiles.h"
+#include "flag_checks.h"
 
 namespace dcm::cli {
+
+namespace {
+
+/// `s` as integers separated by `sep` (each a whole decimal int, a leading
+/// '-' allowed); false on anything else, overflow included.
+bool SplitInts(const std::string& s, char sep, std::vector<int>* out) {
+  out->clear();
+  size_t begin = 0;
+  while (true) {
+    const size_t end = s.find(sep, begin);
+    const std::string part = s.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
+    int v = 0;
+    const auto [ptr, ec] = std::from_chars(part.data(), part.data() + part.size(), v);
+    if (part.empty() || ec != std::errc() || ptr != part.data() + part.size()) return false;
+    out->push_back(v);
+    if (end == std::string::npos) return true;
+    begin = end + 1;
+  }
+}
+
+/// --tile I/N: the index and count.
+Status ParseTile(const std::string& text, int* index, int* count) {
+  std::vector<int> v;
+  if (!SplitInts(text, '/', &v) || v.size() != 2 || v[1] < 1)
+    return Status::Error("expected I/N with N >= 1 (e.g. 0/8), got '" + text + "'");
+  if (v[0] < 0 || v[0] >= v[1])
+    return Status::Error("I must be in 0.." + std::to_string(v[1] - 1) + " (tiles are numbered from 0, as Slurm's "
+                         "--array=0-" + std::to_string(v[1] - 1) + "), got '" + text + "'");
+  *index = v[0];
+  *count = v[1];
+  return Status::Ok();
+}
+
+/// --region x,y,w,h: the region (not yet checked against the frame).
+Status ParseRegion(const std::string& text, Bounds2i* region) {
+  std::vector<int> v;
+  if (!SplitInts(text, ',', &v) || v.size() != 4 || v[0] < 0 || v[1] < 0 || v[2] < 1 || v[3] < 1 ||
+      int64_t(v[0]) + v[2] > INT32_MAX || int64_t(v[1]) + v[3] > INT32_MAX)
+    return Status::Error("expected x,y,w,h with x, y >= 0 and w, h >= 1, got '" + text + "'");
+  *region = {{v[0], v[1]}, {v[0] + v[2], v[1] + v[3]}};
+  return Status::Ok();
+}
+
+/// --frames N or A-B: the first and last frame.
+Status ParseFrames(const std::string& text, int* first, int* last) {
+  std::vector<int> v;
+  if (!SplitInts(text, '-', &v) || v.empty() || v.size() > 2)
+    return Status::Error("expected N or A-B (e.g. 1-24), got '" + text + "'");
+  *first = v.front();
+  *last = v.back();
+  if (*first < 0 || *last < *first || int64_t(*last) - *first >= 1000000)
+    return Status::Error("expected 0 <= A <= B (and fewer than a million frames), got '" + text + "'");
+  return Status::Ok();
+}
+
+}  // namespace
+
+void AddFramesFlag(CLI::App* app, std::string* frames, const std::string& help) {
+  app->add_option("--frames", *frames, help)
+      ->check(Parsed("", [](const std::string& s) {
+        int a = 0, b = 0;
+        return ParseFrames(s, &a, &b);
+      }))
+      ->group(kGroupTiles);
+}
 
 void AddTileFlags(CLI::App* app, TileFlags* f, bool plans) {
   auto* tile = app->add_option(
@@ -14,39 +82,39 @@ void AddTileFlags(CLI::App* app, TileFlags* f, bool plans) {
               "included); then dcm reconstruct --tile I/N and dcm merge"
             : "I/N: compute tile I (0-based, as Slurm's --array=0-N-1) of N and write it as a part (the frame's "
               "display window, the tile's data window); assemble with dcm merge");
+  tile->check(Parsed("", [](const std::string& s) {
+        int i = 0, n = 0;
+        return ParseTile(s, &i, &n);
+      }))
+      ->group(kGroupTiles);
   app->add_option("--region", f->region,
                   plans ? "x,y,w,h: plan the pixels this region of the output frame still needs"
                         : "x,y,w,h: compute this region of the output frame and write it as a part")
-      ->excludes(tile);
-  app->add_option("--frames", f->frames,
-                  "N or A-B: substitute the frame number for each run of '#' in file names (zero-padded to "
-                  "the run's length: room.####.exr), one frame after another");
+      ->check(Parsed("", [](const std::string& s) {
+        Bounds2i r;
+        return ParseRegion(s, &r);
+      }))
+      ->excludes(tile)
+      ->group(kGroupTiles);
+  AddFramesFlag(app, &f->frames,
+                "N or A-B: substitute the frame number for each run of '#' in file names (zero-padded to "
+                "the run's length: room.####.exr), one frame after another");
 }
 
 Status ResolveRegion(const TileFlags& f, int width, int height, int align, Bounds2i* region, std::string* tile) {
   tile->clear();
   if (!f.tile.empty()) {
     int index = 0, count = 0;
-    char extra = 0;
-    if (std::sscanf(f.tile.c_str(), "%d/%d%c", &index, &count, &extra) != 2 || count < 1)
-      return Status::Error("--tile: expected I/N with N >= 1 (e.g. 0/8), got '" + f.tile + "'");
-    if (index < 0 || index >= count)
-      return Status::Error("--tile " + f.tile + ": I must be in 0.." + std::to_string(count - 1) +
-                           " (tiles are numbered from 0, as Slurm's --array=0-" + std::to_string(count - 1) + ")");
+    if (Status st = ParseTile(f.tile, &index, &count); !st.ok()) return Status::Error("--tile: " + st.message());
     Status st = TileRegion(width, height, index, count, align, region);
     if (!st.ok()) return Status::Error("--tile " + f.tile + ": " + st.message());
     *tile = std::to_string(index) + "/" + std::to_string(count);
     return Status::Ok();
   }
-  int x = 0, y = 0, w = 0, h = 0;
-  char extra = 0;
-  if (std::sscanf(f.region.c_str(), "%d,%d,%d,%d%c", &x, &y, &w, &h, &extra) != 4 || x < 0 || y < 0 || w < 1 ||
-      h < 1)
-    return Status::Error("--region: expected x,y,w,h with x, y >= 0 and w, h >= 1, got '" + f.region + "'");
-  if (int64_t(x) + w > width || int64_t(y) + h > height)
+  if (Status st = ParseRegion(f.region, region); !st.ok()) return Status::Error("--region: " + st.message());
+  if (region->max.x > width || region->max.y > height)
     return Status::Error("--region " + f.region + " reaches beyond the " + std::to_string(width) + "x" +
                          std::to_string(height) + " output frame");
-  *region = {{x, y}, {x + w, y + h}};
   return Status::Ok();
 }
 
@@ -54,15 +122,7 @@ Status FrameList(const TileFlags& f, std::vector<int>* frames) {
   frames->clear();
   if (f.frames.empty()) return Status::Ok();
   int a = 0, b = 0;
-  char dash = 0, extra = 0;
-  const int n = std::sscanf(f.frames.c_str(), "%d%c%d%c", &a, &dash, &b, &extra);
-  if (n == 1) {
-    b = a;
-  } else if (n != 3 || dash != '-') {
-    return Status::Error("--frames: expected N or A-B (e.g. 1-24), got '" + f.frames + "'");
-  }
-  if (a < 0 || b < a || b - a >= 1000000)
-    return Status::Error("--frames " + f.frames + ": expected 0 <= A <= B (and fewer than a million frames)");
+  if (Status st = ParseFrames(f.frames, &a, &b); !st.ok()) return Status::Error("--frames: " + st.message());
   for (int i = a; i <= b; ++i) frames->push_back(i);
   return Status::Ok();
 }

@@ -29,7 +29,11 @@ struct TileFlags {
   std::string frames;  ///< "N" or "A-B"
 };
 
-/// Adds --tile, --region (exclusive) and --frames. `plans`: the command
+/// Adds --frames (N or A-B, checked at parse time) in the tiles group.
+void AddFramesFlag(CLI::App* app, std::string* frames, const std::string& help);
+
+/// Adds --tile, --region (exclusive) and --frames, their syntax checked at
+/// parse time (the frame's size only once the input is read). `plans`: the command
 /// plans the part's pixels (dcm plan) instead of writing it as a part.
 void AddTileFlags(CLI::App* app, TileFlags* flags, bool plans = false);
 
