@@ -5,6 +5,7 @@
 #include <assimp/scene.h>
 
 #include <charconv>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -36,11 +37,18 @@ constexpr double kBytesPerPlyElement = 64.0;
 Status CheckDeclaredMeshSize(const std::string& path, const std::string& what) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return Status::Ok();  // missing or unreadable: Assimp's message says so
-  char magic[4] = {};
-  in.read(magic, 4);
-  if (in.gcount() < 4 || std::string(magic, 3) != "ply" || (magic[3] != '\n' && magic[3] != '\r'))
-    return Status::Ok();  // not a PLY file: no declared counts to check
-  in.seekg(0);
+  // Assimp reads a .ply file as PLY whatever it holds (and 5.2.5 reads on
+  // forever in one whose first line is not "ply"), and a file of another
+  // extension when it starts with the line "ply".
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  std::string first;
+  std::getline(in, first);
+  if (!first.empty() && first.back() == '\r') first.pop_back();
+  if (first != "ply") {
+    if (ext != ".ply") return Status::Ok();  // not PLY: no declared counts to check
+    return Status::Error(what + ": mesh '" + path + "' is no PLY file (its first line is not 'ply')");
+  }
   std::error_code ec;
   const auto fileBytes = std::filesystem::file_size(path, ec);
   if (ec) return Status::Ok();
@@ -51,15 +59,18 @@ Status CheckDeclaredMeshSize(const std::string& path, const std::string& what) {
     double minBytes = 0.0;  ///< the least one element can take in the file
   };
   std::vector<Element> elements;
-  bool binary = false;
+  bool binary = false, ended = false;
   std::string line;
-  // The header is text; 64 KiB of it without end_header is no PLY Assimp reads.
+  // The header is text; one of more than 64 KiB is taken as having no end.
   while (in.tellg() >= 0 && in.tellg() < (1 << 16) && std::getline(in, line)) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
     std::istringstream ls(line);
     std::string key;
     ls >> key;
-    if (key == "end_header") break;
+    if (key == "end_header") {
+      ended = true;
+      break;
+    }
     if (key == "format") {
       std::string f;
       ls >> f;
@@ -72,7 +83,8 @@ Status CheckDeclaredMeshSize(const std::string& path, const std::string& what) {
       if (err == std::errc::result_out_of_range)
         return Status::Error(what + ": mesh '" + path + "' declares " + count + " " + e.name +
                              " elements, more than any file holds");
-      if (err != std::errc() || p != count.data() + count.size()) return Status::Ok();  // Assimp reports it
+      if (err != std::errc() || p != count.data() + count.size())
+        return Status::Error(what + ": mesh '" + path + "': PLY element '" + e.name + "' has no count");
       elements.push_back(e);
     } else if (key == "property" && !elements.empty()) {
       std::string type;
@@ -84,6 +96,8 @@ Status CheckDeclaredMeshSize(const std::string& path, const std::string& what) {
       elements.back().minBytes += binary ? double(std::max(bytes, 1)) : 2.0;
     }
   }
+  // Assimp 5.2.5 reads past the end of a header without one (SIGSEGV).
+  if (!ended) return Status::Error(what + ": mesh '" + path + "' is a PLY file without 'end_header'");
   // An element without properties takes no bytes in a binary file, yet
   // Assimp builds an instance of it for each: count a byte (ASCII's newline).
   for (Element& e : elements) e.minBytes = std::max(e.minBytes, 1.0);

@@ -150,9 +150,9 @@ Status CheckDeclaredTextureSize(const std::string& path, const std::string& what
                                std::to_string(spec.height) + " pixels of " + std::to_string(spec.nchannels) +
                                " channels";
   if (least > double(fileBytes))
-    return Status::Error(declared + " (" + ByteText(stored) + " of " + (raw ? "uncompressed" : "compressed") +
-                         " pixel data), more than its " + ByteText(double(fileBytes)) +
-                         " can hold (truncated or corrupt)");
+    return Status::Error(declared + ", " + ByteText(stored) + " of samples" +
+                         (raw ? " stored raw, but the file holds " : ", more than any compression packs into its ") +
+                         ByteText(double(fileBytes)) + " (truncated or corrupt)");
   // The texture system keeps float samples and a MIP pyramid (4/3 of the image).
   return CheckMemoryBudget(declared + ", which", pixels * double(spec.nchannels) * 4.0 * 4.0 / 3.0);
 }
