@@ -21,7 +21,9 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <regex>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #ifndef DCM_BINARY
@@ -384,4 +386,21 @@ TEST(MeshLoaderFindings, PlyWithEmptyFacesIsRefused) {
   dir.Write("typo.ply", ply);
   dir.Write("scene.json", Scene("typo.ply"));
   ExpectRefused(Render(dir), dir, {"scene.json: objects[0].file", "typo.ply", "has a face of 0 vertices"});
+}
+
+TEST(MeshLoaderFindings, PlyWithoutEndHeaderOrPlyLineIsRefused) {
+  // No end_header, or a .ply whose first line is not "ply": Assimp 5.2.5
+  // reads on past the end of the file (both hung `dcm render`; with other
+  // bytes after the header, SIGSEGV).
+  for (const auto& [name, bytes, message] :
+       {std::tuple<std::string, std::string, std::string>{
+            "noend.ply", std::regex_replace(PlyHeader("binary_big_endian", 4, 4), std::regex("end_header"), "0eader"),
+            "without 'end_header'"},
+        {"noply.ply", "ply)\nformat binary_big_endian 1.0\nelement vertex 4\nproperty float x\n", "is no PLY file"}}) {
+    SCOPED_TRACE(name);
+    TempDir dir;
+    dir.Write(name, bytes);
+    dir.Write("scene.json", Scene(name));
+    ExpectRefused(Render(dir), dir, {"scene.json: objects[0].file", name, message});
+  }
 }
