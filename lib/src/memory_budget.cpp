@@ -24,7 +24,7 @@ bool ParseByteSize(const std::string& text, int64_t* bytes) {
     }
     ++p;
     if (p != end && *p == 'i') ++p;                   // "2Gi", "2GiB"
-    if (p != end && (*p == 'B' || *p == 'b')) ++p;  // "2GB": binary units all the same
+    if (p != end && (*p == 'B' || *p == 'b')) ++p;  // "2GB" is 2 GiB too
   }
   if (p != end) return false;
   const double b = v * scale;

@@ -10,8 +10,8 @@
 namespace dcm {
 
 /// Default budget for what one input (an image, a mesh, a texture) may cost:
-/// 8 GiB, a 16k x 16k image with 8 float RGB planes, far above any input of
-/// the examples and below the RAM of the machines dcm is run on.
+/// 8 GiB, the figure of the guards it replaced: far above any input of the
+/// examples, below the RAM of the machines dcm is run on.
 inline constexpr int64_t kDefaultMemoryBudget = int64_t(8) << 30;
 
 /// The largest ratio of decoded pixel bytes to file bytes believed of a
@@ -24,8 +24,7 @@ inline constexpr double kMaxCompressionRatio = 65536.0;
 
 /// The budget in bytes: DCM_MEMORY_LIMIT when it is set to a valid size
 /// (bytes, or a number with K, M, G or T for KiB..TiB: "512M", "2G",
-/// "2GiB"), else
-/// kDefaultMemoryBudget.
+/// "2GiB"), else kDefaultMemoryBudget.
 int64_t MemoryBudget();
 
 /// Parses a DCM_MEMORY_LIMIT value; false when it is not a positive size.
