@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (fuzz/, clang-14) and runs each for SECONDS
-# (default 60) on its seed corpus. Exits non-zero when a build fails or a
-# target finds a crash, a sanitizer report, a timeout, an out-of-memory or a
-# violated contract; the reproducer is left in the build dir (crash-*, oom-*,
-# timeout-*) and its path printed.
+# (default 60) on its seed corpus: all five, or the TARGETs named. Exits
+# non-zero when a build fails or a target finds a crash, a sanitizer report, a
+# timeout, an out-of-memory or a violated contract; the reproducer is left in
+# the build dir (crash-*, oom-*, timeout-*) and its path printed.
 #
-#   scripts/fuzz.sh [SECONDS]
+#   scripts/fuzz.sh [SECONDS [TARGET...]]
+#   scripts/fuzz.sh 30 fuzz_pipe fuzz_mesh   # two targets, 30 s each
 #   DCM_FUZZ_SEED=N scripts/fuzz.sh   # libFuzzer's -seed (0, the default: random;
 #                                     # the test command uses a fixed one)
 #   DCM_FUZZ_BUILD_DIR=/x scripts/fuzz.sh 300
@@ -14,6 +15,9 @@
 # runtimes), plus dcm's own build dependencies (scripts/install-deps.sh).
 set -euo pipefail
 seconds=${1:-60}
+shift $(( $# > 0 ? 1 : 0 ))
+targets=("$@")
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_scene fuzz_exr fuzz_pipe fuzz_mesh fuzz_texture)
 here=$(cd "$(dirname "$0")/.." && pwd)
 build=${DCM_FUZZ_BUILD_DIR:-$here/build-fuzz}
 cxx=${CXX_FUZZ:-clang++-14}
@@ -25,7 +29,7 @@ if ! command -v "$cxx" >/dev/null; then
   exit 2
 fi
 cmake -S "$here/fuzz" -B "$build" -G Ninja -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
-cmake --build "$build" -j"${DCM_JOBS:-2}"
+cmake --build "$build" -j"${DCM_JOBS:-2}" --target "${targets[@]}"
 
 # The targets check their own contracts and abort on a violation; sanitizer
 # reports abort too. Leaks count as findings. -timeout=60: an EXR header may
@@ -35,7 +39,7 @@ export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 
 status=0
-for target in fuzz_scene fuzz_exr; do
+for target in "${targets[@]}"; do
   corpus="$build/corpus/$target"   # grows during the run; the seeds stay in the repo
   mkdir -p "$corpus" "$build/artifacts/$target"
   seeds="$here/fuzz/corpus/${target#fuzz_}"

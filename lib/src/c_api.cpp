@@ -103,13 +103,14 @@ void SetError(DCMReconstructor r, DCMError code, const char* message) noexcept {
   }
 }
 
-/// Runs `body`, turning exceptions into errors recorded on `r`.
+/// Runs `body` of the entry point `function`, turning exceptions into errors
+/// recorded on `r`.
 template <typename F>
-void Guard(DCMReconstructor r, F&& body) noexcept {
+void Guard(DCMReconstructor r, const char* function, F&& body) noexcept {
   try {
     body();
   } catch (const std::bad_alloc&) {
-    SetError(r, DCM_ERROR_OUT_OF_MEMORY, "out of memory");
+    SetError(r, DCM_ERROR_OUT_OF_MEMORY, std::string("out of memory while running ") + function);
   } catch (const std::exception& e) {
     SetError(r, DCM_ERROR_UNKNOWN, std::string("internal error: ") + e.what());
   } catch (...) {
@@ -337,7 +338,7 @@ DCM_API DCMError dcmGetError(DCMReconstructor r, const char** message) {
 
 DCM_API void dcmSetString(DCMReconstructor r, const char* name, const char* value) {
   if (!CheckArgs(r, name, "dcmSetString")) return;
-  Guard(r, [&] {
+  Guard(r, "dcmSetString", [&] {
     if (!value) return SetError(r, DCM_ERROR_INVALID_ARGUMENT, std::string("option ") + name + ": NULL value");
     const dcm::Status st = dcm::SetStringOption(&r->options, name, value);
     if (!st.ok()) SetError(r, DCM_ERROR_INVALID_ARGUMENT, st.message());
@@ -346,7 +347,7 @@ DCM_API void dcmSetString(DCMReconstructor r, const char* name, const char* valu
 
 DCM_API void dcmSetInt(DCMReconstructor r, const char* name, int value) {
   if (!CheckArgs(r, name, "dcmSetInt")) return;
-  Guard(r, [&] {
+  Guard(r, "dcmSetInt", [&] {
     if (int* p = dcm::FindIntOption(r->options, name)) *p = value;
     else if (bool* b = dcm::FindBoolOption(r->options, name)) *b = value != 0;
     else SetError(r, DCM_ERROR_INVALID_ARGUMENT, UnknownOption("integer", name));
@@ -355,7 +356,7 @@ DCM_API void dcmSetInt(DCMReconstructor r, const char* name, int value) {
 
 DCM_API void dcmSetFloat(DCMReconstructor r, const char* name, float value) {
   if (!CheckArgs(r, name, "dcmSetFloat")) return;
-  Guard(r, [&] {
+  Guard(r, "dcmSetFloat", [&] {
     if (float* f = dcm::FindFloatOption(r->options, name)) {
       *f = value;
     } else if (int* p = dcm::FindIntOption(r->options, name)) {
@@ -371,7 +372,7 @@ DCM_API void dcmSetFloat(DCMReconstructor r, const char* name, float value) {
 
 DCM_API void dcmSetBool(DCMReconstructor r, const char* name, int value) {
   if (!CheckArgs(r, name, "dcmSetBool")) return;
-  Guard(r, [&] {
+  Guard(r, "dcmSetBool", [&] {
     if (bool* b = dcm::FindBoolOption(r->options, name)) *b = value != 0;
     else SetError(r, DCM_ERROR_INVALID_ARGUMENT, UnknownOption("bool", name));
   });
@@ -380,7 +381,7 @@ DCM_API void dcmSetBool(DCMReconstructor r, const char* name, int value) {
 DCM_API int dcmGetInt(DCMReconstructor r, const char* name) {
   if (!CheckArgs(r, name, "dcmGetInt")) return 0;
   int result = 0;
-  Guard(r, [&] {
+  Guard(r, "dcmGetInt", [&] {
     if (int* p = dcm::FindIntOption(r->options, name)) result = *p;
     else if (bool* b = dcm::FindBoolOption(r->options, name)) result = *b ? 1 : 0;
     else SetError(r, DCM_ERROR_INVALID_ARGUMENT, UnknownOption("integer", name));
@@ -391,7 +392,7 @@ DCM_API int dcmGetInt(DCMReconstructor r, const char* name) {
 DCM_API float dcmGetFloat(DCMReconstructor r, const char* name) {
   if (!CheckArgs(r, name, "dcmGetFloat")) return 0.f;
   float result = 0.f;
-  Guard(r, [&] {
+  Guard(r, "dcmGetFloat", [&] {
     if (float* f = dcm::FindFloatOption(r->options, name)) result = *f;
     else if (int* p = dcm::FindIntOption(r->options, name)) result = float(*p);
     else SetError(r, DCM_ERROR_INVALID_ARGUMENT, UnknownOption("float", name));
@@ -402,7 +403,7 @@ DCM_API float dcmGetFloat(DCMReconstructor r, const char* name) {
 DCM_API int dcmGetBool(DCMReconstructor r, const char* name) {
   if (!CheckArgs(r, name, "dcmGetBool")) return 0;
   int result = 0;
-  Guard(r, [&] {
+  Guard(r, "dcmGetBool", [&] {
     if (bool* b = dcm::FindBoolOption(r->options, name)) result = *b ? 1 : 0;
     else SetError(r, DCM_ERROR_INVALID_ARGUMENT, UnknownOption("bool", name));
   });
@@ -411,7 +412,7 @@ DCM_API int dcmGetBool(DCMReconstructor r, const char* name) {
 
 DCM_API void dcmSetImageSize(DCMReconstructor r, int width, int height) {
   if (!r) return SetError(nullptr, DCM_ERROR_INVALID_ARGUMENT, "dcmSetImageSize: NULL reconstructor");
-  Guard(r, [&] {
+  Guard(r, "dcmSetImageSize", [&] {
     constexpr int kMaxSide = 1 << 17;
     if (width < 1 || height < 1 || width > kMaxSide || height > kMaxSide || int64_t(width) * height > (int64_t(1) << 30))
       return SetError(r, DCM_ERROR_INVALID_ARGUMENT,
@@ -427,7 +428,7 @@ DCM_API void dcmSetImageSize(DCMReconstructor r, int width, int height) {
 
 DCM_API void dcmSetObjectIds(DCMReconstructor r, const uint32_t* ids) {
   if (!CanSetGuide(r, "dcmSetObjectIds")) return;
-  Guard(r, [&] {
+  Guard(r, "dcmSetObjectIds", [&] {
     if (!ids) return r->objectIds.clear();
     r->objectIds.assign(ids, ids + size_t(r->width) * size_t(r->height));
   });
@@ -435,7 +436,7 @@ DCM_API void dcmSetObjectIds(DCMReconstructor r, const uint32_t* ids) {
 
 DCM_API void dcmSetShaderIds(DCMReconstructor r, const uint32_t* ids) {
   if (!CanSetGuide(r, "dcmSetShaderIds")) return;
-  Guard(r, [&] {
+  Guard(r, "dcmSetShaderIds", [&] {
     if (!ids) return r->shaderIds.clear();
     r->shaderIds.assign(ids, ids + size_t(r->width) * size_t(r->height));
   });
@@ -443,12 +444,12 @@ DCM_API void dcmSetShaderIds(DCMReconstructor r, const uint32_t* ids) {
 
 DCM_API void dcmSetTexture(DCMReconstructor r, const float* rgb) {
   if (!CanSetGuide(r, "dcmSetTexture")) return;
-  Guard(r, [&] { CopyTriples(r, rgb, &r->texture); });
+  Guard(r, "dcmSetTexture", [&] { CopyTriples(r, rgb, &r->texture); });
 }
 
 DCM_API void dcmSetNormals(DCMReconstructor r, const float* xyz) {
   if (!CanSetGuide(r, "dcmSetNormals")) return;
-  Guard(r, [&] { CopyTriples(r, xyz, &r->normals); });
+  Guard(r, "dcmSetNormals", [&] { CopyTriples(r, xyz, &r->normals); });
 }
 
 DCM_API void dcmSetSampleFunction(DCMReconstructor r, DCMSampleFunction fn, void* user, int flags) {
@@ -527,7 +528,7 @@ DCM_API DCMError dcmExecute(DCMReconstructor r) {
     r->hasResult = true;
   } catch (const std::bad_alloc&) {
     r->result = dcm::Reconstruction{};
-    fail(DCM_ERROR_OUT_OF_MEMORY, "dcmExecute: out of memory");
+    fail(DCM_ERROR_OUT_OF_MEMORY, "dcmExecute: out of memory while reconstructing");
   } catch (const std::exception& e) {
     r->result = dcm::Reconstruction{};
     fail(DCM_ERROR_UNKNOWN, std::string("dcmExecute: internal error: ") + e.what());
@@ -591,7 +592,7 @@ DCM_API double dcmGetStat(DCMReconstructor r, const char* name) {
   if (n == "time_provider_s") return s.timeProviderS;
   if (n == "time_guides_s") return s.timeGuidesS;
   if (n == "time_engine_s") return s.timeEngineS;
-  Guard(r, [&] { SetError(r, DCM_ERROR_INVALID_ARGUMENT, "dcmGetStat: unknown statistic '" + std::string(n) + "'"); });
+  Guard(r, "dcmGetStat", [&] { SetError(r, DCM_ERROR_INVALID_ARGUMENT, "dcmGetStat: unknown statistic '" + std::string(n) + "'"); });
   return 0.0;
 }
 

@@ -1,10 +1,13 @@
 #include "embree/textures.h"
 
+#include <OpenImageIO/imageio.h>
 #include <OpenImageIO/texture.h>
 #include <OpenImageIO/ustring.h>
 
 #include <cmath>
+#include <filesystem>
 
+#include "dcm/memory_budget.h"
 #include "embree/sampling.h"
 
 namespace dcm::embree {
@@ -123,6 +126,37 @@ class ImageTexture final : public Texture {
 
 }  // namespace
 
+Status CheckDeclaredTextureSize(const std::string& path, const std::string& what) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) {
+    (void)OIIO::geterror();
+    return Status::Ok();  // the texture system's own message follows
+  }
+  const OIIO::ImageSpec& spec = in->spec();
+  std::error_code ec;
+  const auto fileBytes = std::filesystem::file_size(path, ec);
+  if (ec) return Status::Ok();
+  const std::string format = in->format_name();
+  const double pixels = double(spec.width) * double(spec.height) * double(std::max(spec.depth, 1));
+  const int bits = spec.get_int_attribute("oiio:BitsPerSample", int(spec.format.size()) * 8);
+  const double stored = pixels * double(spec.nchannels) * double(bits) / 8.0;
+  // PNM stores its samples raw (binary, or longer as ASCII text); any other
+  // format is taken as compressed, up to kMaxCompressionRatio (OpenImageIO
+  // names neither a TGA's RLE nor a BMP's or TIFF's palette, whose samples
+  // are expanded to RGB).
+  const bool raw = format == "pnm";
+  const double least = raw ? stored : stored / kMaxCompressionRatio;
+  const std::string declared = what + ": texture '" + path + "' declares " + std::to_string(spec.width) + "x" +
+                               std::to_string(spec.height) + " pixels of " + std::to_string(spec.nchannels) +
+                               " channels";
+  if (least > double(fileBytes))
+    return Status::Error(declared + ", " + ByteText(stored) + " of samples" +
+                         (raw ? " stored raw, but the file holds " : ", more than any compression packs into its ") +
+                         ByteText(double(fileBytes)) + " (truncated or corrupt)");
+  // The texture system keeps float samples and a MIP pyramid (4/3 of the image).
+  return CheckMemoryBudget(declared + ", which", pixels * double(spec.nchannels) * 4.0 * 4.0 / 3.0);
+}
+
 struct TextureCache::Impl {
   OIIO::TextureSystem* ts = nullptr;
 };
@@ -139,6 +173,9 @@ Status TextureCache::Create(const TextureDesc& d, const std::string& what, std::
     case TextureKind::kPlanks: *out = std::make_unique<PlanksTexture>(d); return Status::Ok();
     case TextureKind::kImage: break;
   }
+  // The texture system reads (and MIP-maps) the whole image at the first
+  // lookup: check what the header declares first.
+  DCM_RETURN_IF_ERROR(CheckDeclaredTextureSize(d.file, what));
   if (!impl_->ts) {
     impl_->ts = OIIO::TextureSystem::create(/*shared=*/false);
     impl_->ts->attribute("automip", 1);  // mip-map plain images on the fly

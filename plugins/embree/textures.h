@@ -29,6 +29,13 @@ class Texture {
   virtual RGB Eval(const TexCoord& tc) const = 0;
 };
 
+/// Checks the size an image file declares in its header against what the
+/// file can hold (its raw size for PNM, 1/kMaxCompressionRatio of it for
+/// any other format) and against MemoryBudget(). An unreadable file
+/// passes (the texture system reports it). The message names the file and
+/// the declared size.
+Status CheckDeclaredTextureSize(const std::string& path, const std::string& what);
+
 /// Owns the OpenImageIO texture system shared by all image textures of a scene.
 class TextureCache {
  public:

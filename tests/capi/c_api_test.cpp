@@ -1,7 +1,11 @@
 // The C API through libdcm.so only (the engine's C++ symbols are hidden there).
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -519,3 +523,41 @@ TEST(CApi, HardShadowsGuidedSkipsTheCentreProbes) {
 }
 
 }  // namespace
+
+#if !defined(__SANITIZE_ADDRESS__)  // RLIMIT_AS and ASan's shadow memory exclude each other
+namespace {
+
+int ConstantGray(void*, const int*, int count, float* rgb, float*, float*) {
+  for (int i = 0; i < 3 * count; ++i) rgb[i] = 0.5f;
+  return 0;
+}
+
+TEST(CApi, OutOfMemoryIsAnErrorStatus) {
+  // A 32768x32768 image (the largest size dcmSetImageSize accepts, 2^30
+  // pixels) needs tens of GiB of working images; in a child whose address
+  // space is limited to 1 GiB the allocation fails, and dcmExecute must
+  // return DCM_ERROR_OUT_OF_MEMORY with a message, not let std::bad_alloc out.
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const rlimit limit{rlim_t(1) << 30, rlim_t(1) << 30};
+    if (::setrlimit(RLIMIT_AS, &limit) != 0) _exit(101);
+    DCMReconstructor r = dcmNewReconstructor();
+    if (!r) _exit(102);
+    dcmSetInt(r, "threads", 1);
+    dcmSetImageSize(r, 32768, 32768);
+    dcmSetSampleFunction(r, ConstantGray, nullptr, 0);
+    const DCMError code = dcmExecute(r);
+    const char* message = nullptr;
+    dcmGetError(r, &message);
+    const bool named = message && std::string(message).find("out of memory while reconstructing") != std::string::npos;
+    _exit(code == DCM_ERROR_OUT_OF_MEMORY ? (named ? 0 : 103) : 110 + int(code));
+  }
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "101: setrlimit failed, 103: message without the step, 110+N: error code N";
+}
+}  // namespace
+#endif

@@ -11,6 +11,8 @@
 #include <limits>
 #include <system_error>
 
+#include "dcm/memory_budget.h"
+
 namespace dcm::toolkit {
 namespace {
 
@@ -148,12 +150,13 @@ Status CheckImageDimensions(const std::string& path, int width, int height, int 
                          std::to_string(height) + " (at most " + std::to_string(kMaxSide) +
                          " pixels per side)");
   const double bytes = double(width) * double(height) * double(std::max(channels, 1)) * 4.0;
-  if (bytes > double(kMaxImageBytes))
+  const int64_t budget = MemoryBudget();
+  if (bytes > double(budget))
     return Status::Error("'" + path + "': " + std::to_string(width) + "x" + std::to_string(height) +
                          " with " + std::to_string(channels) + " channels needs " +
                          std::to_string(int64_t(bytes / double(1 << 20))) +
                          " MiB, more than the limit of " +
-                         std::to_string(kMaxImageBytes >> 20) + " MiB");
+                         std::to_string(budget >> 20) + " MiB (DCM_MEMORY_LIMIT)");
   return Status::Ok();
 }
 

@@ -52,13 +52,9 @@ Status WriteImage(const std::string& path, const OIIO::ImageSpec& spec, const vo
 /// Writes an 8-bit RGB image atomically (PNG, or any format OIIO picks from the extension).
 Status WriteRgb8(const std::string& path, int width, int height, std::span<const uint8_t> rgb);
 
-/// Upper bound on the float pixel data one image may need (width * height *
-/// channels * 4 bytes): 8 GiB. Checked from the header, before allocating.
-inline constexpr int64_t kMaxImageBytes = int64_t(8) << 30;
-
 /// The memory guard: rejects dimensions <= 0, above 2^17 per side, or whose
-/// float data (`channels` planes) would exceed kMaxImageBytes. The message
-/// names the file.
+/// float data (`channels` planes) would exceed dcm::MemoryBudget(). Checked
+/// from the header, before allocating. The message names the file.
 Status CheckImageDimensions(const std::string& path, int width, int height, int channels);
 
 /// Reads the R, G, B channels of an image (by channel name; a 1-channel image

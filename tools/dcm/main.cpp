@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <iostream>
 #include <memory>
+#include <new>
 
 #include "commands.h"
 #include "flag_checks.h"
@@ -44,6 +45,11 @@ int main(int argc, char** argv) {
     if (sub->parsed()) {
       try {
         return run();
+      } catch (const std::bad_alloc&) {
+        // An allocation no header check foresaw: a message, not a terminate.
+        std::cerr << "dcm " << sub->get_name() << ": error: out of memory while running 'dcm " << sub->get_name()
+                  << "' (DCM_MEMORY_LIMIT bounds what one input may declare)\n";
+        return kExitFailure;
       } catch (const std::exception& e) {
         std::cerr << "dcm " << sub->get_name() << ": error: " << e.what() << "\n";
         return kExitFailure;

@@ -9,6 +9,8 @@
 #include <cstring>
 #include <filesystem>
 
+#include "dcm/memory_budget.h"
+
 namespace dcm::aov::detail {
 
 namespace fs = std::filesystem;
@@ -28,14 +30,40 @@ Status CheckDimensions(const std::string& path, int width, int height) {
     return Status::Error(Quote(path) + ": absurd image dimensions " + std::to_string(width) + "x" +
                          std::to_string(height) + " (at most " + std::to_string(kMaxSide) +
                          " pixels per side)");
-  const double bytes = double(width) * double(height) * kPlanesPerPixel * 4.0;
-  if (bytes > double(kMaxBytes))
-    return Status::Error(Quote(path) + ": " + std::to_string(width) + "x" +
-                         std::to_string(height) + " pixels would need about " +
-                         std::to_string(int64_t(bytes / double(int64_t(1) << 30))) +
-                         " GiB, more than the limit of " + std::to_string(kMaxBytes >> 30) +
-                         " GiB");
-  return Status::Ok();
+  return CheckMemoryBudget(Quote(path) + ": " + std::to_string(width) + "x" + std::to_string(height) + " pixels",
+                           double(width) * double(height) * kPlanesPerPixel * 4.0);
+}
+
+/// Scanlines per chunk of an OpenEXR compression method (OIIO's name).
+int LinesPerChunk(std::string compression) {
+  compression = compression.substr(0, compression.find(':'));  // "dwaa:45"
+  if (compression.empty() || compression == "none" || compression == "rle" || compression == "zips") return 1;
+  if (compression == "zip" || compression == "pxr24") return 16;
+  if (compression == "piz" || compression == "b44" || compression == "b44a" || compression == "dwaa") return 32;
+  return 256;  // dwab, and the most any method takes
+}
+
+/// The least a part of `spec` takes in an OpenEXR file of `parts` parts: per
+/// chunk (a block of scanlines, or a tile of level 0) an offset-table entry
+/// and the chunk's header (coordinates and data size), and its pixel data
+/// compressed at most kMaxCompressionRatio:1 (stored raw without compression).
+double LeastPartBytes(const ImageSpec& spec, int parts) {
+  const double w = std::max(spec.width, 1), h = std::max(spec.height, 1);
+  const std::string compression = spec.get_string_attribute("compression", "none");
+  const double partNumber = parts > 1 ? 4.0 : 0.0;
+  double chunks = 0.0, perChunk = 0.0;
+  if (spec.tile_width > 0 && spec.tile_height > 0) {
+    chunks = std::ceil(w / spec.tile_width) * std::ceil(h / spec.tile_height);
+    perChunk = 8.0 + partNumber + 20.0;  // tile x, y, level x, y, data size
+  } else {
+    chunks = std::ceil(h / LinesPerChunk(compression));
+    perChunk = 8.0 + partNumber + 8.0;  // y, data size
+  }
+  double raw = 0.0;
+  for (int c = 0; c < spec.nchannels; ++c) raw += double(spec.channelformat(c).size());
+  raw *= w * h;
+  const bool compressed = !(compression.empty() || compression == "none");
+  return chunks * perChunk + (compressed ? raw / kMaxCompressionRatio : raw);
 }
 
 }  // namespace
@@ -70,6 +98,17 @@ Status ChannelSet::Add(const std::string& path) {
   }
   (void)f.in->geterror();
   if (f.specs.empty()) return Status::Error(Quote(path) + ": no image in the file");
+  // A header may declare any size; the file must hold the chunks of it.
+  {
+    double least = 0.0;
+    for (const ImageSpec& sp : f.specs) least += LeastPartBytes(sp, int(f.specs.size()));
+    const auto fileBytes = fs::file_size(path, ec);
+    if (!ec && least > double(fileBytes))
+      return Status::Error(Quote(path) + ": declares " + std::to_string(f.specs[0].width) + "x" +
+                           std::to_string(f.specs[0].height) + " pixels, whose chunks need at least " +
+                           ByteText(least) + ", but the file holds " + ByteText(double(fileBytes)) +
+                           " (truncated or corrupt)");
+  }
   const ImageSpec& sp = f.specs[0];
   const ImageWindows w{{{sp.x, sp.y}, {sp.x + sp.width, sp.y + sp.height}},
                        {{sp.full_x, sp.full_y}, {sp.full_x + sp.full_width, sp.full_y + sp.full_height}}};

@@ -16,14 +16,11 @@
 
 namespace dcm::aov::detail {
 
-/// Upper bound on the float data the provider may hold for one image
-/// (width * height * planes * 4 bytes): 8 GiB, checked from the headers
-/// before anything is allocated.
-inline constexpr int64_t kMaxBytes = int64_t(8) << 30;
 /// Upper bound on either side of an image.
 inline constexpr int kMaxSide = 1 << 17;
 /// Planes (RGB roles, IDs, mask, read buffers) the provider may allocate per
-/// pixel, used by the memory guard.
+/// pixel, checked against dcm::MemoryBudget() from the headers before
+/// anything is allocated.
 inline constexpr int kPlanesPerPixel = 24;
 /// A part of a scanline file whose channels take at most this many bytes as
 /// float is read in one pass at its first float read (ChannelSet::ReadFloat),
