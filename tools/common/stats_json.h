@@ -3,6 +3,7 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "dcm/options.h"
 #include "dcm/reconstructor.h"
@@ -25,6 +26,10 @@ nlohmann::json StatsToJson(const ReconstructionStats& s);
 /// time_wall_s.
 nlohmann::json RunToJson(const Reconstruction& r, const std::string& method, const ReconstructionOptions& o,
                          double wallS);
+
+/// The warnings a run's samples deserve, one sentence each: NaN/Inf samples
+/// (kept to their pixels) and huge finite ones (clamped to kMaxSampleMagnitude).
+std::vector<std::string> SampleWarnings(const ReconstructionStats& s);
 
 /// Writes JSON (pretty, 2 spaces) atomically. Non-finite numbers become null
 /// (JSON has no infinity).

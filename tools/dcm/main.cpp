@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "commands.h"
+#include "common/output_transaction.h"
 
 namespace dcm::cli {
 std::vector<CommandEntry>& CommandRegistry() {
@@ -14,6 +15,8 @@ std::vector<CommandEntry>& CommandRegistry() {
 
 int main(int argc, char** argv) {
   using namespace dcm::cli;
+  // Interrupted at any moment, a run leaves no temporary file and no child.
+  dcm::toolkit::InstallSignalCleanup();
   CLI::App app{"dcm: image reconstruction with Directional Coherence Maps (Guo 1998, Scheel et al. 2001)"};
   app.set_version_flag("--version", std::string("dcm ") + DCM_VERSION);
   app.require_subcommand(1, 1);
