@@ -35,7 +35,19 @@ OutputTransaction* g_active = nullptr;
 
 constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP};
 
+// Who owns the temporaries: nobody (0), a commit renaming them (1), a signal
+// handler removing them (2). A signal that arrives in any thread during a
+// commit waits in g_deferred until the commit is done.
+constexpr int kIdle = 0, kCommitting = 1, kDying = 2;
+std::atomic<int> g_state{kIdle};
+std::atomic<int> g_deferred{0};
+
 void OnSignal(int sig) {
+  int state = kIdle;
+  if (!g_state.compare_exchange_strong(state, kDying) && state == kCommitting) {
+    g_deferred.store(sig);
+    return;
+  }
   for (auto& slot : g_slots)
     if (slot.used.load(std::memory_order_acquire) == 1) ::unlink(slot.path);
   if (auto hook = g_hook.load()) hook();
@@ -152,15 +164,19 @@ Status CreateTemporary(const std::string& target, bool writeThrough, std::string
 }
 
 /// Copies the temporary file into the device or FIFO `path` (no truncation:
-/// a character device has none).
+/// a character device has none, and a file behind /dev/stdout is shared).
 Status WriteThrough(const std::string& tmp, const std::string& path) {
   const int in = ::open(tmp.c_str(), O_RDONLY | O_CLOEXEC);
   if (in < 0) return Status::Error(Errno(path, "cannot read back the temporary file: "));
-  const int out = ::open(path.c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC);
+  // A regular file under /dev or /proc (/dev/stdout redirected to a file)
+  // is appended to, not written over from its start.
+  struct stat info {};
+  const bool regular = ::stat(path.c_str(), &info) == 0 && S_ISREG(info.st_mode);
+  const int out = ::open(path.c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC | (regular ? O_APPEND : 0));
   if (out < 0) {
-    const Status st = Status::Error(Errno(path));
+    const Status error = Status::Error(Errno(path));
     ::close(in);
-    return st;
+    return error;
   }
   char buffer[1 << 16];
   Status st;
@@ -270,8 +286,12 @@ Status OutputTransaction::Commit() {
   if (g_active == this) g_active = nullptr;
   committed_ = true;
   Status failed;
+  int state = kIdle;
+  if (!g_state.compare_exchange_strong(state, kCommitting))
+    return Status::Error("interrupted: the outputs are being removed");  // a handler runs in another thread
   {
-    // All renamed or none: a signal waits until every file is in place.
+    // All renamed or none: a signal waits until every file is in place (in
+    // this thread blocked, in another deferred by the handler).
     BlockSignals block;
     std::vector<std::string> renamed;
     for (const auto& p : pending_) {
@@ -287,6 +307,8 @@ Status OutputTransaction::Commit() {
     if (!failed.ok())
       for (const auto& r : renamed) ::unlink(r.c_str());
   }
+  g_state.store(kIdle);
+  if (const int sig = g_deferred.exchange(0)) ::raise(sig);
   // Devices and FIFOs last, outside the blocked section: writing to a FIFO
   // may wait for its reader, and must stay interruptible.
   for (const auto& p : pending_) {

@@ -36,9 +36,9 @@ void SetSignalHook(void (*hook)());
 Status WriteAtomically(const std::string& path, const std::function<Status(const std::string& tmpPath)>& write);
 
 /// All outputs of one run: while one exists, WriteAtomically keeps each
-/// output as its temporary file; Commit() renames them all into place with
-/// SIGINT, SIGTERM and SIGHUP blocked, then writes the character devices and
-/// FIFOs through. Destroyed without Commit() (a failure, an early return),
+/// output as its temporary file; Commit() renames them all into place (a
+/// SIGINT, SIGTERM or SIGHUP meanwhile waits until all are renamed), then
+/// writes the character devices and FIFOs through. Destroyed without Commit() (a failure, an early return),
 /// it removes the temporaries: no output of the run appears. One at a time.
 class OutputTransaction {
  public:

@@ -88,12 +88,25 @@ void KillOwnGroup(int) { ::kill(0, SIGKILL); }
 /// When dcm dies, even by SIGKILL, the kernel sends it SIGTERM
 /// (PR_SET_PDEATHSIG) and it kills the whole group: the shell, the renderer
 /// it started and every process of its pipeline. A parent-death signal on the
-/// shell alone would spare the processes the shell starts.
+/// shell alone would spare the processes the shell starts. (The kernel sends
+/// it when the *thread* that forked ends; dcm starts providers from its main
+/// thread.)
 [[noreturn]] void Supervise(pid_t dcm, const int toChild[2], const int fromChild[2], char* const argv[]) {
   struct sigaction term {};
   term.sa_handler = KillOwnGroup;
   sigemptyset(&term.sa_mask);
   ::sigaction(SIGTERM, &term, nullptr);
+  // dcm's own handlers (its cleanup of SIGINT and SIGHUP) are not the
+  // supervisor's: the default action, unless the signal is ignored (nohup).
+  for (int sig : {SIGINT, SIGHUP}) {
+    struct sigaction old {};
+    if (::sigaction(sig, nullptr, &old) == 0 && old.sa_handler != SIG_IGN) {
+      struct sigaction dfl {};
+      dfl.sa_handler = SIG_DFL;
+      sigemptyset(&dfl.sa_mask);
+      ::sigaction(sig, &dfl, nullptr);
+    }
+  }
   sigset_t none;
   sigemptyset(&none);
   ::sigprocmask(SIG_SETMASK, &none, nullptr);
