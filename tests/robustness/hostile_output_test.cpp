@@ -199,6 +199,18 @@ TEST(HostileOutput, MergeOntoAPartIsRefused) {
   ExpectRefused(dir, {"merge", "part*.exr", "-o", "part0.exr", "--quiet"}, "part0.exr", {"part", "-o"}, "glob");
 }
 
+#ifdef DCM_SCENE
+TEST(HostileOutput, RenderOntoItsSceneOrReferenceIsRefused) {
+  TempDir dir;
+  fs::copy_file(DCM_SCENE, dir / "scene.json");
+  WriteInput(dir / "ref.exr");
+  for (const auto& [how, name] : Aliases(dir, "scene.json"))
+    ExpectRefused(dir, {"render", "scene.json", "-o", name}, "scene.json", {"scene", "-o"}, "render " + how);
+  ExpectRefused(dir, {"render", "scene.json", "--compare", "ref.exr", "-o", "out.exr", "--reference-out", "ref.exr"},
+                "ref.exr", {"--compare", "--reference-out"}, "--reference-out onto --compare");
+}
+#endif
+
 TEST(HostileOutput, TwoOutputsOntoOneFileAreRefused) {
   TempDir dir;
   WriteInput(dir / "in.exr");
