@@ -17,7 +17,7 @@ nlohmann::json OptionsToJson(const ReconstructionOptions& o);
 
 /// exact_pixels, total_pixels, exact_fraction, time_s (engine), time_illum_s
 /// (provider), time_guides_s, by_reason {reason name: count, for every reason
-/// including "interpolated"}, blocks {...}, non_finite_samples, provider_calls,
+/// including "interpolated"}, blocks {...}, non_finite_samples, clamped_samples, provider_calls,
 /// used {split, object_id, shader_id}.
 nlohmann::json StatsToJson(const ReconstructionStats& s);
 
