@@ -296,11 +296,18 @@ std::vector<pid_t> WaitForPids(const std::string& pidFile) {
   return {};
 }
 
-/// True when `pid` is gone (allowing 3 s for it to die and be reaped by init).
+/// True when `pid` has ended within 3 s: no such process, or a zombie (dead,
+/// waiting for an init that may not reap it at once).
 bool Gone(pid_t pid) {
   const auto end = Clock::now() + std::chrono::seconds(3);
   while (Clock::now() < end) {
     if (::kill(pid, 0) != 0 && errno == ESRCH) return true;
+    std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+    std::string line;
+    // "PID (COMM) STATE ...": the state follows the last ')'.
+    if (std::getline(stat, line) && line.rfind(')') != std::string::npos && line.rfind(')') + 2 < line.size() &&
+        line[line.rfind(')') + 2] == 'Z')
+      return true;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   return false;
