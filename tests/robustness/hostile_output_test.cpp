@@ -275,6 +275,21 @@ TEST(HostileOutput, SpecialAndLongOutputNames) {
   EXPECT_TRUE(dir.Temporaries().empty());
 }
 
+TEST(HostileOutput, ALaterOutputFailingLeavesNone) {
+  TempDir dir;
+  WriteInput(dir / "in.exr");
+  {
+    std::ofstream(dir / "out.exr") << "an earlier result";
+  }
+  // --stats is written last, into a folder that does not exist.
+  const Result r = RunDcm(dir, {"reconstruct", "in.exr", "-o", "out.exr", "--sample-map", "map.png", "--stats",
+                                "missing/stats.json", "--quiet"});
+  EXPECT_TRUE(r.exited && r.code == 1) << Describe(r);
+  EXPECT_EQ(ReadAll(dir / "out.exr"), "an earlier result") << "the EXR was replaced by a run that failed";
+  EXPECT_FALSE(fs::exists(dir / "map.png"));
+  EXPECT_TRUE(dir.Temporaries().empty());
+}
+
 #ifdef DCM_HOSTILE_PROVIDER
 
 std::string ProviderCmd(const std::string& mode, const std::string& pidFile) {
