@@ -35,10 +35,17 @@ rm -f "$R"/* "$P"/*.cpu "$out/summary.txt" "$out/samples.exr"
 # antialiasing, linear half-float EXR). POV-Ray's own CPU time (parse +
 # bounding + trace, all threads) is appended to LOG.cpu. Include files
 # (pixels.inc) are found through +L$out.
+# It runs as a background job: POV-Ray is started in the background of the
+# job and waited for, so that the TERM of run.sh's cleanup (below) reaches
+# POV-Ray, which no interrupted run leaves behind.
 pov() {
     log=$1 dst=$2 w=$3 h=$4
     shift 4
-    if ! povray -D -A +FE +W"$w" +H"$h" +L"$out" "$@" +I"$here/scene.pov" +O"$dst.tmp.exr" >"$log" 2>&1; then
+    pov_pid=
+    trap '[ -z "$pov_pid" ] || kill "$pov_pid" 2>/dev/null; wait; rm -f "$dst".tmp.*; exit 143' TERM HUP
+    povray -D -A +FE +W"$w" +H"$h" +L"$out" "$@" +I"$here/scene.pov" +O"$dst.tmp.exr" >"$log" 2>&1 &
+    pov_pid=$!
+    if ! wait "$pov_pid"; then
         echo "run.sh: povray failed (log: $log):" >&2
         grep -iE "error|fatal" "$log" >&2 || tail -5 "$log" >&2
         return 1
@@ -47,6 +54,18 @@ pov() {
     sed -n 's/.*with \([0-9.]*\) CPU-seconds total.*/\1/p' "$log" |
         awk '{ s += $1 } END { printf "%.3f\n", s }' >>"$log.cpu"
 }
+# Interrupted (Ctrl-C, TERM, HUP), run.sh ends its POV-Ray jobs before it exits.
+end_jobs() {
+    trap - INT TERM HUP
+    # Not $(jobs -p): a command substitution is a subshell without the jobs.
+    jobs -p >"$out/.jobs"
+    while read -r job; do kill "$job" 2>/dev/null || :; done <"$out/.jobs"
+    rm -f "$out/.jobs"
+    wait
+}
+trap 'end_jobs; exit 130' INT
+trap 'end_jobs; exit 143' TERM
+trap 'end_jobs; exit 129' HUP
 # wait_all PID...: waits for every process; fails if any failed.
 wait_all() {
     rc=0

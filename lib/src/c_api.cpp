@@ -585,6 +585,7 @@ DCM_API double dcmGetStat(DCMReconstructor r, const char* name) {
   if (n == "exact_fraction") return s.exactFraction();
   if (n == "provider_calls") return double(s.providerCalls);
   if (n == "non_finite_samples") return double(s.nonFiniteSamples);
+  if (n == "clamped_samples") return double(s.clampedSamples);
   if (n == "smooth_blocks") return double(s.smoothBlocks);
   if (n == "simple_edge_blocks") return double(s.simpleEdgeBlocks);
   if (n == "complex_edge_blocks") return double(s.complexEdgeBlocks);

@@ -43,6 +43,20 @@ std::array<float, 2> SampleStore::LuminanceVariances(RGB varL, RGB tau) {
   return {a * a, b * b};
 }
 
+bool SampleStore::ClampSample(ExactSample* s) {
+  bool clamped = false;
+  for (RGB* v : {&s->L, &s->Li, &s->Lc})
+    for (int c = 0; c < 3; ++c) {
+      float& x = (*v)[c];
+      // NaN and infinity stay: they are counted apart and kept to their pixel.
+      if (std::isfinite(x) && std::fabs(x) > kMaxSampleMagnitude) {
+        x = std::copysign(kMaxSampleMagnitude, x);
+        clamped = true;
+      }
+    }
+  return clamped;
+}
+
 void SampleStore::ReplaceExact(int64_t i, const Value& v) { Write(i, v); }
 
 void SampleStore::Write(int64_t i, const Value& v) {
@@ -112,7 +126,8 @@ Status SampleStore::Flush(SampleProvider& provider, const SampleRequest& what, i
 
   for (size_t k = 0; k < pixels.size(); ++k) {
     const int64_t i = Index(pixels[k].x, pixels[k].y);
-    const ExactSample& s = samples[k];
+    ExactSample& s = samples[k];
+    if (ClampSample(&s)) ++stats->clampedSamples;
     reason_[i] = reasons[k];
     ++stats->byReason[size_t(reasons[k])];
     out_[i] = s.L;

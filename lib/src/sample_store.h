@@ -56,6 +56,9 @@ class SampleStore {
   /// Exact sample i can give L_i to pixel q: not when i has tau = 0 (its L_i
   /// is unknown) and q has not. Holds whatever the surface-aware switch.
   bool LiKnownFor(int64_t i, int64_t q) const { return tauZero_.empty() || !tauZero_[i] || tauZero_[q]; }
+  /// Clamps the finite values of L, L_i and L_c beyond kMaxSampleMagnitude to
+  /// it (NaN and infinity stay); true when one was.
+  static bool ClampSample(ExactSample* s);
   /// (varA, varB) of a sample whose L has per-channel variance `varL`.
   static std::array<float, 2> LuminanceVariances(RGB varL, RGB tau);
   /// Without the split the interpolated quantity is L itself, stored once.

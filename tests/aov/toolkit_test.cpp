@@ -119,6 +119,33 @@ TEST(ImageIo, AtomicWriteRemovesTheTemporaryOnFailure) {
   EXPECT_EQ(dir.Files(), std::vector<std::string>{"out.exr"});
 }
 
+TEST(ImageIo, TransactionPutsAllOutputsInPlaceAtCommitOrNone) {
+  ScratchDir dir;
+  auto write = [&](const std::string& name, const std::string& text) {
+    return toolkit::WriteAtomically(dir / name, [&](const std::string& tmp) {
+      std::ofstream(tmp) << text;
+      return Status::Ok();
+    });
+  };
+  {
+    toolkit::OutputTransaction run;
+    ASSERT_TRUE(write("a.exr", "A").ok());
+    ASSERT_TRUE(write("b.json", "B").ok());
+    EXPECT_EQ(dir.Files().size(), 2u) << "two temporaries";
+    EXPECT_FALSE(fs::exists(dir / "a.exr")) << "nothing in place before the commit";
+  }  // not committed: a failure or an early return
+  EXPECT_TRUE(dir.Files().empty()) << "the temporaries are gone";
+  {
+    toolkit::OutputTransaction run;
+    ASSERT_TRUE(write("a.exr", "A").ok());
+    ASSERT_TRUE(write("b.json", "B").ok());
+    ASSERT_TRUE(run.Commit().ok());
+  }
+  EXPECT_EQ(ReadText(dir / "a.exr"), "A");
+  EXPECT_EQ(ReadText(dir / "b.json"), "B");
+  EXPECT_EQ(dir.Files(), (std::vector<std::string>{"a.exr", "b.json"}));
+}
+
 TEST(ImageIo, ExrRoundTripWithMetadataAndAlpha) {
   ScratchDir dir;
   std::vector<RGB> px = {{0.1f, 2.f, -1.f}, {1e6f, 0.f, 0.5f}};

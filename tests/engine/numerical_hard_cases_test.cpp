@@ -57,6 +57,31 @@ TEST(HardCases, NonFiniteSamplesNeverSpread) {
   }
 }
 
+// Huge finite samples (a provider's -3e38, finite in float) are clamped to
+// kMaxSampleMagnitude as they arrive and counted: no sum or square of the
+// engine overflows to infinity, so every pixel stays finite.
+TEST(HardCases, HugeFiniteSamplesGiveFinitePixels) {
+  const int N = 96;
+  auto base = FurnishedScene(N, N);
+  auto huge = [&](int x, int y) {
+    PixelTruth t = base(x, y);
+    // Lattice points of the default 16-pixel blocks (always evaluated), of
+    // both signs, and an arbitrary pixel.
+    if ((x == 16 && y == 32) || (x == 48 && y == 48)) t.Li = RGB(-3e38f, -3e38f, -3e38f);
+    if ((x == 64 && y == 16) || (x == 13 && y == 77)) t.Li = RGB(3e38f, 0, 0);
+    return t;
+  };
+  for (const ReconstructionOptions& opt : {ReconstructionOptions{}, ReconstructionOptions::Guo()}) {
+    AnalyticProvider p(N, N, huge);
+    const Reconstruction r = ReconstructOrFail(p, opt);
+    for (size_t i = 0; i < r.workImage.size(); ++i)
+      ASSERT_TRUE(IsFinite(r.workImage[i])) << "pixel " << i % N << "," << i / N;
+    EXPECT_EQ(r.stats.nonFiniteSamples, 0);
+    EXPECT_GE(r.stats.clampedSamples, 3);  // the three lattice points at least
+    EXPECT_LE(r.stats.clampedSamples, 4);
+  }
+}
+
 TEST(HardCases, DynamicRangeOfTwelveDecadesInOneBlock) {
   const int N = 33;
   auto scene = [](int x, int y) {

@@ -44,7 +44,7 @@ namespace fs = std::filesystem;
 
 /// The address space dcm may use here: 1 GiB. The control scene below
 /// renders within it with one thread and two malloc arenas (it needs between
-/// 512 and 768 MiB, mostly the mapped libraries: docs/ROBUSTNESS.md), while
+/// 512 and 768 MiB, mostly the mapped libraries: docs/PROMISES.md), while
 /// the allocations the lying files used to cause are 2.4 GB (2e8 PLY
 /// vertices) and 5.9 GB (the 9400^2 EXR), so a guard that lets them through
 /// fails the test.

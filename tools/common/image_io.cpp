@@ -1,11 +1,8 @@
 // Image files in and out through OpenImageIO, every output written atomically.
 #include "image_io.h"
 
-#include <unistd.h>
-
 #include <OpenImageIO/imageio.h>
 
-#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -22,22 +19,6 @@ using OIIO::ImageOutput;
 using OIIO::ImageSpec;
 using OIIO::TypeDesc;
 
-/// A temporary name next to `path` that keeps its extension (OpenImageIO picks
-/// the format from it) and cannot collide with another process or thread.
-std::string TemporaryName(const std::string& path) {
-  static std::atomic<unsigned> counter{0};
-  fs::path p(path);
-  // Built by append: GCC 12 warns falsely (-Wrestrict) on "." + std::string.
-  std::string name(1, '.');
-  name.append(p.stem().string());
-  name.append(".dcmtmp");
-  name.append(std::to_string(::getpid()));
-  name.push_back('_');
-  name.append(std::to_string(counter.fetch_add(1)));
-  name.append(p.extension().string());
-  return (p.parent_path() / name).string();
-}
-
 Status CheckSize(const std::string& path, int width, int height, size_t count) {
   if (width <= 0 || height <= 0)
     return Status::Error("cannot write '" + path + "': empty image (" + std::to_string(width) + "x" +
@@ -50,30 +31,6 @@ Status CheckSize(const std::string& path, int width, int height, size_t count) {
 }
 
 }  // namespace
-
-Status WriteAtomically(const std::string& path,
-                       const std::function<Status(const std::string& tmpPath)>& write) {
-  if (path.empty()) return Status::Error("empty output file name");
-  const std::string tmp = TemporaryName(path);
-  Status st;
-  try {
-    st = write(tmp);
-  } catch (const std::exception& e) {
-    st = Status::Error("cannot write '" + path + "': " + e.what());
-  }
-  std::error_code ec;
-  if (!st.ok()) {
-    fs::remove(tmp, ec);
-    return st;
-  }
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    return Status::Error("cannot write '" + path + "': " + ec.message());
-  }
-  return Status::Ok();
-}
 
 ImageSpec WindowedSpec(const Bounds2i& display, const Bounds2i& data, int channels) {
   ImageSpec spec(data.width(), data.height(), channels, TypeDesc::FLOAT);

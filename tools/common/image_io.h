@@ -1,6 +1,6 @@
-// Image files in and out. Every output is written to a temporary name in the
-// destination folder and renamed into place, so a failure never leaves a
-// partial or truncated file under the requested name.
+// Image files in and out. Every output is written through WriteAtomically
+// (output_transaction.h), so a failure never leaves a partial or truncated
+// file under the requested name.
 #pragma once
 
 #include <OpenImageIO/imageio.h>
@@ -15,6 +15,7 @@
 #include "dcm/color.h"
 #include "dcm/geometry.h"
 #include "dcm/status.h"
+#include "output_transaction.h"
 
 namespace dcm::toolkit {
 
@@ -60,10 +61,5 @@ Status CheckImageDimensions(const std::string& path, int width, int height, int 
 /// Reads the R, G, B channels of an image (by channel name; a 1-channel image
 /// is read as gray): the pixels of its data window. The message names the file and what is wrong.
 Status ReadRgb(const std::string& path, int* width, int* height, std::vector<RGB>* pixels);
-
-/// Runs `write(tmpPath)` and renames the temporary file to `path` on success;
-/// removes it on failure.
-Status WriteAtomically(const std::string& path,
-                       const std::function<Status(const std::string& tmpPath)>& write);
 
 }  // namespace dcm::toolkit

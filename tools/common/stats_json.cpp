@@ -87,6 +87,7 @@ nlohmann::json StatsToJson(const ReconstructionStats& s) {
                  {"lazy_rejected", s.lazyRejected},
                  {"fallback", s.fallbackBlocks}};
   j["non_finite_samples"] = s.nonFiniteSamples;
+  j["clamped_samples"] = s.clampedSamples;
   j["denoised_samples"] = s.denoisedSamples;
   j["checkerboard_filled"] = s.checkerboardFilled;
   j["crossings_filled"] = s.crossingsFilled;
@@ -106,6 +107,19 @@ nlohmann::json RunToJson(const Reconstruction& r, const std::string& method, con
   j["working_resolution"] = {r.workWidth, r.workHeight};
   j["time_wall_s"] = wallS;
   return j;
+}
+
+std::vector<std::string> SampleWarnings(const ReconstructionStats& s) {
+  std::vector<std::string> w;
+  if (s.nonFiniteSamples)
+    w.push_back(std::to_string(s.nonFiniteSamples) + " exact samples are NaN/Inf (kept to their pixels)");
+  if (s.clampedSamples) {
+    char limit[32];
+    std::snprintf(limit, sizeof limit, "%g", double(kMaxSampleMagnitude));
+    w.push_back(std::to_string(s.clampedSamples) + " exact samples have finite values beyond +-" + limit +
+                " (clamped to it)");
+  }
+  return w;
 }
 
 Status WriteJson(const std::string& path, const nlohmann::json& j) {

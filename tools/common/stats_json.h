@@ -3,6 +3,7 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "dcm/options.h"
 #include "dcm/reconstructor.h"
@@ -16,7 +17,7 @@ nlohmann::json OptionsToJson(const ReconstructionOptions& o);
 
 /// exact_pixels, total_pixels, exact_fraction, time_s (engine), time_illum_s
 /// (provider), time_guides_s, by_reason {reason name: count, for every reason
-/// including "interpolated"}, blocks {...}, non_finite_samples, provider_calls,
+/// including "interpolated"}, blocks {...}, non_finite_samples, clamped_samples, provider_calls,
 /// used {split, object_id, shader_id}.
 nlohmann::json StatsToJson(const ReconstructionStats& s);
 
@@ -25,6 +26,10 @@ nlohmann::json StatsToJson(const ReconstructionStats& s);
 /// time_wall_s.
 nlohmann::json RunToJson(const Reconstruction& r, const std::string& method, const ReconstructionOptions& o,
                          double wallS);
+
+/// The warnings a run's samples deserve, one sentence each: NaN/Inf samples
+/// (kept to their pixels) and huge finite ones (clamped to kMaxSampleMagnitude).
+std::vector<std::string> SampleWarnings(const ReconstructionStats& s);
 
 /// Writes JSON (pretty, 2 spaces) atomically. Non-finite numbers become null
 /// (JSON has no infinity).

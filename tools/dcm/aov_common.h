@@ -15,6 +15,8 @@
 #include <vector>
 
 #include "commands.h"
+#include "common/output_guard.h"
+#include "common/output_transaction.h"
 #include "common/progress.h"
 #include "common/tiles.h"
 #include "dcm/aov/aov_provider.h"
@@ -186,32 +188,39 @@ inline Status Run(aov::AovProvider& provider, ReconstructionOptions options, con
   return st;
 }
 
-/// Removes the files written so far (after a later output failed).
-inline void RemoveAll(const std::vector<std::string>& paths) {
-  for (const auto& p : paths) {
-    std::error_code ec;
-    std::filesystem::remove(p, ec);
-  }
-}
-
-/// A command's outputs, written one after another (each atomically): when
-/// one fails, those written before are removed too, and the error printed.
+/// A command's outputs as one transaction (toolkit::OutputTransaction): made
+/// before the work starts, so that every file the run writes appears at
+/// Commit() or not at all.
 class Outputs {
  public:
   explicit Outputs(std::string cmd) : cmd_(std::move(cmd)) {}
-  /// `status` of writing `path`: kExitOk, or the failure's exit code.
-  int Write(const std::string& path, Status status) {
-    if (!status.ok()) {
-      RemoveAll(written_);
-      return Fail(cmd_, status.message());
-    }
-    written_.push_back(path);
-    return kExitOk;
-  }
+  /// `status` of writing an output: kExitOk, or the failure's exit code (the
+  /// error printed; nothing of the run appears).
+  int Write(const Status& status) { return status.ok() ? kExitOk : Fail(cmd_, status.message()); }
+  /// Puts every output in place: kExitOk or the failure's exit code.
+  int Commit() { return Write(transaction_.Commit()); }
 
  private:
   std::string cmd_;
-  std::vector<std::string> written_;
+  toolkit::OutputTransaction transaction_;
 };
+
+/// The output guard (toolkit::CheckOutputs): kExitOk, or kExitUsage with the
+/// error printed.
+inline int CheckFiles(const std::string& cmd, const std::vector<toolkit::FileArg>& inputs,
+                      const std::vector<toolkit::FileArg>& outputs) {
+  const Status st = toolkit::CheckOutputs(inputs, outputs);
+  return st.ok() ? kExitOk : Fail(cmd, st.message(), kExitUsage);
+}
+
+/// The input files of the AOV flags (inputs, --samples, --second-render, --texture).
+inline std::vector<toolkit::FileArg> InputArgs(const AovFlags& f) {
+  std::vector<toolkit::FileArg> args;
+  for (const auto& p : f.inputs) args.push_back({"input", p});
+  for (const auto& p : f.samples) args.push_back({"--samples", p});
+  for (const auto& p : f.secondRender) args.push_back({"--second-render", p});
+  for (const auto& t : f.textures) args.push_back(toolkit::TextureArg(t));
+  return args;
+}
 
 }  // namespace dcm::cli::aov_common

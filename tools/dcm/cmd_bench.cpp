@@ -35,6 +35,7 @@
 #include "common/metrics.h"
 #include "common/progress.h"
 #include "common/sample_map.h"
+#include "common/output_guard.h"
 #include "common/stats_json.h"
 #include "dcm/reconstructor.h"
 #include "embree/embree_provider.h"
@@ -584,6 +585,15 @@ int Fail(const Status& st, int code = kExitFailure) {
 }
 
 int RunBench(const BenchFlags& f) {
+  std::vector<toolkit::FileArg> inputs;
+  for (const auto& in : f.inputs) inputs.push_back({"input", in});
+  std::vector<toolkit::FileArg> outputs;
+  for (const char* name : {"bench.csv", "bench.json", "summary.md", "*.png"})
+    outputs.push_back({"--out", (fs::path(f.out) / name).string(), std::string(name).find('*') != std::string::npos});
+  if (Status st = toolkit::CheckOutputs(inputs, outputs); !st.ok()) {
+    std::cerr << "dcm bench: error: " << st.message() << "\n";
+    return kExitUsage;
+  }
   std::error_code ec;
   fs::create_directories(f.out, ec);
   if (ec) return Fail(Status::Error("cannot create '" + f.out + "': " + ec.message()));

@@ -11,13 +11,14 @@
 #include <glob.h>
 
 #include <algorithm>
-#include <cstdio>
 #include <iostream>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "commands.h"
+#include "common/output_guard.h"
+#include "common/output_transaction.h"
 #include "common/stats_json.h"
 #include "common/tiles.h"
 #include "flag_checks.h"
@@ -67,6 +68,11 @@ int MergeOne(const std::vector<std::string>& patterns, const std::string& output
   std::vector<std::string> parts;
   for (const auto& p : patterns)
     if (Status st = Expand(p, &parts); !st.ok()) return Fail(st.message());
+  std::vector<toolkit::FileArg> inputs;
+  for (const auto& p : parts) inputs.push_back({"part", p});
+  if (Status st = toolkit::CheckOutputs(inputs, {{"-o", output}, {"--stats", statsPath}}); !st.ok())
+    return Fail(st.message(), kExitUsage);
+  toolkit::OutputTransaction outputs;  // the frame and its stats together, or neither
   toolkit::MergedFrame frame;
   if (Status st = toolkit::MergeParts(parts, &frame); !st.ok()) return Fail(st.message());
   toolkit::Metadata extra;
@@ -86,11 +92,9 @@ int MergeOne(const std::vector<std::string>& patterns, const std::string& output
     nlohmann::json j = frame.stats;
     j["parts_files"] = parts;
     j["resolution"] = {frame.width, frame.height};
-    if (Status st = toolkit::WriteJson(statsPath, j); !st.ok()) {
-      std::remove(output.c_str());  // all outputs or none
-      return Fail(st.message());
-    }
+    if (Status st = toolkit::WriteJson(statsPath, j); !st.ok()) return Fail(st.message());
   }
+  if (Status st = outputs.Commit(); !st.ok()) return Fail(st.message());
   if (!quiet)
     std::cout << "dcm merge: " << parts.size() << " parts -> " << output << " (" << frame.width << "x"
               << frame.height << ")\n";

@@ -15,6 +15,8 @@
 
 #include "commands.h"
 #include "common/image_io.h"
+#include "common/output_guard.h"
+#include "common/output_transaction.h"
 #include "common/progress.h"
 #include "common/sample_map.h"
 #include "common/stats_json.h"
@@ -52,6 +54,16 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
   const bool partial = IsPartial(f.tiles);
   if (partial && !f.engine.progressive.empty())
     return Fail("--progressive needs the whole frame; not with --tile or --region", kExitUsage);
+
+  if (Status st = toolkit::CheckOutputs({}, {{"-o", f.output},
+                                             {"--stats", f.stats},
+                                             {"--sample-map", f.sampleMap},
+                                             toolkit::ProgressiveArg(f.engine.progressive)});
+      !st.ok())
+    return Fail(st.message(), kExitUsage);
+  // Every output of the run appears at its Commit(), or none; a signal ends the child too.
+  toolkit::OutputTransaction outputs;
+  toolkit::SetSignalHook(pipe::KillAllChildren);
 
   const auto t0 = std::chrono::steady_clock::now();
   std::unique_ptr<pipe::PipeProvider> provider;
@@ -127,6 +139,7 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
     if (partial) j["part"] = PartJson(tile, info);
     if (Status w = toolkit::WriteJson(f.stats, j); !w.ok()) return Fail(w.message());
   }
+  if (Status w = outputs.Commit(); !w.ok()) return Fail(w.message());
 
   if (partial)
     std::printf("%s: %s %s of %dx%d (window %dx%d working pixels), %s, provider '%s'\n", f.output.c_str(),
@@ -140,6 +153,7 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
   std::printf("  time           provider %.2f s, DCM %.2f s, guides %.2f s, total %.2f s\n", stats.timeProviderS,
               stats.timeEngineS, stats.timeGuidesS, wallS);
   std::printf("  provider calls %lld\n", static_cast<long long>(stats.providerCalls));
+  for (const auto& w : toolkit::SampleWarnings(stats)) std::cerr << "dcm " << cmd << ": warning: " << w << "\n";
   return kExitOk;
 }
 

@@ -85,6 +85,13 @@ int RunPlan(const PlanFlags& f) {
   if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
   if (f.mask.empty() && f.list.empty())
     return aov_common::Fail(cmd, "give --list and/or --mask for the pixels to render", kExitUsage);
+  if (int rc = aov_common::CheckFiles(cmd, aov_common::InputArgs(f.aov),
+                                      {{"--mask", f.mask},
+                                       {"--list", f.list},
+                                       {"--stats", f.stats},
+                                       toolkit::ProgressiveArg(f.engine.progressive)}))
+    return rc;
+  aov_common::Outputs outputs(cmd);  // before the run: --progressive writes during it
   aov::AovOptions aovOptions;
   st = aov_common::ToAovOptions(f.aov, /*sparse=*/true, options.textureSplit, &aovOptions);
   if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
@@ -122,11 +129,9 @@ int RunPlan(const PlanFlags& f) {
   const Bounds2i display = provider->DisplayWindow(), data = provider->DataWindow();
   const auto channels = provider->SampleChannels();
 
-  aov_common::Outputs outputs(cmd);
-  auto check = [&outputs](const std::string& path, Status s) { return outputs.Write(path, std::move(s)); };
   int rc = kExitOk;
-  if (!f.mask.empty() && (rc = check(f.mask, WriteMask(f.mask, display, data, next, channels)))) return rc;
-  if (!f.list.empty() && (rc = check(f.list, WriteList(f.list, display, data, next, channels)))) return rc;
+  if (!f.mask.empty() && (rc = outputs.Write(WriteMask(f.mask, display, data, next, channels)))) return rc;
+  if (!f.list.empty() && (rc = outputs.Write(WriteList(f.list, display, data, next, channels)))) return rc;
   if (!f.stats.empty()) {
     nlohmann::json j;
     j["command"] = cmd;
@@ -141,8 +146,9 @@ int RunPlan(const PlanFlags& f) {
       if (!done) j["part"].erase("window_stats");  // the engine did not finish the window
     }
     else if (done) j["result"] = toolkit::StatsToJson(r.stats);
-    if ((rc = check(f.stats, toolkit::WriteJson(f.stats, j)))) return rc;
+    if ((rc = outputs.Write(toolkit::WriteJson(f.stats, j)))) return rc;
   }
+  if ((rc = outputs.Commit())) return rc;
   if (!f.engine.quiet) {
     if (IsPartial(f.tiles))
       std::cerr << "dcm plan: " << (tile.empty() ? "region " : "tile " + tile + ", ")

@@ -97,6 +97,7 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
   identity["alpha"] = f.alpha;
   const nlohmann::json settings = toolkit::PartSettings(cmd, DCM_VERSION, options, identity);
 
+  aov_common::Outputs outputs(cmd);
   Reconstruction r;
   RegionInfo info;
   std::vector<Point2i> pending;
@@ -132,15 +133,13 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
   toolkit::Metadata meta = ProvenanceMetadata(f, provider, options);
   AddPartMetadata(tile, region, settings, r, info, &meta);
 
-  aov_common::Outputs outputs(cmd);
-  auto write = [&outputs](const std::string& path, Status s) { return outputs.Write(path, std::move(s)); };
-  int rc = write(f.output, toolkit::WritePartExr(f.output, frame.x, frame.y, region, r.image, meta, f.alpha));
+  int rc = outputs.Write(toolkit::WritePartExr(f.output, frame.x, frame.y, region, r.image, meta, f.alpha));
   if (rc) return rc;
-  if (!f.sampleMap.empty() && (rc = write(f.sampleMap, toolkit::WriteSampleMap(f.sampleMap, r)))) return rc;
-  if (!f.preview.empty() &&
-      (rc = write(f.preview, toolkit::WritePreview(f.preview, r.width, r.height, r.image))))
+  if (!f.sampleMap.empty() && (rc = outputs.Write(toolkit::WriteSampleMap(f.sampleMap, r)))) return rc;
+  if (!f.preview.empty() && (rc = outputs.Write(toolkit::WritePreview(f.preview, r.width, r.height, r.image))))
     return rc;
-  if (!f.stats.empty() && (rc = write(f.stats, toolkit::WriteJson(f.stats, stats)))) return rc;
+  if (!f.stats.empty() && (rc = outputs.Write(toolkit::WriteJson(f.stats, stats)))) return rc;
+  if ((rc = outputs.Commit())) return rc;
   if (!f.engine.quiet) {
     std::ostringstream s;
     s << "dcm " << cmd << ": " << (tile.empty() ? "region " + toolkit::RegionText(region) : "tile " + tile)
@@ -180,6 +179,16 @@ int RunReconstruct(const ReconstructFlags& f) {
   }
   if (f.aov.inputs.empty())
     return aov_common::Fail(cmd, "no input files (EXR AOVs), and no --provider-cmd", kExitUsage);
+  std::vector<toolkit::FileArg> inputs = aov_common::InputArgs(f.aov);
+  inputs.push_back({"--reference", f.reference});
+  if (int rc = aov_common::CheckFiles(cmd, inputs,
+                                      {{"-o", f.output},
+                                       {"--stats", f.stats},
+                                       {"--sample-map", f.sampleMap},
+                                       {"--preview", f.preview},
+                                       {"--error-map", f.errorMap},
+                                       toolkit::ProgressiveArg(f.engine.progressive)}))
+    return rc;
   ReconstructionOptions options;
   Status st = ToOptions(f.engine, &options);
   if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
@@ -196,6 +205,7 @@ int RunReconstruct(const ReconstructFlags& f) {
   st = CheckDownsample(provider->width(), provider->height(), options.downsample, "the inputs' data window");
   if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
   if (IsPartial(f.tiles)) return RunReconstructPart(f, options, *provider);
+  aov_common::Outputs outputs(cmd);  // before the run: --progressive writes during it
   ExrReconstruction run;
   bool usage = false;
   st = ReconstructWholeExr(cmd, *provider, f.aov, f.engine, options, f.reference, &run, &usage);
@@ -208,19 +218,17 @@ int RunReconstruct(const ReconstructFlags& f) {
   meta.floats.push_back({"dcm:exact_fraction", float(r.stats.exactFraction())});
   if (haveRef && std::isfinite(error.psnr)) meta.floats.push_back({"dcm:psnr", float(error.psnr)});
 
-  // Every output is atomic; if a later one fails, the earlier ones go too.
-  aov_common::Outputs outputs(cmd);
-  auto write = [&outputs](const std::string& path, Status s) { return outputs.Write(path, std::move(s)); };
-  int rc = write(f.output, toolkit::WriteRgbExr(f.output, run.display, run.data, r.image, meta, f.alpha));
+  // All outputs appear together at Commit(), or none.
+  int rc = outputs.Write(toolkit::WriteRgbExr(f.output, run.display, run.data, r.image, meta, f.alpha));
   if (rc) return rc;
-  if (!f.sampleMap.empty() && (rc = write(f.sampleMap, toolkit::WriteSampleMap(f.sampleMap, r)))) return rc;
-  if (!f.preview.empty() &&
-      (rc = write(f.preview, toolkit::WritePreview(f.preview, r.width, r.height, r.image))))
+  if (!f.sampleMap.empty() && (rc = outputs.Write(toolkit::WriteSampleMap(f.sampleMap, r)))) return rc;
+  if (!f.preview.empty() && (rc = outputs.Write(toolkit::WritePreview(f.preview, r.width, r.height, r.image))))
     return rc;
   if (!f.errorMap.empty() &&
-      (rc = write(f.errorMap, toolkit::WriteErrorMap(f.errorMap, r.image, run.reference, r.width, r.height))))
+      (rc = outputs.Write(toolkit::WriteErrorMap(f.errorMap, r.image, run.reference, r.width, r.height))))
     return rc;
-  if (!f.stats.empty() && (rc = write(f.stats, toolkit::WriteJson(f.stats, run.stats)))) return rc;
+  if (!f.stats.empty() && (rc = outputs.Write(toolkit::WriteJson(f.stats, run.stats)))) return rc;
+  if ((rc = outputs.Commit())) return rc;
 
   if (!f.engine.quiet) {
     std::ostringstream s;
@@ -230,9 +238,7 @@ int RunReconstruct(const ReconstructFlags& f) {
     if (haveRef) s << ", PSNR " << PsnrText(error.psnr) << ", RMSE " << std::setprecision(5) << error.rmse;
     s << ", engine " << std::setprecision(3) << r.stats.timeEngineS << " s -> " << f.output;
     std::cout << s.str() << "\n";
-    if (r.stats.nonFiniteSamples)
-      std::cerr << "dcm " << cmd << ": warning: " << r.stats.nonFiniteSamples
-                << " exact samples are NaN/Inf (kept to their pixels)\n";
+    for (const auto& w : toolkit::SampleWarnings(r.stats)) std::cerr << "dcm " << cmd << ": warning: " << w << "\n";
   }
   return kExitOk;
 }

@@ -14,6 +14,7 @@
 #include "commands.h"
 #include "common/image_io.h"
 #include "common/metrics.h"
+#include "common/output_guard.h"
 #include "common/preview.h"
 #include "common/progress.h"
 #include "common/sample_map.h"
@@ -113,7 +114,7 @@ toolkit::Metadata RenderMetadata(const std::string& scene, const std::string& me
 
 /// --tile / --region: the region of the frame, written as a part for `dcm merge`.
 int RunRenderPart(const RenderFlags& f, const embree::Scene& scene, ReconstructionOptions options,
-                  embree::EmbreeProvider& provider, toolkit::Progress& progress) {
+                  embree::EmbreeProvider& provider, toolkit::Progress& progress, toolkit::OutputTransaction& outputs) {
   auto usage = [](const std::string& message) {
     std::cerr << "dcm render: " << message << "\n";
     return kExitUsage;
@@ -166,6 +167,7 @@ int RunRenderPart(const RenderFlags& f, const embree::Scene& scene, Reconstructi
     j["part"] = PartJson(tile, info);
     if (Status st = toolkit::WriteJson(f.stats, j); !st.ok()) return Fail(st);
   }
+  if (Status st = outputs.Commit(); !st.ok()) return Fail(st);
   std::printf("%s: %s %s of %dx%d (window %dx%d working pixels), %s\n", f.scene.c_str(),
               tile.empty() ? "region" : "tile", tile.empty() ? toolkit::RegionText(region).c_str() : tile.c_str(),
               frame.x, frame.y, info.window.width(), info.window.height(), method.c_str());
@@ -179,6 +181,19 @@ int RunRenderPart(const RenderFlags& f, const embree::Scene& scene, Reconstructi
 }
 
 int RunRender(const RenderFlags& f, CLI::App* app) {
+  if (Status st = toolkit::CheckOutputs({{"scene", f.scene}, {"--compare", f.compare}},
+                                        {{"-o", f.output},
+                                         {"--stats", f.stats},
+                                         {"--sample-map", f.sampleMap},
+                                         {"--preview", f.preview},
+                                         {"--reference-out", f.referenceOut},
+                                         toolkit::ProgressiveArg(f.engine.progressive)});
+      !st.ok()) {
+    std::cerr << "dcm render: error: " << st.message() << "\n";
+    return kExitUsage;
+  }
+  // Every output of the run appears at its Commit(), or none (--progressive too).
+  toolkit::OutputTransaction outputs;
   // Scene and its overrides.
   embree::Scene scene;
   if (Status st = embree::LoadSceneFile(f.scene, &scene, f.overrides); !st.ok()) return Fail(st);
@@ -221,7 +236,7 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
               << Join(provider->effects().Names()) << "\n"
               << "engine settings: " << SettingsSummary(options, provider->Capabilities()) << "\n";
   }
-  if (IsPartial(f.tiles)) return RunRenderPart(f, scene, options, *provider, progress);
+  if (IsPartial(f.tiles)) return RunRenderPart(f, scene, options, *provider, progress, outputs);
 
   // The reference compared against, from a file or rendered in this run.
   std::optional<std::vector<RGB>> reference;
@@ -297,6 +312,7 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
     }
     if (Status st = toolkit::WriteJson(f.stats, j); !st.ok()) return Fail(st);
   }
+  if (Status st = outputs.Commit(); !st.ok()) return Fail(st);
 
   std::printf("%s: %dx%d (working %dx%d), %s\n", f.scene.c_str(), rec.width, rec.height, rec.workWidth,
               rec.workHeight, method.c_str());
@@ -309,6 +325,7 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
               static_cast<unsigned long long>(run.rays.total()), static_cast<unsigned long long>(run.rays.shadow),
               static_cast<unsigned long long>(run.rays.glossy), static_cast<unsigned long long>(run.rays.mirror),
               static_cast<unsigned long long>(run.rays.indirect));
+  for (const auto& w : toolkit::SampleWarnings(stats)) std::cerr << "dcm render: warning: " << w << "\n";
   if (full) {
     std::printf("  full render    illumination %.2f s, total %.2f s, %llu rays\n", full->rec.stats.timeProviderS,
                 full->wallS, static_cast<unsigned long long>(full->rays.total()));

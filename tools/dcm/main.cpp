@@ -7,6 +7,7 @@
 
 #include "commands.h"
 #include "flag_checks.h"
+#include "common/output_transaction.h"
 
 namespace dcm::cli {
 std::vector<CommandEntry>& CommandRegistry() {
@@ -17,6 +18,8 @@ std::vector<CommandEntry>& CommandRegistry() {
 
 int main(int argc, char** argv) {
   using namespace dcm::cli;
+  // Interrupted at any moment, a run leaves no temporary file and no child.
+  dcm::toolkit::InstallSignalCleanup();
   CLI::App app{"dcm: image reconstruction with Directional Coherence Maps (Guo 1998, Scheel et al. 2001)"};
   const std::string version = std::string("dcm ") + DCM_VERSION;
   app.set_version_flag("--version", version);

@@ -264,6 +264,7 @@ DCM_API const uint8_t* dcmGetSampleMap(DCMReconstructor r, int* width, int* heig
 
 /** A statistic of the last successful dcmExecute(): "exact_pixels",
  *  "total_pixels", "exact_fraction", "provider_calls", "non_finite_samples",
+ *  "clamped_samples",
  *  "smooth_blocks", "simple_edge_blocks", "complex_edge_blocks",
  *  "fallback_blocks", "time_provider_s", "time_guides_s", "time_engine_s".
  *  0 and an error for an unknown name or before a result. */

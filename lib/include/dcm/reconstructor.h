@@ -68,6 +68,7 @@ struct ReconstructionStats {
   int64_t exactPixels = 0;
   std::array<int64_t, kSampleReasonCount> byReason{};
   int64_t nonFiniteSamples = 0;  ///< exact samples with NaN or infinity, kept to their pixel
+  int64_t clampedSamples = 0;    ///< exact samples with a finite value beyond kMaxSampleMagnitude, clamped to it
   int64_t denoisedSamples = 0;   ///< exact samples replaced by their local fit (noisy samples)
   int64_t smoothBlocks = 0, simpleEdgeBlocks = 0, complexEdgeBlocks = 0;
   int64_t lazyAccepted = 0, lazyRejected = 0, fallbackBlocks = 0;

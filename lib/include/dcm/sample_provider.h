@@ -62,6 +62,12 @@ struct SampleRequest {
   bool variance = false;  ///< fill variance
 };
 
+/// The largest magnitude of a sample value (L, L_i, L_c) the engine takes;
+/// finite values beyond it are clamped to it as they arrive. Far above any
+/// radiance (the sun's disc is about 1.6e9 cd/m^2), and small enough that the
+/// engine's sums and squares of samples stay finite in float (1e30 per square).
+inline constexpr float kMaxSampleMagnitude = 1e15f;
+
 /// One exact (expensive) sample of a pixel.
 struct ExactSample {
   RGB L;         ///< radiance; always filled

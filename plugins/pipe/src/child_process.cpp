@@ -1,14 +1,18 @@
-// The child process behind PipeProvider: posix_spawn, pipes, poll deadlines.
+// The child process behind PipeProvider: a supervisor that takes the child
+// with it when dcm dies, pipes, poll deadlines.
 #include "child_process.h"
+#include "dcm/pipe/pipe_provider.h"
 
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
-#include <spawn.h>
+#include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <thread>
@@ -56,7 +60,102 @@ class SigpipeGuard {
   bool wasPending_ = false;
 };
 
+/// The process groups of the children alive, for KillAllChildren (a signal
+/// handler may neither allocate nor lock).
+constexpr int kMaxChildren = 64;
+std::atomic<pid_t> g_groups[kMaxChildren];
+
+void Track(pid_t group) {
+  for (auto& g : g_groups) {
+    pid_t none = 0;
+    if (g.compare_exchange_strong(none, group)) return;
+  }
+}
+
+void Untrack(pid_t group) {
+  for (auto& g : g_groups) {
+    pid_t mine = group;
+    if (g.compare_exchange_strong(mine, 0)) return;
+  }
+}
+
+/// SIGTERM of the supervisor (its parent-death signal): the whole group goes.
+void KillOwnGroup(int) { ::kill(0, SIGKILL); }
+
+/// The supervisor, forked from dcm (only async-signal-safe calls from here
+/// on): leads the child's process group, starts `/bin/sh -c COMMAND` in it
+/// with the pipes as its stdin and stdout, and ends with the shell's status.
+/// When dcm dies, even by SIGKILL, the kernel sends it SIGTERM
+/// (PR_SET_PDEATHSIG) and it kills the whole group: the shell, the renderer
+/// it started and every process of its pipeline. A parent-death signal on the
+/// shell alone would spare the processes the shell starts. (The kernel sends
+/// it when the *thread* that forked ends; dcm starts providers from its main
+/// thread.)
+[[noreturn]] void Supervise(pid_t dcm, const int toChild[2], const int fromChild[2], char* const argv[]) {
+  struct sigaction term {};
+  term.sa_handler = KillOwnGroup;
+  sigemptyset(&term.sa_mask);
+  ::sigaction(SIGTERM, &term, nullptr);
+  // dcm's own handlers (its cleanup of SIGINT and SIGHUP) are not the
+  // supervisor's: the default action, unless the signal is ignored (nohup).
+  for (int sig : {SIGINT, SIGHUP}) {
+    struct sigaction old {};
+    if (::sigaction(sig, nullptr, &old) == 0 && old.sa_handler != SIG_IGN) {
+      struct sigaction dfl {};
+      dfl.sa_handler = SIG_DFL;
+      sigemptyset(&dfl.sa_mask);
+      ::sigaction(sig, &dfl, nullptr);
+    }
+  }
+  sigset_t none;
+  sigemptyset(&none);
+  ::sigprocmask(SIG_SETMASK, &none, nullptr);
+  ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+  if (::getppid() != dcm) KillOwnGroup(0);  // dcm died before the line above
+  const pid_t shell = ::fork();
+  if (shell < 0) _exit(127);
+  if (shell == 0) {
+    struct sigaction dfl {};
+    dfl.sa_handler = SIG_DFL;
+    sigemptyset(&dfl.sa_mask);
+    ::sigaction(SIGTERM, &dfl, nullptr);
+    ::sigaction(SIGPIPE, &dfl, nullptr);
+    if (::dup2(toChild[0], STDIN_FILENO) < 0 || ::dup2(fromChild[1], STDOUT_FILENO) < 0) _exit(127);
+    ::execve("/bin/sh", argv, environ);
+    _exit(127);
+  }
+  // The supervisor keeps only stderr: dcm must see the end of the child's
+  // stdout when the child closes it, and nothing else of dcm's stays open.
+  const int null = ::open("/dev/null", O_RDWR);
+  if (null >= 0) {
+    ::dup2(null, STDIN_FILENO);
+    ::dup2(null, STDOUT_FILENO);
+  }
+  ::close_range(3, ~0u, 0);
+  int status = 0;
+  while (::waitpid(shell, &status, 0) < 0) {
+    if (errno != EINTR) _exit(127);
+  }
+  if (WIFEXITED(status)) _exit(WEXITSTATUS(status));
+  if (WIFSIGNALED(status)) {
+    // Die of the same signal, so that dcm reports what happened to the shell.
+    const rlimit noCore{0, 0};
+    ::setrlimit(RLIMIT_CORE, &noCore);
+    struct sigaction dfl {};
+    dfl.sa_handler = SIG_DFL;
+    sigemptyset(&dfl.sa_mask);
+    ::sigaction(WTERMSIG(status), &dfl, nullptr);
+    ::raise(WTERMSIG(status));
+  }
+  _exit(127);
+}
+
 }  // namespace
+
+void KillAllChildren() {
+  for (auto& g : g_groups)
+    if (const pid_t group = g.load(); group > 0) ::kill(-group, SIGKILL);
+}
 
 Status ChildProcess::Spawn(const std::string& command, std::unique_ptr<ChildProcess>* out) {
   int toChild[2], fromChild[2];
@@ -67,35 +166,30 @@ Status ChildProcess::Spawn(const std::string& command, std::unique_ptr<ChildProc
     close(toChild[1]);
     return st;
   }
-  posix_spawn_file_actions_t actions;
-  posix_spawnattr_t attr;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawnattr_init(&attr);
-  posix_spawn_file_actions_adddup2(&actions, toChild[0], STDIN_FILENO);
-  posix_spawn_file_actions_adddup2(&actions, fromChild[1], STDOUT_FILENO);
-  // Own process group: the whole pipeline of the shell command can be killed.
-  // Default SIGPIPE disposition and an empty mask in the child.
-  sigset_t none, defaults;
-  sigemptyset(&none);
-  sigemptyset(&defaults);
-  sigaddset(&defaults, SIGPIPE);
-  posix_spawnattr_setsigmask(&attr, &none);
-  posix_spawnattr_setsigdefault(&attr, &defaults);
-  posix_spawnattr_setpgroup(&attr, 0);
-  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
+  // Everything the forked side needs is made before fork(): after it, a copy
+  // of a threaded process may only make async-signal-safe calls.
   std::string c = command;
   char sh[] = "/bin/sh", dashC[] = "-c";
   char* argv[] = {sh, dashC, c.data(), nullptr};
-  pid_t pid = -1;
-  const int rc = posix_spawn(&pid, "/bin/sh", &actions, &attr, argv, environ);
-  posix_spawn_file_actions_destroy(&actions);
-  posix_spawnattr_destroy(&attr);
+  const pid_t self = ::getpid();
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    // Own process group: the whole pipeline of the shell command can be killed,
+    // and a Ctrl-C on the terminal reaches dcm, which ends it.
+    ::setpgid(0, 0);
+    Supervise(self, toChild, fromChild, argv);
+  }
+  const int forkErrno = errno;
+  if (pid > 0) {
+    ::setpgid(pid, pid);  // also here: no kill(-pid) before the child has run setpgid
+    Track(pid);
+  }
   close(toChild[0]);
   close(fromChild[1]);
-  if (rc != 0) {
+  if (pid < 0) {
     close(toChild[1]);
     close(fromChild[0]);
-    return Status::Error(std::string("cannot start /bin/sh: ") + std::strerror(rc));
+    return Status::Error(std::string("cannot start /bin/sh: ") + std::strerror(forkErrno));
   }
   std::unique_ptr<ChildProcess> child(new ChildProcess());
   child->pid_ = pid;
@@ -207,6 +301,7 @@ bool ChildProcess::TryReap() {
     r = waitpid(pid_, &status, WNOHANG);
   } while (r < 0 && errno == EINTR);
   if (r == pid_ || (r < 0 && errno == ECHILD)) {
+    Untrack(pid_);
     reaped_ = true;
     waitStatus_ = r == pid_ ? status : 0;
     return true;
@@ -233,6 +328,7 @@ void ChildProcess::Kill() {
   do {
     r = waitpid(pid_, &status, 0);
   } while (r < 0 && errno == EINTR);
+  Untrack(pid_);
   reaped_ = true;
   waitStatus_ = r == pid_ ? status : 0;
 }

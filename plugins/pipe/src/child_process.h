@@ -14,8 +14,10 @@
 
 namespace dcm::pipe {
 
-/// The child: `/bin/sh -c COMMAND` in its own process group, stdin and stdout
-/// connected to us, stderr inherited.
+/// The child: a supervisor process leading its own process group, in which
+/// it runs `/bin/sh -c COMMAND` with stdin and stdout connected to us, stderr
+/// inherited, and whose exit status it passes on. When dcm dies, even by
+/// SIGKILL, the supervisor kills the group (see Supervise in the .cpp).
 class ChildProcess {
  public:
   using Clock = std::chrono::steady_clock;

@@ -30,6 +30,11 @@ struct PipeOptions {
 
 class ChildProcess;
 
+/// Kills the process group of every child still running (SIGKILL). Async-
+/// signal-safe: for a signal handler of the program (dcm's SIGINT, SIGTERM,
+/// SIGHUP cleanup), so that no child outlives it.
+void KillAllChildren();
+
 /// Starts the child, performs the handshake and serves its guides and samples
 /// to the engine. Every failure of the child (it crashes, exits early, sends
 /// garbage or wrong counts, or does not answer in time) becomes an error
