@@ -132,7 +132,8 @@ Status ReconstructionOptions::Validate() const {
   if (crossingFillReach < 0 || crossingFillReach > 256)
     return bad("crossingFillReach", "must be from 0 to 256, got " + std::to_string(crossingFillReach));
   if (downsample < 1 || downsample > 64) return bad("downsample", "must be from 1 to 64, got " + std::to_string(downsample));
-  if (threads < 0) return bad("threads", "must be >= 0");
+  // TBB crashes on absurd arenas; the CLI's --threads has the same bound.
+  if (threads < 0 || threads > 1024) return bad("threads", "must be from 0 (all cores) to 1024, got " + std::to_string(threads));
   if (tileSize < 1) return bad("tileSize", "must be >= 1");
   if (batchSize < 1) return bad("batchSize", "must be >= 1");
   return Status::Ok();

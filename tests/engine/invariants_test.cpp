@@ -164,6 +164,8 @@ TEST(Invariants, InvalidOptionsNameTheField) {
   ExpectRejected(p, [](ReconstructionOptions& o) { o.fallbackShadingChanges = -2; }, "fallbackShadingChanges",
                  "got -2");
   ExpectRejected(p, [](ReconstructionOptions& o) { o.crossingFillReach = -1; }, "crossingFillReach", "got -1");
+  // TBB crashed on an arena of 10^7 threads; the library refuses it as the CLI does.
+  ExpectRejected(p, [](ReconstructionOptions& o) { o.threads = 10000000; }, "threads", "got 10000000");
   // Checked at every supersampling, whichever threshold the run uses.
   ExpectRejected(p,
                  [](ReconstructionOptions& o) {

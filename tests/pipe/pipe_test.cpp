@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -171,6 +172,17 @@ dcm::Status Drive(const std::string& command, double timeout = 60) {
   std::vector<dcm::ExactSample> s(px.size());
   DCM_RETURN_IF_ERROR(p->Evaluate(px, {true, false}, s));
   return p->Finish();
+}
+
+TEST(PipeProvider, TimeoutsOutOfRangeAreRefusedBeforeTheChildStarts) {
+  // 1e10 s overflowed the nanosecond deadline and threw a good run away; a
+  // library user gets the same refusal as --provider-timeout.
+  for (double t : {1e10, -1.0, 0.0, std::numeric_limits<double>::quiet_NaN()}) {
+    std::unique_ptr<dcm::pipe::PipeProvider> p;
+    const dcm::Status st = Start(Analytic("--width 8 --height 8"), &p, t);
+    ASSERT_FALSE(st.ok()) << t;
+    EXPECT_NE(st.message().find("timeouts"), std::string::npos) << st.message();
+  }
 }
 
 TEST(PipeProvider, VarianceOfANoisyProvider) {

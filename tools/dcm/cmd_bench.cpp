@@ -563,8 +563,8 @@ std::string FindPlotScript(const BenchFlags& f) {
   std::vector<fs::path> candidates;
   if (!f.plotScript.empty()) return f.plotScript;
   if (const char* e = std::getenv("DCM_PLOT_SCRIPT")) candidates.emplace_back(e);
-  // The source tree this binary was built from.
-  candidates.push_back(fs::path(__FILE__).parent_path().parent_path() / "bench" / "plot_tradeoff.py");
+  // The source tree this binary was built from (absolute, unlike __FILE__ under ccache's base_dir).
+  candidates.push_back(fs::path(DCM_SOURCE_DIR) / "tools" / "bench" / "plot_tradeoff.py");
   candidates.push_back(fs::path("tools/bench/plot_tradeoff.py"));
   for (const auto& c : candidates) {
     std::error_code ec;

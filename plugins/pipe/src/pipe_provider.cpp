@@ -88,8 +88,10 @@ PipeProvider::~PipeProvider() {
 
 Status PipeProvider::Start(const PipeOptions& options, std::unique_ptr<PipeProvider>* out) {
   if (options.command.empty()) return Status::Error("provider command is empty");
-  if (!(options.timeoutSeconds > 0) || !(options.startupTimeoutSeconds > 0))
-    return Status::Error("provider timeouts must be > 0 seconds");
+  // Above 1e6 s the deadline (now + timeout in nanoseconds) could overflow.
+  const auto valid = [](double s) { return s > 0 && s <= 1e6; };
+  if (!valid(options.timeoutSeconds) || !valid(options.startupTimeoutSeconds))
+    return Status::Error("provider timeouts must be > 0 and at most 1e6 seconds");
   std::unique_ptr<ChildProcess> child;
   if (Status st = ChildProcess::Spawn(options.command, &child); !st.ok())
     return Status::Error("provider '" + options.command + "': " + st.message());
