@@ -20,6 +20,7 @@
 #include "commands.h"
 #include "common/stats_json.h"
 #include "common/tiles.h"
+#include "output_flags.h"
 #include "tile_flags.h"
 
 namespace dcm::cli {
@@ -31,6 +32,7 @@ struct MergeFlags {
   std::string stats;
   TileFlags frames;  ///< only --frames is used
   bool quiet = false;
+  toolkit::ExrFormat exr;  ///< -d, --compression, --ch
 };
 
 int Fail(const std::string& message, int code = kExitFailure) {
@@ -62,7 +64,7 @@ Status Expand(const std::string& pattern, std::vector<std::string>* out) {
 }
 
 int MergeOne(const std::vector<std::string>& patterns, const std::string& output, const std::string& statsPath,
-             bool quiet) {
+             bool quiet, const toolkit::ExrFormat& format) {
   std::vector<std::string> parts;
   for (const auto& p : patterns)
     if (Status st = Expand(p, &parts); !st.ok()) return Fail(st.message());
@@ -80,7 +82,7 @@ int MergeOne(const std::vector<std::string>& patterns, const std::string& output
   }
   if (!statsPath.empty() && !frame.stats.is_object())
     return Fail("--stats: a part carries no " + std::string(toolkit::kAttrPartStats) + " attribute");
-  if (Status st = toolkit::WriteMergedExr(output, frame, extra); !st.ok()) return Fail(st.message());
+  if (Status st = toolkit::WriteMergedExr(output, frame, extra, format); !st.ok()) return Fail(st.message());
   if (!statsPath.empty()) {
     nlohmann::json j = frame.stats;
     j["parts_files"] = parts;
@@ -99,13 +101,14 @@ int MergeOne(const std::vector<std::string>& patterns, const std::string& output
 int RunMerge(const MergeFlags& f) {
   std::vector<int> frames;
   if (Status st = FrameList(f.frames, &frames); !st.ok()) return Fail(st.message(), kExitUsage);
-  if (frames.empty()) return MergeOne(f.parts, f.output, f.stats, f.quiet);
+  if (Status st = toolkit::CheckExrFormat(f.exr); !st.ok()) return Fail(st.message(), kExitUsage);
+  if (frames.empty()) return MergeOne(f.parts, f.output, f.stats, f.quiet, f.exr);
   if (!HasFramePattern(f.output))
     return Fail("--frames " + f.frames.frames + ": the output name has no '#' frame pattern", kExitUsage);
   return RunFrames("merge", frames, [&](int frame) {
     std::vector<std::string> parts;
     for (const auto& p : f.parts) parts.push_back(ExpandFrame(p, frame));
-    return MergeOne(parts, ExpandFrame(f.output, frame), ExpandFrame(f.stats, frame), f.quiet);
+    return MergeOne(parts, ExpandFrame(f.output, frame), ExpandFrame(f.stats, frame), f.quiet, f.exr);
   });
 }
 
@@ -120,6 +123,7 @@ Registration reg("merge", "Assemble the parts of --tile/--region runs into the f
                    app->add_option("--frames", f->frames.frames,
                                    "N or A-B: replace '#' runs in the part and output names by the frame number");
                    app->add_flag("--quiet", f->quiet, "no summary on stderr");
+                   AddExrFormatFlags(app, &f->exr);
                    return [f] { return RunMerge(*f); };
                  });
 

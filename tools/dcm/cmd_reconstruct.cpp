@@ -24,6 +24,7 @@
 #include "common/sample_map.h"
 #include "common/stats_json.h"
 #include "common/tiles.h"
+#include "output_flags.h"
 #include "pipe_run.h"
 #include "tile_flags.h"
 
@@ -35,6 +36,9 @@ struct ReconstructFlags {
   EngineFlags engine;
   std::string output, stats, sampleMap, preview, errorMap, reference;
   bool alpha = false;
+  toolkit::ExrFormat exr;  ///< -d, --compression, --ch
+  toolkit::DisplayTransform display;  ///< --colorconfig, --display, --view, --look
+  std::string displayText;            ///< which transform the preview uses (RunReconstruct)
   TileFlags tiles;
   PipeFlags pipe;  ///< --provider-cmd: a renderer in a child process instead of EXR inputs
 };
@@ -51,6 +55,8 @@ toolkit::Metadata ProvenanceMetadata(const ReconstructFlags& f, const aov::AovPr
                                      const ReconstructionOptions& options) {
   toolkit::Metadata meta;
   meta.strings.push_back({"Software", std::string("dcm ") + DCM_VERSION});
+  meta.strings.push_back({"dcm:version", DCM_VERSION});
+  meta.strings.push_back({"dcm:command_line", toolkit::CommandLine()});
   meta.strings.push_back({"dcm:method", f.engine.method});
   meta.strings.push_back({"dcm:mode", provider.dense() ? "dense" : "sparse"});
   meta.strings.push_back({"dcm:settings", toolkit::OptionsToJson(options).dump()});
@@ -68,6 +74,9 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
   if (!f.reference.empty() || !f.errorMap.empty())
     return aov_common::Fail(cmd, "--reference and --error-map need the whole frame; not with --tile or --region "
                                  "(compare the merged frame)", kExitUsage);
+  if (!f.exr.dataType.empty() || !f.exr.channels.empty() || f.exr.compression != toolkit::ExrFormat{}.compression)
+    return aov_common::Fail(cmd, "-d, --compression and --ch shape the whole frame; give them to `dcm merge`",
+                            kExitUsage);
   Bounds2i region;
   std::string tile;
   Point2i frame;
@@ -127,6 +136,7 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
   nlohmann::json stats = ExrStatsJson(cmd, f.aov, f.engine, provider, r, options, wall);
   stats["part"] = PartJson(tile, info);
   if (haveRef) stats["reference"] = ErrorJson(error);
+  if (!f.preview.empty()) stats["preview_transform"] = f.displayText;
 
   toolkit::Metadata meta = ProvenanceMetadata(f, provider, options);
   AddPartMetadata(tile, region, settings, r, info, &meta);
@@ -137,7 +147,7 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
   if (rc) return rc;
   if (!f.sampleMap.empty() && (rc = write(f.sampleMap, toolkit::WriteSampleMap(f.sampleMap, r)))) return rc;
   if (!f.preview.empty() &&
-      (rc = write(f.preview, toolkit::WritePreview(f.preview, r.width, r.height, r.image))))
+      (rc = write(f.preview, toolkit::WritePreview(f.preview, r.width, r.height, r.image, f.display))))
     return rc;
   if (!f.stats.empty() && (rc = write(f.stats, toolkit::WriteJson(f.stats, stats)))) return rc;
   if (!f.engine.quiet) {
@@ -171,6 +181,7 @@ int RunReconstruct(const ReconstructFlags& f) {
     p.sampleMap = f.sampleMap;
     p.engine = f.engine;
     p.tiles = f.tiles;
+    p.exr = f.exr;
     p.tiles.frames.clear();  // RunReconstructFrames ran the frames
     return RunPipe(cmd, p);
 #else
@@ -179,8 +190,14 @@ int RunReconstruct(const ReconstructFlags& f) {
   }
   if (f.aov.inputs.empty())
     return aov_common::Fail(cmd, "no input files (EXR AOVs), and no --provider-cmd", kExitUsage);
+  Status st = toolkit::CheckExrFormat(f.exr);
+  if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
+  ReconstructFlags g = f;  // with the preview's transform resolved
+  if (st = toolkit::CheckDisplayTransform(f.display, &g.displayText); !st.ok())
+    return aov_common::Fail(cmd, st.message(), kExitUsage);
+  if (f.engine.verbose && !f.preview.empty()) std::cerr << "dcm " << cmd << ": preview: " << g.displayText << "\n";
   ReconstructionOptions options;
-  Status st = ToOptions(f.engine, &options);
+  st = ToOptions(f.engine, &options);
   if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
   const bool sparse = !f.aov.samples.empty();
   aov::AovOptions aovOptions;
@@ -192,7 +209,17 @@ int RunReconstruct(const ReconstructFlags& f) {
   std::unique_ptr<aov::AovProvider> provider;
   st = aov_common::OpenProvider(cmd, f.aov, aovOptions, f.engine, options, &provider);
   if (!st.ok()) return aov_common::Fail(cmd, st.message());
-  if (IsPartial(f.tiles)) return RunReconstructPart(f, options, *provider);
+  if (IsPartial(f.tiles)) return RunReconstructPart(g, options, *provider);
+  // The output's channels are known from the headers: --ch is checked
+  // before the engine runs.
+  OutputLayout layout;
+  st = PlanOutputLayout(*provider, f.aov.inputs, f.alpha, options.downsample, &layout);
+  if (!st.ok()) return aov_common::Fail(cmd, st.message());
+  std::vector<size_t> order;
+  if (st = toolkit::SelectChannels(layout.Names(), f.exr.channels, &order); !st.ok())
+    return aov_common::Fail(cmd, st.message(), kExitUsage);
+  if (f.engine.verbose)
+    for (const auto& note : layout.notes) std::cerr << "dcm " << cmd << ": " << note << "\n";
   ExrReconstruction run;
   bool usage = false;
   st = ReconstructWholeExr(cmd, *provider, f.aov, f.engine, options, f.reference, &run, &usage);
@@ -208,15 +235,18 @@ int RunReconstruct(const ReconstructFlags& f) {
   // Every output is atomic; if a later one fails, the earlier ones go too.
   aov_common::Outputs outputs(cmd);
   auto write = [&outputs](const std::string& path, Status s) { return outputs.Write(path, std::move(s)); };
-  int rc = write(f.output, toolkit::WriteRgbExr(f.output, run.display, run.data, r.image, meta, f.alpha));
+  toolkit::OutputImage image;
+  st = BuildOutputImage(layout, f.aov.inputs, run, options.downsample, meta, &image);
+  int rc = write(f.output, st.ok() ? toolkit::WriteOutputExr(f.output, image, f.exr) : st);
   if (rc) return rc;
   if (!f.sampleMap.empty() && (rc = write(f.sampleMap, toolkit::WriteSampleMap(f.sampleMap, r)))) return rc;
   if (!f.preview.empty() &&
-      (rc = write(f.preview, toolkit::WritePreview(f.preview, r.width, r.height, r.image))))
+      (rc = write(f.preview, toolkit::WritePreview(f.preview, r.width, r.height, r.image, f.display))))
     return rc;
   if (!f.errorMap.empty() &&
       (rc = write(f.errorMap, toolkit::WriteErrorMap(f.errorMap, r.image, run.reference, r.width, r.height))))
     return rc;
+  if (!f.preview.empty()) run.stats["preview_transform"] = g.displayText;
   if (!f.stats.empty() && (rc = write(f.stats, toolkit::WriteJson(f.stats, run.stats)))) return rc;
 
   if (!f.engine.quiet) {
@@ -251,13 +281,15 @@ Registration reg("reconstruct", "Reconstruct an image from a renderer's EXR AOVs
                  [](CLI::App* app) -> std::function<int()> {
                    auto f = std::make_shared<ReconstructFlags>();
                    aov_common::AddAovFlags(app, &f->aov, false);
-                   app->add_option("-o,--output", f->output, "output EXR (float RGB)")->required();
+                   app->add_option("-o,--output", f->output, "output EXR (the inputs' layout)")->required();
                    app->add_option("--stats", f->stats, "statistics as JSON");
                    app->add_option("--sample-map", f->sampleMap, "PNG: which pixels were exact and why");
                    app->add_option("--preview", f->preview, "PNG through OpenColorIO ($OCIO or sRGB)");
                    app->add_option("--error-map", f->errorMap, "PNG heat map of the error (dense or --reference)");
                    app->add_option("--reference", f->reference, "compare with this EXR instead of the full input");
-                   app->add_flag("--alpha", f->alpha, "write RGBA with A = 1");
+                   app->add_flag("--alpha", f->alpha, "write alpha even if the inputs have none (A = 1)");
+                   AddExrFormatFlags(app, &f->exr);
+                   AddDisplayFlags(app, &f->display);
                    AddEngineFlags(app, &f->engine);
                    AddTileFlags(app, &f->tiles);
                    app->add_option("--provider-cmd", f->pipe.command,

@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "commands.h"
+#include "common/output_exr.h"
 
 namespace dcm::cli {
 std::vector<CommandEntry>& CommandRegistry() {
@@ -14,6 +15,7 @@ std::vector<CommandEntry>& CommandRegistry() {
 
 int main(int argc, char** argv) {
   using namespace dcm::cli;
+  dcm::toolkit::SetCommandLine(argc, argv);  // the provenance of every output
   CLI::App app{"dcm: image reconstruction with Directional Coherence Maps (Guo 1998, Scheel et al. 2001)"};
   const std::string version = std::string("dcm ") + DCM_VERSION;
   app.set_version_flag("--version", version);
