@@ -20,7 +20,8 @@ namespace dcm::toolkit {
 struct ExrFormat {
   /// -d: "" keeps each channel's type (the beauty float, a copied pass its
   /// input's), "half" or "float" stores every channel so except the raw ones
-  /// (integer IDs, Cryptomatte hashes), which a conversion would destroy.
+  /// (object and shader IDs, Cryptomatte hashes), which a conversion would
+  /// destroy.
   std::string dataType;
   std::string compression = "zip";    ///< --compression: an OpenEXR compression (kExrCompressions)
   std::vector<std::string> channels;  ///< --ch: the channels written (OpenEXR sorts them by name); empty: all

@@ -187,8 +187,9 @@ Status PlanOutputLayout(const aov::AovProvider& provider, const std::vector<std:
       }
     }
   }
+  const auto& ids = provider.IdChannels();
   for (auto& s : all) {
-    s.raw = s.type == OIIO::TypeDesc::UINT;
+    s.raw = s.type == OIIO::TypeDesc::UINT || std::find(ids.begin(), ids.end(), s.name) != ids.end();
     for (const auto& layer : cryptoLayers)
       if (s.name.size() > layer.size() && s.name.compare(0, layer.size(), layer) == 0 &&
           std::isdigit(static_cast<unsigned char>(s.name[layer.size()])))

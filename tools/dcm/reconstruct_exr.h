@@ -69,7 +69,7 @@ struct OutputLayout {
     int file = 0, subimage = 0, index = 0;
     std::string name;
     OIIO::TypeDesc type;  ///< stored as FLOAT, HALF or UINT
-    bool raw = false;     ///< an integer ID or a Cryptomatte hash: -d leaves it alone
+    bool raw = false;     ///< an ID (AovProvider::IdChannels, UINT) or a Cryptomatte hash: -d leaves it alone
   };
   enum class Kind { kBeauty, kAlpha, kPass };
   /// One output channel: a beauty component (`index` 0..2), the alpha, or

@@ -466,6 +466,7 @@ struct AovProvider::Data {
   int64_t haveCount = 0;
   std::vector<std::string> notes, warnings, sampleChannels;
   std::vector<std::string> beautyChannels;  ///< AovProvider::BeautyChannels
+  std::vector<std::string> idChannels;      ///< AovProvider::IdChannels
 };
 
 namespace {
@@ -800,6 +801,8 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
   }
   const auto& idExpr = roles[size_t(Role::kObjectId)];
   const auto& shaderExpr = roles[size_t(Role::kShaderId)];
+  for (const auto* e : {&idExpr, &shaderExpr})
+    if (*e && (*e)->crypto.empty()) d->idChannels.push_back((*e)->terms[0][0]);
   if (idExpr) {
     DCM_RETURN_IF_ERROR(LoadId(guides, *idExpr, &d->objectId));
     d->notes.push_back(IdNote(guides, "object ID", *idExpr));
@@ -1103,6 +1106,7 @@ int64_t AovProvider::SampleCount() const {
 }
 const std::vector<RGB>& AovProvider::Beauty() const { return d_->L; }
 const std::vector<std::string>& AovProvider::BeautyChannels() const { return d_->beautyChannels; }
+const std::vector<std::string>& AovProvider::IdChannels() const { return d_->idChannels; }
 const std::vector<std::string>& AovProvider::Notes() const { return d_->notes; }
 const std::vector<std::string>& AovProvider::Warnings() const { return d_->warnings; }
 std::vector<std::string> AovProvider::SampleChannels() const { return d_->sampleChannels; }

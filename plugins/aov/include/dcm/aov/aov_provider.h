@@ -162,6 +162,9 @@ class AovProvider final : public SampleProvider {
   /// generic): the names the output EXR keeps. Empty when L is an expression
   /// (--map L=a+b) or the inputs do not carry it (sparse mode).
   const std::vector<std::string>& BeautyChannels() const;
+  /// The input channels read as object or shader IDs (not Cryptomatte
+  /// layers): integers, which a conversion to half would change above 2048.
+  const std::vector<std::string>& IdChannels() const;
   /// What was found and how it is used (role -> channels, tests switched off);
   /// printed by -v.
   const std::vector<std::string>& Notes() const;
