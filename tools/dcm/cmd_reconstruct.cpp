@@ -2,7 +2,9 @@
 //
 //   dcm reconstruct IN.exr [IN2.exr ...] [--preset blender|generic] [--map ROLE=CH]
 //       -o OUT.exr [--stats S.json] [--sample-map M.png] [--preview P.png]
-//       [--error-map E.png] [--reference REF.exr] [--samples S.exr ...] + engine flags
+//       [--error-map E.png] [--reference REF.exr] [--samples S.exr ...]
+//       [-d half|float] [--compression C] [--ch NAME,...] [--colorconfig F] [--display D] [--view V]
+//       [--look L] + engine flags
 //
 // Dense input (the expensive channels for every pixel): reconstructs from the
 // pixels the engine asks for and reports the error against the full input.

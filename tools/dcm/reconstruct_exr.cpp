@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
-#include <map>
 #include <cmath>
+#include <map>
 
 #include "common/image_io.h"
 #include "common/stats_json.h"
@@ -117,9 +117,6 @@ Status ReconstructWholeExr(const std::string& cmd, aov::AovProvider& provider, c
   return Status::Ok();
 }
 
-}  // namespace dcm::cli
-
-namespace dcm::cli {
 namespace {
 
 /// The channel name of the alpha beside the beauty's red `r`: "A" for "R",
@@ -202,10 +199,8 @@ Status PlanOutputLayout(const aov::AovProvider& provider, const std::vector<std:
     return std::any_of(all.begin(), all.end(), [&](const auto& s) { return s.name == b; });
   });
   using Kind = OutputLayout::Kind;
-  auto addAlpha = [&] { out->channels.push_back({Kind::kAlpha, 0, alphaName}); };
-  if (!inPlace) {
+  if (!inPlace)
     for (int c = 0; c < 3; ++c) out->channels.push_back({Kind::kBeauty, c, beauty[size_t(c)]});
-  }
   for (const auto& s : all) {
     if (isBeauty(s.name)) {
       if (inPlace)
@@ -213,8 +208,7 @@ Status PlanOutputLayout(const aov::AovProvider& provider, const std::vector<std:
             {Kind::kBeauty, int(std::find(beauty.begin(), beauty.end(), s.name) - beauty.begin()), s.name});
     } else if (!alphaName.empty() && s.name == alphaName) {
       out->alpha = s;
-      if (!inPlace) continue;  // placed after the beauty below
-      addAlpha();
+      if (inPlace) out->channels.push_back({Kind::kAlpha, 0, alphaName});  // else after the beauty, below
     } else if (copyPasses) {
       out->channels.push_back({Kind::kPass, int(out->passes.size()), s.name});
       out->passes.push_back(s);
