@@ -188,5 +188,29 @@ TEST(OutputLayout, GenericAlpha) {
   EXPECT_LT(ReadExr(dir / "none.exr").spec.channelindex("A"), 0);
 }
 
+TEST(OutputLayout, PartsTakeTheFormatFromMerge) {
+  ScratchDir dir;
+  Scene sc{32, 16};
+  WriteExr(dir / "in.exr", sc.width, sc.height, sc.GenericChannels(false));
+  auto r = RunDcm({"reconstruct", dir / "in.exr", "--tile", "0/2", "-o", dir / "t0.exr", "-d", "half"}, dir);
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_THAT(r.err, HasSubstr("give them to `dcm merge`"));
+  for (const auto& [tile, name] : {std::pair{"0/2", "t0.exr"}, std::pair{"1/2", "t1.exr"}}) {
+    r = RunDcm({"reconstruct", dir / "in.exr", "--tile", tile, "-o", dir / name, "--quiet"}, dir);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+  }
+  r = RunDcm({"merge", dir / "t0.exr", dir / "t1.exr", "-o", dir / "m.exr", "--compression", "lzw"}, dir);
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_THAT(r.err, HasSubstr("--compression lzw"));
+  r = RunDcm({"merge", dir / "t0.exr", dir / "t1.exr", "-o", dir / "m.exr", "-d", "half", "--compression", "piz",
+              "--quiet"},
+             dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const Exr m = ReadExr(dir / "m.exr");
+  EXPECT_THAT(m.names(), UnorderedElementsAre("R", "G", "B"));
+  EXPECT_EQ(m.spec.format, OIIO::TypeDesc::HALF);
+  EXPECT_EQ(m.spec.get_string_attribute("compression"), "piz");
+}
+
 }  // namespace
 }  // namespace dcm::aov::test
