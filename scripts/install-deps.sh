@@ -11,6 +11,8 @@ packages=(
   libopenimageio-dev openimageio-tools libopenexr-dev libimath-dev
   libopencolorio-dev libembree-dev libtbb-dev
   libcli11-dev nlohmann-json3-dev libassimp-dev
+  # the text of the sample map's legend and the error map's colour bar (DejaVu Sans)
+  fonts-dejavu-core
   # the Python module (python/, for /usr/bin/python3)
   pybind11-dev python3-pybind11
   # tests and benchmarks

@@ -9,6 +9,7 @@
 #include <system_error>
 
 #include "dcm/memory_budget.h"
+#include "output_exr.h"
 
 namespace dcm::toolkit {
 namespace {
@@ -73,23 +74,7 @@ Status WriteRgbExr(const std::string& path, int width, int height, std::span<con
 Status WriteRgbExr(const std::string& path, const Bounds2i& display, const Bounds2i& data,
                    std::span<const RGB> pixels, const Metadata& metadata, bool alpha) {
   DCM_RETURN_IF_ERROR(CheckSize(path, data.width(), data.height(), pixels.size()));
-  if (display.empty()) return Status::Error("cannot write '" + path + "': empty display window");
-  const int nch = alpha ? 4 : 3;
-  ImageSpec spec = WindowedSpec(display, data, nch);
-  spec.channelnames = alpha ? std::vector<std::string>{"R", "G", "B", "A"}
-                            : std::vector<std::string>{"R", "G", "B"};
-  spec.alpha_channel = alpha ? 3 : -1;
-  spec.attribute("compression", "zip");
-  for (const auto& [name, value] : metadata.strings) spec.attribute(name, value);
-  for (const auto& [name, value] : metadata.floats) spec.attribute(name, value);
-  std::vector<float> buffer(pixels.size() * size_t(nch));
-  for (size_t i = 0; i < pixels.size(); ++i) {
-    buffer[i * nch + 0] = pixels[i].r;
-    buffer[i * nch + 1] = pixels[i].g;
-    buffer[i * nch + 2] = pixels[i].b;
-    if (alpha) buffer[i * nch + 3] = 1.f;
-  }
-  return WriteImage(path, spec, buffer.data(), TypeDesc::FLOAT);
+  return WriteRgbExr(path, display, data, pixels, metadata, alpha, ExrFormat{});
 }
 
 Status WriteRgb8(const std::string& path, int width, int height, std::span<const uint8_t> rgb) {

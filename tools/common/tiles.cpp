@@ -325,22 +325,24 @@ Status MergeParts(const std::vector<std::string>& paths, MergedFrame* frame) {
   return Status::Ok();
 }
 
-Status WriteMergedExr(const std::string& path, const MergedFrame& frame, const Metadata& extra) {
-  const int nch = int(frame.channels.size());
-  if (frame.width <= 0 || frame.height <= 0 || nch <= 0 ||
-      frame.pixels.size() != size_t(frame.width) * size_t(frame.height) * size_t(nch))
+Status WriteMergedExr(const std::string& path, const MergedFrame& frame, const Metadata& extra,
+                      const ExrFormat& format) {
+  const size_t nch = frame.channels.size();
+  const size_t n = size_t(std::max(frame.width, 0)) * size_t(std::max(frame.height, 0));
+  if (n == 0 || nch == 0 || frame.pixels.size() != n * nch)
     return Status::Error("cannot write '" + path + "': inconsistent merged frame");
-  ImageSpec spec(frame.width, frame.height, nch, TypeDesc::FLOAT);
-  spec.channelnames = frame.channels;
-  spec.alpha_channel = -1;
-  for (int c = 0; c < nch; ++c)
-    if (frame.channels[size_t(c)] == "A") spec.alpha_channel = c;
-  spec.attribute("compression", "zip");
-  for (const Metadata* m : {&frame.metadata, &extra}) {
-    for (const auto& [name, value] : m->strings) spec.attribute(name, value);
-    for (const auto& [name, value] : m->floats) spec.attribute(name, value);
+  OutputImage image;
+  image.display = image.data = {{0, 0}, {frame.width, frame.height}};
+  for (size_t c = 0; c < nch; ++c) {
+    OutputChannel ch;
+    ch.name = frame.channels[c];
+    ch.values.resize(n);
+    for (size_t i = 0; i < n; ++i) ch.values[i] = frame.pixels[i * nch + c];
+    image.channels.push_back(std::move(ch));
   }
-  return WriteImage(path, spec, frame.pixels.data(), TypeDesc::FLOAT);
+  AddMetadata(frame.metadata, &image.attributes);
+  AddMetadata(extra, &image.attributes);
+  return WriteOutputExr(path, image, format);
 }
 
 }  // namespace dcm::toolkit

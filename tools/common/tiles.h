@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/image_io.h"
+#include "common/output_exr.h"
 #include "dcm/color.h"
 #include "dcm/geometry.h"
 #include "dcm/options.h"
@@ -87,7 +88,9 @@ struct MergedFrame {
 /// or the tile count, when two parts overlap, or when pixels are not covered.
 Status MergeParts(const std::vector<std::string>& paths, MergedFrame* frame);
 
-/// Writes a merged frame as an EXR (display window = data window), atomically.
-Status WriteMergedExr(const std::string& path, const MergedFrame& frame, const Metadata& extra);
+/// Writes a merged frame as an EXR (display window = data window), atomically,
+/// stored as `format` says.
+Status WriteMergedExr(const std::string& path, const MergedFrame& frame, const Metadata& extra,
+                      const ExrFormat& format = {});
 
 }  // namespace dcm::toolkit

@@ -22,6 +22,7 @@
 #include "common/stats_json.h"
 #include "common/tiles.h"
 #include "flag_checks.h"
+#include "output_flags.h"
 #include "tile_flags.h"
 
 namespace dcm::cli {
@@ -33,6 +34,7 @@ struct MergeFlags {
   std::string stats;
   TileFlags frames;  ///< only --frames is used
   bool quiet = false;
+  toolkit::ExrFormat exr;  ///< -d, --compression, --ch
 };
 
 int Fail(const std::string& message, int code = kExitFailure) {
@@ -64,7 +66,7 @@ Status Expand(const std::string& pattern, std::vector<std::string>* out) {
 }
 
 int MergeOne(const std::vector<std::string>& patterns, const std::string& output, const std::string& statsPath,
-             bool quiet) {
+             bool quiet, const toolkit::ExrFormat& format) {
   std::vector<std::string> parts;
   for (const auto& p : patterns)
     if (Status st = Expand(p, &parts); !st.ok()) return Fail(st.message());
@@ -87,7 +89,7 @@ int MergeOne(const std::vector<std::string>& patterns, const std::string& output
   }
   if (!statsPath.empty() && !frame.stats.is_object())
     return Fail("--stats: a part carries no " + std::string(toolkit::kAttrPartStats) + " attribute");
-  if (Status st = toolkit::WriteMergedExr(output, frame, extra); !st.ok()) return Fail(st.message());
+  if (Status st = toolkit::WriteMergedExr(output, frame, extra, format); !st.ok()) return Fail(st.message());
   if (!statsPath.empty()) {
     nlohmann::json j = frame.stats;
     j["parts_files"] = parts;
@@ -104,13 +106,14 @@ int MergeOne(const std::vector<std::string>& patterns, const std::string& output
 int RunMerge(const MergeFlags& f) {
   std::vector<int> frames;
   if (Status st = FrameList(f.frames, &frames); !st.ok()) return Fail(st.message(), kExitUsage);
-  if (frames.empty()) return MergeOne(f.parts, f.output, f.stats, f.quiet);
+  if (Status st = toolkit::CheckExrFormat(f.exr); !st.ok()) return Fail(st.message(), kExitUsage);
+  if (frames.empty()) return MergeOne(f.parts, f.output, f.stats, f.quiet, f.exr);
   if (!HasFramePattern(f.output))
     return Fail("--frames " + f.frames.frames + ": the output name has no '#' frame pattern", kExitUsage);
   return RunFrames("merge", frames, [&](int frame) {
     std::vector<std::string> parts;
     for (const auto& p : f.parts) parts.push_back(ExpandFrame(p, frame));
-    return MergeOne(parts, ExpandFrame(f.output, frame), ExpandFrame(f.stats, frame), f.quiet);
+    return MergeOne(parts, ExpandFrame(f.output, frame), ExpandFrame(f.stats, frame), f.quiet, f.exr);
   });
 }
 
@@ -123,6 +126,7 @@ Registration reg("merge", "Assemble the parts of --tile/--region runs into the f
                        ->required();
                    app->add_option("-o,--output", f->output, "the frame (EXR)")->required();
                    app->add_option("--stats", f->stats, "write the counts summed over the parts (JSON)");
+                   AddExrFormatFlags(app, &f->exr);
                    app->option_defaults()->group(kGroupGeneral);
                    AddFramesFlag(app, &f->frames.frames,
                                  "N or A-B: replace '#' runs in the part and output names by the frame number");

@@ -26,6 +26,7 @@
 #include "dcm/window_provider.h"
 #include "engine_flags.h"
 #include "flag_checks.h"
+#include "output_flags.h"
 #include "pipe_run.h"
 
 namespace dcm::cli {
@@ -52,6 +53,10 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
   if (!f.tiles.frames.empty())
     return Fail("--frames is not for a provider command (run one dcm pipe per frame)", kExitUsage);
   const bool partial = IsPartial(f.tiles);
+  if (Status st = toolkit::CheckExrFormat(f.exr); !st.ok()) return Fail(st.message(), kExitUsage);
+  if (partial && !(f.exr.dataType.empty() && f.exr.channels.empty() &&
+                   f.exr.compression == toolkit::ExrFormat{}.compression))
+    return Fail("-d, --compression and --ch shape the whole frame; give them to `dcm merge`", kExitUsage);
   if (partial && !f.engine.progressive.empty())
     return Fail("--progressive needs the whole frame; not with --tile or --region", kExitUsage);
 
@@ -125,7 +130,9 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
     AddPartMetadata(tile, region, settings, rec, info, &meta);
     if (Status w = toolkit::WritePartExr(f.output, frame.x, frame.y, region, rec.image, meta); !w.ok())
       return Fail(w.message());
-  } else if (Status w = toolkit::WriteRgbExr(f.output, rec.width, rec.height, rec.image, meta); !w.ok()) {
+  } else if (Status w = toolkit::WriteRgbExr(f.output, Bounds2i{{0, 0}, {rec.width, rec.height}},
+                                             Bounds2i{{0, 0}, {rec.width, rec.height}}, rec.image, meta, false, f.exr);
+             !w.ok()) {
     return Fail(w.message());
   }
   if (!f.sampleMap.empty()) {
@@ -171,6 +178,7 @@ Registration reg("pipe", "Reconstruct with an external renderer as a child proce
                    app->add_option("--sample-map", f->sampleMap, "write the sample map (PNG): which pixels were exact, why");
                    app->option_defaults()->group(kGroupGeneral);
                    AddProviderTimeoutFlags(app, f.get());
+                   AddExrFormatFlags(app, &f->exr);
                    AddEngineFlags(app, &f->engine);
                    AddTileFlags(app, &f->tiles);
                    return [f] { return RunPipe("pipe", *f); };

@@ -2,7 +2,9 @@
 //
 //   dcm reconstruct IN.exr [IN2.exr ...] [--preset blender|generic] [--map ROLE=CH]
 //       -o OUT.exr [--stats S.json] [--sample-map M.png] [--preview P.png]
-//       [--error-map E.png] [--reference REF.exr] [--samples S.exr ...] + engine flags
+//       [--error-map E.png] [--reference REF.exr] [--samples S.exr ...]
+//       [-d half|float] [--compression C] [--ch NAME,...] [--colorconfig F] [--display D] [--view V]
+//       [--look L] + engine flags
 //
 // Dense input (the expensive channels for every pixel): reconstructs from the
 // pixels the engine asks for and reports the error against the full input.
@@ -25,6 +27,7 @@
 #include "common/stats_json.h"
 #include "common/tiles.h"
 #include "flag_checks.h"
+#include "output_flags.h"
 #include "pipe_run.h"
 #include "tile_flags.h"
 
@@ -36,6 +39,9 @@ struct ReconstructFlags {
   EngineFlags engine;
   std::string output, stats, sampleMap, preview, errorMap, reference;
   bool alpha = false;
+  toolkit::ExrFormat exr;  ///< -d, --compression, --ch
+  toolkit::DisplayTransform display;  ///< --colorconfig, --display, --view, --look
+  std::string displayText;            ///< which transform the preview uses (RunReconstruct)
   TileFlags tiles;
   PipeFlags pipe;  ///< --provider-cmd: a renderer in a child process instead of EXR inputs
 };
@@ -52,6 +58,8 @@ toolkit::Metadata ProvenanceMetadata(const ReconstructFlags& f, const aov::AovPr
                                      const ReconstructionOptions& options) {
   toolkit::Metadata meta;
   meta.strings.push_back({"Software", std::string("dcm ") + DCM_VERSION});
+  meta.strings.push_back({"dcm:version", DCM_VERSION});
+  meta.strings.push_back({"dcm:command_line", toolkit::CommandLine()});
   meta.strings.push_back({"dcm:method", f.engine.method});
   meta.strings.push_back({"dcm:mode", provider.dense() ? "dense" : "sparse"});
   meta.strings.push_back({"dcm:settings", toolkit::OptionsToJson(options).dump()});
@@ -69,6 +77,9 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
   if (!f.reference.empty() || !f.errorMap.empty())
     return aov_common::Fail(cmd, "--reference and --error-map need the whole frame; not with --tile or --region "
                                  "(compare the merged frame)", kExitUsage);
+  if (!f.exr.dataType.empty() || !f.exr.channels.empty() || f.exr.compression != toolkit::ExrFormat{}.compression)
+    return aov_common::Fail(cmd, "-d, --compression and --ch shape the whole frame; give them to `dcm merge`",
+                            kExitUsage);
   Bounds2i region;
   std::string tile;
   Point2i frame;
@@ -129,6 +140,7 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
   nlohmann::json stats = ExrStatsJson(cmd, f.aov, f.engine, provider, r, options, wall);
   stats["part"] = PartJson(tile, info);
   if (haveRef) stats["reference"] = ErrorJson(error);
+  if (!f.preview.empty()) stats["preview_transform"] = f.displayText;
 
   toolkit::Metadata meta = ProvenanceMetadata(f, provider, options);
   AddPartMetadata(tile, region, settings, r, info, &meta);
@@ -136,7 +148,8 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
   int rc = outputs.Write(toolkit::WritePartExr(f.output, frame.x, frame.y, region, r.image, meta, f.alpha));
   if (rc) return rc;
   if (!f.sampleMap.empty() && (rc = outputs.Write(toolkit::WriteSampleMap(f.sampleMap, r)))) return rc;
-  if (!f.preview.empty() && (rc = outputs.Write(toolkit::WritePreview(f.preview, r.width, r.height, r.image))))
+  if (!f.preview.empty() &&
+      (rc = outputs.Write(toolkit::WritePreview(f.preview, r.width, r.height, r.image, f.display))))
     return rc;
   if (!f.stats.empty() && (rc = outputs.Write(toolkit::WriteJson(f.stats, stats)))) return rc;
   if ((rc = outputs.Commit())) return rc;
@@ -171,6 +184,7 @@ int RunReconstruct(const ReconstructFlags& f) {
     p.sampleMap = f.sampleMap;
     p.engine = f.engine;
     p.tiles = f.tiles;
+    p.exr = f.exr;
     p.tiles.frames.clear();  // RunReconstructFrames ran the frames
     return RunPipe(cmd, p);
 #else
@@ -189,8 +203,14 @@ int RunReconstruct(const ReconstructFlags& f) {
                                        {"--error-map", f.errorMap},
                                        toolkit::ProgressiveArg(f.engine.progressive)}))
     return rc;
+  Status st = toolkit::CheckExrFormat(f.exr);
+  if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
+  ReconstructFlags g = f;  // with the preview's transform resolved
+  if (st = toolkit::CheckDisplayTransform(f.display, &g.displayText); !st.ok())
+    return aov_common::Fail(cmd, st.message(), kExitUsage);
+  if (f.engine.verbose && !f.preview.empty()) std::cerr << "dcm " << cmd << ": preview: " << g.displayText << "\n";
   ReconstructionOptions options;
-  Status st = ToOptions(f.engine, &options);
+  st = ToOptions(f.engine, &options);
   if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
   const bool sparse = !f.aov.samples.empty();
   aov::AovOptions aovOptions;
@@ -204,7 +224,17 @@ int RunReconstruct(const ReconstructFlags& f) {
   if (!st.ok()) return aov_common::Fail(cmd, st.message());
   st = CheckDownsample(provider->width(), provider->height(), options.downsample, "the inputs' data window");
   if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
-  if (IsPartial(f.tiles)) return RunReconstructPart(f, options, *provider);
+  if (IsPartial(f.tiles)) return RunReconstructPart(g, options, *provider);
+  // The output's channels are known from the headers: --ch is checked
+  // before the engine runs.
+  OutputLayout layout;
+  st = PlanOutputLayout(*provider, f.aov.inputs, f.alpha, options.downsample, &layout);
+  if (!st.ok()) return aov_common::Fail(cmd, st.message());
+  std::vector<size_t> order;
+  if (st = toolkit::SelectChannels(layout.Names(), f.exr.channels, &order); !st.ok())
+    return aov_common::Fail(cmd, st.message(), kExitUsage);
+  if (f.engine.verbose)
+    for (const auto& note : layout.notes) std::cerr << "dcm " << cmd << ": " << note << "\n";
   aov_common::Outputs outputs(cmd);  // before the run: --progressive writes during it
   ExrReconstruction run;
   bool usage = false;
@@ -219,14 +249,18 @@ int RunReconstruct(const ReconstructFlags& f) {
   if (haveRef && std::isfinite(error.psnr)) meta.floats.push_back({"dcm:psnr", float(error.psnr)});
 
   // All outputs appear together at Commit(), or none.
-  int rc = outputs.Write(toolkit::WriteRgbExr(f.output, run.display, run.data, r.image, meta, f.alpha));
+  toolkit::OutputImage image;
+  st = BuildOutputImage(layout, f.aov.inputs, run, options.downsample, meta, &image);
+  int rc = outputs.Write(st.ok() ? toolkit::WriteOutputExr(f.output, image, f.exr) : st);
   if (rc) return rc;
   if (!f.sampleMap.empty() && (rc = outputs.Write(toolkit::WriteSampleMap(f.sampleMap, r)))) return rc;
-  if (!f.preview.empty() && (rc = outputs.Write(toolkit::WritePreview(f.preview, r.width, r.height, r.image))))
+  if (!f.preview.empty() &&
+      (rc = outputs.Write(toolkit::WritePreview(f.preview, r.width, r.height, r.image, f.display))))
     return rc;
   if (!f.errorMap.empty() &&
       (rc = outputs.Write(toolkit::WriteErrorMap(f.errorMap, r.image, run.reference, r.width, r.height))))
     return rc;
+  if (!f.preview.empty()) run.stats["preview_transform"] = g.displayText;
   if (!f.stats.empty() && (rc = outputs.Write(toolkit::WriteJson(f.stats, run.stats)))) return rc;
   if ((rc = outputs.Commit())) return rc;
 
@@ -261,13 +295,15 @@ Registration reg("reconstruct", "Reconstruct an image from a renderer's EXR AOVs
                    auto f = std::make_shared<ReconstructFlags>();
                    aov_common::AddAovFlags(app, &f->aov, false);
                    app->option_defaults()->group(kGroupIo);
-                   app->add_option("-o,--output", f->output, "output EXR (float RGB)")->required();
+                   app->add_option("-o,--output", f->output, "output EXR (the inputs' layout)")->required();
                    app->add_option("--stats", f->stats, "statistics as JSON");
                    app->add_option("--sample-map", f->sampleMap, "PNG: which pixels were exact and why");
                    app->add_option("--preview", f->preview, "PNG through OpenColorIO ($OCIO or sRGB)");
                    app->add_option("--error-map", f->errorMap, "PNG heat map of the error (dense or --reference)");
                    app->add_option("--reference", f->reference, "compare with this EXR instead of the full input");
-                   app->add_flag("--alpha", f->alpha, "write RGBA with A = 1");
+                   app->add_flag("--alpha", f->alpha, "write alpha even if the inputs have none (A = 1)");
+                   AddExrFormatFlags(app, &f->exr);
+                   AddDisplayFlags(app, &f->display);
                    app->add_option("--provider-cmd", f->pipe.command,
                                    "instead of input files: a renderer started as a child process that speaks the "
                                    "dcm-pipe protocol (plugins/pipe/PROTOCOL.md; as dcm pipe)");

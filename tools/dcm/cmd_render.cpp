@@ -25,6 +25,7 @@
 #include "embree/scene_file.h"
 #include "engine_flags.h"
 #include "flag_checks.h"
+#include "output_flags.h"
 #include "tile_flags.h"
 
 namespace dcm::cli {
@@ -46,6 +47,8 @@ struct RenderFlags {
   std::string referenceOut;
   EngineFlags engine;
   TileFlags tiles;
+  toolkit::ExrFormat exr;  ///< -d, --compression, --ch
+  toolkit::DisplayTransform display;  ///< --colorconfig, --display, --view, --look
 };
 
 /// --size WIDTHxHEIGHT, each from 1 to 16384.
@@ -157,7 +160,7 @@ int RunRenderPart(const RenderFlags& f, const embree::Scene& scene, Reconstructi
     if (Status st = toolkit::WriteSampleMap(f.sampleMap, rec); !st.ok()) return Fail(st);
   }
   if (!f.preview.empty()) {
-    if (Status st = toolkit::WritePreview(f.preview, rec.width, rec.height, rec.image); !st.ok()) return Fail(st);
+    if (Status st = toolkit::WritePreview(f.preview, rec.width, rec.height, rec.image, f.display); !st.ok()) return Fail(st);
   }
   if (!f.stats.empty()) {
     nlohmann::json j = toolkit::RunToJson(rec, method, options, wallS);
@@ -215,6 +218,21 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
     std::cerr << "dcm render: " << st.message() << "\n";
     return kExitUsage;
   }
+  if (Status st = toolkit::CheckExrFormat(f.exr); !st.ok()) {
+    std::cerr << "dcm render: " << st.message() << "\n";
+    return kExitUsage;
+  }
+  if (IsPartial(f.tiles) && !(f.exr.dataType.empty() && f.exr.channels.empty() &&
+                              f.exr.compression == toolkit::ExrFormat{}.compression)) {
+    std::cerr << "dcm render: -d, --compression and --ch shape the whole frame; give them to `dcm merge`\n";
+    return kExitUsage;
+  }
+  std::string displayText;
+  if (Status st = toolkit::CheckDisplayTransform(f.display, &displayText); !st.ok()) {
+    std::cerr << "dcm render: " << st.message() << "\n";
+    return kExitUsage;
+  }
+  if (f.engine.verbose && !f.preview.empty()) std::cerr << "preview: " << displayText << "\n";
   if (app->count("--downsample") && f.engine.downsample != scene.render.supersampling) {
     std::cerr << "dcm render: --downsample is the scene's render.supersampling ("
               << scene.render.supersampling << "); use --supersampling to change it\n";
@@ -277,12 +295,15 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
   meta.floats.push_back({"dcm:exact_fraction", float(stats.exactFraction())});
   meta.floats.push_back({"dcm:time_illum_s", float(stats.timeProviderS)});
   meta.floats.push_back({"dcm:time_dcm_s", float(stats.timeEngineS)});
-  if (Status st = toolkit::WriteRgbExr(f.output, rec.width, rec.height, rec.image, meta); !st.ok()) return Fail(st);
+  const Bounds2i whole{{0, 0}, {rec.width, rec.height}};
+  if (Status st = toolkit::WriteRgbExr(f.output, whole, whole, rec.image, meta, false, f.exr); !st.ok())
+    return Fail(st);
   if (full && !f.referenceOut.empty()) {
     toolkit::Metadata fm = meta;
     fm.strings[1].second = "full";
     fm.floats = {{"dcm:exact_fraction", 1.f}, {"dcm:time_illum_s", float(full->rec.stats.timeProviderS)}};
-    if (Status st = toolkit::WriteRgbExr(f.referenceOut, full->rec.width, full->rec.height, full->rec.image, fm);
+    const Bounds2i fullFrame{{0, 0}, {full->rec.width, full->rec.height}};
+    if (Status st = toolkit::WriteRgbExr(f.referenceOut, fullFrame, fullFrame, full->rec.image, fm, false, f.exr);
         !st.ok()) {
       return Fail(st);
     }
@@ -291,7 +312,7 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
     if (Status st = toolkit::WriteSampleMap(f.sampleMap, rec); !st.ok()) return Fail(st);
   }
   if (!f.preview.empty()) {
-    if (Status st = toolkit::WritePreview(f.preview, rec.width, rec.height, rec.image); !st.ok()) return Fail(st);
+    if (Status st = toolkit::WritePreview(f.preview, rec.width, rec.height, rec.image, f.display); !st.ok()) return Fail(st);
   }
 
   std::optional<toolkit::ImageError> error;
@@ -304,6 +325,7 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
     j["effects"] = effects;
     j["rays"] = RaysToJson(run.rays);
     if (error) j["reference"] = ErrorToJson(*error);
+    if (!f.preview.empty()) j["preview_transform"] = displayText;
     if (full) {
       j["full"] = {{"time_illum_s", full->rec.stats.timeProviderS},
                    {"time_wall_s", full->wallS},
@@ -388,6 +410,9 @@ Registration reg("render", "Ray trace a scene file (Embree) with DCM: a few perc
                                    "from 2 on, samples carry their variance)")
                        ->transform(Integer(1, 1 << 20))
                        ->group(kGroupNoise);
+                   app->option_defaults()->group(kGroupIo);
+                   AddExrFormatFlags(app, &f->exr);
+                   AddDisplayFlags(app, &f->display);
                    app->option_defaults()->group(kGroupGeneral);
                    AddEngineFlags(app, &f->engine);
                    AddTileFlags(app, &f->tiles);

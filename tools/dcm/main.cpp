@@ -8,6 +8,7 @@
 #include "commands.h"
 #include "flag_checks.h"
 #include "common/output_transaction.h"
+#include "common/output_exr.h"
 
 namespace dcm::cli {
 std::vector<CommandEntry>& CommandRegistry() {
@@ -20,6 +21,7 @@ int main(int argc, char** argv) {
   using namespace dcm::cli;
   // Interrupted at any moment, a run leaves no temporary file and no child.
   dcm::toolkit::InstallSignalCleanup();
+  dcm::toolkit::SetCommandLine(argc, argv);  // the provenance of every output
   CLI::App app{"dcm: image reconstruction with Directional Coherence Maps (Guo 1998, Scheel et al. 2001)"};
   const std::string version = std::string("dcm ") + DCM_VERSION;
   app.set_version_flag("--version", version);

@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "common/output_exr.h"
 #include "engine_flags.h"
 #include "tile_flags.h"
 
@@ -22,6 +23,7 @@ struct PipeFlags {
   double startupTimeout = 600.0;  ///< --provider-startup-timeout, for the handshake
   EngineFlags engine;
   TileFlags tiles;  ///< --tile / --region: a part of the frame for `dcm merge` (no --frames)
+  toolkit::ExrFormat exr;  ///< -d, --compression, --ch (the whole frame)
 };
 
 /// Adds --provider-timeout and --provider-startup-timeout.

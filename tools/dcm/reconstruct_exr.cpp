@@ -1,7 +1,10 @@
 #include "reconstruct_exr.h"
 
+#include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
+#include <map>
 
 #include "common/image_io.h"
 #include "common/stats_json.h"
@@ -111,6 +114,212 @@ Status ReconstructWholeExr(const std::string& cmd, aov::AovProvider& provider, c
                                 {"texture", caps.texture},    {"split_radiance", caps.splitRadiance},
                                 {"variance", caps.variance},  {"hard_shadows_guided", caps.hardShadowsGuided}};
   if (out->haveReference) out->stats["reference"] = ErrorJson(out->error);
+  return Status::Ok();
+}
+
+namespace {
+
+/// The channel name of the alpha beside the beauty's red `r`: "A" for "R",
+/// "<layer>.Combined.A" for "<layer>.Combined.R"; empty when `r` is named
+/// otherwise.
+std::string AlphaBeside(const std::string& r) {
+  if (r == "R") return "A";
+  if (r.size() > 2 && r.compare(r.size() - 2, 2, ".R") == 0) return r.substr(0, r.size() - 1) + "A";
+  return "";
+}
+
+/// The stored type an input channel keeps in the output.
+OIIO::TypeDesc KeptType(OIIO::TypeDesc t) {
+  if (t == OIIO::TypeDesc::UINT) return OIIO::TypeDesc::UINT;
+  return t == OIIO::TypeDesc::HALF ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT;
+}
+
+}  // namespace
+
+std::vector<std::string> OutputLayout::Names() const {
+  std::vector<std::string> names;
+  for (const auto& c : channels) names.push_back(c.name);
+  return names;
+}
+
+Status PlanOutputLayout(const aov::AovProvider& provider, const std::vector<std::string>& inputs, bool alpha,
+                        int downsample, OutputLayout* out) {
+  *out = OutputLayout{};
+  std::vector<std::string> beauty = provider.BeautyChannels();
+  if (beauty.size() != 3) {
+    beauty = {"R", "G", "B"};
+    out->notes.push_back("output: the beauty is no single channel of the inputs; written as R, G, B");
+  }
+  const std::string alphaName = AlphaBeside(beauty[0]);
+  const bool copyPasses = provider.dense() && downsample <= 1;
+  if (!provider.dense())
+    out->notes.push_back("output: sparse mode: the inputs' other passes are those of the guide render; not written");
+  else if (!copyPasses)
+    out->notes.push_back("output: --downsample " + std::to_string(downsample) +
+                         ": the inputs' other passes are at the input resolution; not written");
+
+  // Every input channel, first file first (as the provider reads them).
+  std::vector<OutputLayout::Source> all;
+  std::vector<std::string> cryptoLayers;
+  const Bounds2i window = provider.DataWindow();
+  out->inputSize = {window.width(), window.height()};
+  for (size_t f = 0; f < inputs.size(); ++f) {
+    auto in = OIIO::ImageInput::open(inputs[f]);
+    if (!in) return Status::Error("cannot read '" + inputs[f] + "': " + OIIO::geterror());
+    for (int sub = 0; in->seek_subimage(sub, 0); ++sub) {
+      const OIIO::ImageSpec& spec = in->spec();
+      const Bounds2i data{{spec.x, spec.y}, {spec.x + spec.width, spec.y + spec.height}};
+      if (!(data == window)) continue;  // a part of another window is not this image's
+      for (const auto& attr : spec.extra_attribs) {
+        const std::string name = attr.name().string();
+        if (toolkit::IsStructuralAttribute(name) || out->attributes.contains(name)) continue;
+        out->attributes.push_back(attr);
+        if (name.rfind("cryptomatte/", 0) == 0 && name.size() > 5 && name.compare(name.size() - 5, 5, "/name") == 0)
+          cryptoLayers.push_back(attr.get_string());
+      }
+      for (int c = 0; c < spec.nchannels; ++c) {
+        const std::string& name = spec.channelnames[size_t(c)];
+        if (std::any_of(all.begin(), all.end(), [&](const auto& s) { return s.name == name; })) continue;
+        all.push_back({int(f), sub, c, name, KeptType(spec.channelformat(c)), false});
+      }
+    }
+  }
+  const auto& ids = provider.IdChannels();
+  for (auto& s : all) {
+    s.raw = s.type == OIIO::TypeDesc::UINT || std::find(ids.begin(), ids.end(), s.name) != ids.end();
+    for (const auto& layer : cryptoLayers)
+      if (s.name.size() > layer.size() && s.name.compare(0, layer.size(), layer) == 0 &&
+          std::isdigit(static_cast<unsigned char>(s.name[layer.size()])))
+        s.raw = true;
+  }
+
+  // The input's order where it holds the beauty, else the beauty first.
+  auto isBeauty = [&](const std::string& name) { return std::find(beauty.begin(), beauty.end(), name) != beauty.end(); };
+  const bool inPlace = std::all_of(beauty.begin(), beauty.end(), [&](const std::string& b) {
+    return std::any_of(all.begin(), all.end(), [&](const auto& s) { return s.name == b; });
+  });
+  using Kind = OutputLayout::Kind;
+  if (!inPlace)
+    for (int c = 0; c < 3; ++c) out->channels.push_back({Kind::kBeauty, c, beauty[size_t(c)]});
+  for (const auto& s : all) {
+    if (isBeauty(s.name)) {
+      if (inPlace)
+        out->channels.push_back(
+            {Kind::kBeauty, int(std::find(beauty.begin(), beauty.end(), s.name) - beauty.begin()), s.name});
+    } else if (!alphaName.empty() && s.name == alphaName) {
+      out->alpha = s;
+      if (inPlace) out->channels.push_back({Kind::kAlpha, 0, alphaName});  // else after the beauty, below
+    } else if (copyPasses) {
+      out->channels.push_back({Kind::kPass, int(out->passes.size()), s.name});
+      out->passes.push_back(s);
+    }
+  }
+  const bool haveAlpha = out->alpha.has_value() || (alpha && !alphaName.empty());
+  if (haveAlpha && (!inPlace || !out->alpha)) {
+    // After the beauty's last component.
+    size_t at = 0;
+    for (size_t i = 0; i < out->channels.size(); ++i)
+      if (out->channels[i].kind == Kind::kBeauty) at = i + 1;
+    out->channels.insert(out->channels.begin() + std::ptrdiff_t(at), {Kind::kAlpha, 0, alphaName});
+  }
+  if (alpha && alphaName.empty())
+    out->notes.push_back("output: --alpha: the beauty's channels (" + beauty[0] + ", ...) have no alpha beside them");
+  out->notes.push_back("output: channels " + std::to_string(out->channels.size()) + " (" +
+                       (out->alpha ? "alpha " + alphaName + " from the inputs"
+                                   : haveAlpha ? "alpha " + alphaName + " = 1" : "no alpha") +
+                       ", " + std::to_string(out->passes.size()) + " passes copied), " +
+                       std::to_string(out->attributes.size()) + " metadata attributes of the inputs");
+  return Status::Ok();
+}
+
+Status BuildOutputImage(const OutputLayout& layout, const std::vector<std::string>& inputs,
+                        const ExrReconstruction& run, int downsample, const toolkit::Metadata& provenance,
+                        toolkit::OutputImage* out) {
+  const Reconstruction& r = run.result;
+  // The inputs' data window: the alpha's resolution.
+  const int inWidth = layout.inputSize.x, inHeight = layout.inputSize.y;
+  out->display = run.display;
+  out->data = run.data;
+  out->attributes = layout.attributes;
+  toolkit::AddMetadata(provenance, &out->attributes);
+  const size_t n = r.image.size();
+  if (n != size_t(run.data.area()))
+    return Status::Error("the output has " + std::to_string(n) + " pixels, its data window " +
+                         std::to_string(run.data.area()));
+
+  // The input channels the layout reads. EXR compresses all channels of a
+  // block of scanlines together: each part is decoded once, as float, and
+  // only UINT channels (IDs above 2^24 would not survive float) apart.
+  struct Part {
+    int nchannels = 0;
+    size_t pixels = 0;
+    std::vector<float> values;  // interleaved
+  };
+  std::map<std::pair<int, int>, Part> parts;
+  auto read = [&](const OutputLayout::Source& s, toolkit::OutputChannel* ch) -> Status {
+    const std::string& path = inputs[size_t(s.file)];
+    auto fail = [&](const std::string& why) {
+      return Status::Error("cannot read channel '" + s.name + "' of '" + path + "': " + why);
+    };
+    if (s.type == OIIO::TypeDesc::UINT) {
+      auto in = OIIO::ImageInput::open(path);
+      if (!in) return fail(OIIO::geterror());
+      const OIIO::ImageSpec spec = in->spec(s.subimage, 0);
+      ch->ids.resize(size_t(spec.width) * size_t(spec.height));
+      if (!in->read_image(s.subimage, 0, s.index, s.index + 1, OIIO::TypeDesc::UINT, ch->ids.data()))
+        return fail(in->geterror());
+      return Status::Ok();
+    }
+    auto [it, fresh] = parts.try_emplace({s.file, s.subimage});
+    Part& part = it->second;
+    if (fresh) {
+      auto in = OIIO::ImageInput::open(path);
+      if (!in) return fail(OIIO::geterror());
+      const OIIO::ImageSpec spec = in->spec(s.subimage, 0);
+      part.nchannels = spec.nchannels;
+      part.pixels = size_t(spec.width) * size_t(spec.height);
+      part.values.resize(part.pixels * size_t(part.nchannels));
+      if (!in->read_image(s.subimage, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, part.values.data()))
+        return fail(in->geterror());
+    }
+    ch->values.resize(part.pixels);
+    for (size_t i = 0; i < part.pixels; ++i) ch->values[i] = part.values[i * size_t(part.nchannels) + size_t(s.index)];
+    return Status::Ok();
+  };
+  for (const auto& c : layout.channels) {
+    toolkit::OutputChannel ch;
+    ch.name = c.name;
+    switch (c.kind) {
+      case OutputLayout::Kind::kBeauty:
+        ch.values.resize(n);
+        for (size_t i = 0; i < n; ++i) ch.values[i] = r.image[i][c.index];
+        break;
+      case OutputLayout::Kind::kAlpha:
+        if (!layout.alpha) {
+          ch.values.assign(n, 1.f);
+          break;
+        }
+        DCM_RETURN_IF_ERROR(read(*layout.alpha, &ch));
+        if (downsample > 1) {
+          // The coverage of the output pixel: the mean of its input pixels'.
+          std::vector<RGB> plane(ch.values.size());
+          for (size_t i = 0; i < plane.size(); ++i) plane[i] = RGB(ch.values[i], 0.f, 0.f);
+          int w = 0, h = 0;
+          const auto small = BoxDownsample(plane, inWidth, inHeight, downsample, &w, &h);
+          ch.values.resize(small.size());
+          for (size_t i = 0; i < small.size(); ++i) ch.values[i] = small[i].r;
+        }
+        break;
+      case OutputLayout::Kind::kPass: {
+        const auto& s = layout.passes[size_t(c.index)];
+        ch.type = s.type;
+        ch.raw = s.raw;
+        DCM_RETURN_IF_ERROR(read(s, &ch));
+        break;
+      }
+    }
+    out->channels.push_back(std::move(ch));
+  }
   return Status::Ok();
 }
 

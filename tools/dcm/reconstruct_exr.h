@@ -7,11 +7,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "aov_common.h"
 #include "common/metrics.h"
+#include "common/output_exr.h"
 #include "dcm/aov/aov_provider.h"
 #include "dcm/reconstructor.h"
 #include "engine_flags.h"
@@ -57,5 +59,49 @@ struct ExrReconstruction {
 Status ReconstructWholeExr(const std::string& cmd, aov::AovProvider& provider, const aov_common::AovFlags& aov,
                            const EngineFlags& engine, const ReconstructionOptions& options,
                            const std::string& referencePath, ExrReconstruction* out, bool* usage);
+
+/// The output EXR's layout, planned from the inputs' headers before the
+/// engine runs: the input's own names for the beauty, its alpha, its other
+/// passes and its metadata.
+struct OutputLayout {
+  /// An input channel carried to the output.
+  struct Source {
+    int file = 0, subimage = 0, index = 0;
+    std::string name;
+    OIIO::TypeDesc type;  ///< stored as FLOAT, HALF or UINT
+    bool raw = false;     ///< an ID (AovProvider::IdChannels, UINT) or a Cryptomatte hash: -d leaves it alone
+  };
+  enum class Kind { kBeauty, kAlpha, kPass };
+  /// One output channel: a beauty component (`index` 0..2), the alpha, or
+  /// the pass passes[index].
+  struct Channel {
+    Kind kind;
+    int index = 0;
+    std::string name;
+  };
+  std::vector<Channel> channels;  ///< in the output's order (the input's)
+  std::optional<Source> alpha;    ///< the input's alpha; none: A = 1 (--alpha) or no alpha
+  std::vector<Source> passes;     ///< copied: dense mode at --downsample 1
+  OIIO::ParamValueList attributes;  ///< the inputs' metadata (IsStructuralAttribute excluded)
+  std::vector<std::string> notes;   ///< what the output keeps and what not, for -v
+  Point2i inputSize;                ///< the inputs' data window's size
+  /// The output channel names.
+  std::vector<std::string> Names() const;
+};
+
+/// Plans the output of `provider` (opened from `inputs`): the beauty under
+/// its input names (provider.BeautyChannels(), else R, G, B), the input's
+/// alpha (the channel beside the beauty's R named A), or A = 1 when `alpha`
+/// and the input has none; in dense mode at `downsample` 1 every other
+/// channel of the inputs. A file that cannot be read is an error naming it.
+Status PlanOutputLayout(const aov::AovProvider& provider, const std::vector<std::string>& inputs, bool alpha,
+                        int downsample, OutputLayout* out);
+
+/// The output image of `run` laid out as `layout` says: the beauty
+/// reconstructed, the alpha and passes read from `inputs` (the alpha
+/// box-filtered by `downsample`), the inputs' metadata plus `provenance`.
+Status BuildOutputImage(const OutputLayout& layout, const std::vector<std::string>& inputs,
+                        const ExrReconstruction& run, int downsample, const toolkit::Metadata& provenance,
+                        toolkit::OutputImage* out);
 
 }  // namespace dcm::cli

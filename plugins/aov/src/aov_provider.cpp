@@ -465,6 +465,8 @@ struct AovProvider::Data {
   std::vector<uint8_t> have;  ///< sparse mode: 1 where a sample was read
   int64_t haveCount = 0;
   std::vector<std::string> notes, warnings, sampleChannels;
+  std::vector<std::string> beautyChannels;  ///< AovProvider::BeautyChannels
+  std::vector<std::string> idChannels;      ///< AovProvider::IdChannels
 };
 
 namespace {
@@ -783,8 +785,24 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
     }
     guides.Want(wanted);
   }
+  {
+    // The beauty's own channel names, for the output's layout: those of the
+    // sample roles as they would be read from the inputs.
+    RoleExprs lroles;
+    if (PresetExprs(options.preset, options.viewLayer, guides, /*samples=*/true, &lroles, nullptr).ok() &&
+        ApplyMappings(options.mappings, guides, /*samples=*/true, &lroles).ok()) {
+      for (int c = 0; c < 3; ++c) {
+        const auto& e = lroles[size_t(Comp(kL, c))];
+        if (e && e->crypto.empty() && e->terms.size() == 1 && e->terms[0].size() == 1)
+          d->beautyChannels.push_back(e->terms[0][0]);
+      }
+      if (d->beautyChannels.size() != 3) d->beautyChannels.clear();
+    }
+  }
   const auto& idExpr = roles[size_t(Role::kObjectId)];
   const auto& shaderExpr = roles[size_t(Role::kShaderId)];
+  for (const auto* e : {&idExpr, &shaderExpr})
+    if (*e && (*e)->crypto.empty()) d->idChannels.push_back((*e)->terms[0][0]);
   if (idExpr) {
     DCM_RETURN_IF_ERROR(LoadId(guides, *idExpr, &d->objectId));
     d->notes.push_back(IdNote(guides, "object ID", *idExpr));
@@ -1087,6 +1105,8 @@ int64_t AovProvider::SampleCount() const {
   return d_->have.empty() ? int64_t(d_->width()) * d_->height() : d_->haveCount;
 }
 const std::vector<RGB>& AovProvider::Beauty() const { return d_->L; }
+const std::vector<std::string>& AovProvider::BeautyChannels() const { return d_->beautyChannels; }
+const std::vector<std::string>& AovProvider::IdChannels() const { return d_->idChannels; }
 const std::vector<std::string>& AovProvider::Notes() const { return d_->notes; }
 const std::vector<std::string>& AovProvider::Warnings() const { return d_->warnings; }
 std::vector<std::string> AovProvider::SampleChannels() const { return d_->sampleChannels; }

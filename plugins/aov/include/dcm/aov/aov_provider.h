@@ -157,6 +157,14 @@ class AovProvider final : public SampleProvider {
   int64_t SampleCount() const;
   /// Beauty L of every pixel (row-major); pixels without a sample are 0.
   const std::vector<RGB>& Beauty() const;
+  /// The input channels of the beauty L.R, L.G, L.B when each is one channel
+  /// of the inputs ("ViewLayer.Combined.R" with the Blender preset, "R"
+  /// generic): the names the output EXR keeps. Empty when L is an expression
+  /// (--map L=a+b) or the inputs do not carry it (sparse mode).
+  const std::vector<std::string>& BeautyChannels() const;
+  /// The input channels read as object or shader IDs (not Cryptomatte
+  /// layers): integers, which a conversion to half would change above 2048.
+  const std::vector<std::string>& IdChannels() const;
   /// What was found and how it is used (role -> channels, tests switched off);
   /// printed by -v.
   const std::vector<std::string>& Notes() const;

@@ -1,0 +1,216 @@
+// The output EXR of `dcm reconstruct` keeps the input's layout: the beauty
+// under its own names, the alpha, the other passes, the metadata; stored as
+// -d, --compression and --ch say.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <OpenImageIO/imageio.h>
+
+#include <filesystem>
+
+#include "test_util.h"
+
+namespace dcm::aov::test {
+namespace {
+
+using ::testing::UnorderedElementsAre;
+using ::testing::HasSubstr;
+
+/// A Blender multilayer EXR of Scene: the passes the preset reads, the
+/// Combined's alpha, a half pass and an integer pass it does not read, and
+/// Blender-like metadata.
+void WriteBlenderInput(const std::string& path, const Scene& sc) {
+  const int w = sc.width, h = sc.height;
+  std::vector<TestChannel> ch;
+  ch.push_back(Fill("ViewLayer.IndexOB.X", w, h, [&](int x, int y) { return float(sc.ObjectId(x, y)); }));
+  const char* comp[3] = {"R", "G", "B"};
+  for (int c = 0; c < 3; ++c) {
+    ch.push_back(Fill(std::string("ViewLayer.DiffCol.") + comp[c], w, h, [&](int x, int y) { return sc.Tau(x, y)[c]; }));
+    ch.push_back(Fill(std::string("ViewLayer.DiffDir.") + comp[c], w, h, [&](int x, int y) { return sc.Li(x, y)[c]; }));
+    ch.push_back(Fill(std::string("ViewLayer.DiffInd.") + comp[c], w, h, [](int, int) { return 0.f; }));
+    ch.push_back(Fill(std::string("ViewLayer.Combined.") + comp[c], w, h, [&](int x, int y) { return sc.L(x, y)[c]; }));
+  }
+  // Coverage that varies (an antialiased silhouette's would).
+  ch.push_back(Fill("ViewLayer.Combined.A", w, h, [](int x, int y) { return float((x * 7 + y * 3) % 11) / 10.f; }));
+  TestChannel depth = Fill("ViewLayer.Depth.Z", w, h, [](int x, int y) { return 1.f + 0.25f * float(x + y); });
+  depth.half = true;
+  ch.push_back(depth);
+  TestChannel ids{"ViewLayer.Custom.id", {}, {}, false};
+  for (int i = 0; i < w * h; ++i) ids.ids.push_back(uint32_t(i) * 2654435761u);  // beyond float's 2^24
+  ch.push_back(ids);
+  WriteExr(path, w, h, ch,
+           {{"Camera", "Camera.001"}, {"cycles.ViewLayer.samples", "128"}, {"studio:shot", "sh010"}});
+}
+
+struct Exr {
+  OIIO::ImageSpec spec;
+  std::vector<std::vector<float>> planes;  ///< per channel, as float
+  std::vector<std::vector<uint32_t>> ids;  ///< per channel, UINT channels only
+  std::vector<std::string> names() const { return spec.channelnames; }
+  const std::vector<float>& Plane(const std::string& name) const {
+    const int i = spec.channelindex(name);
+    EXPECT_GE(i, 0) << name;
+    return planes.at(size_t(std::max(i, 0)));
+  }
+};
+
+Exr ReadExr(const std::string& path) {
+  Exr e;
+  auto in = OIIO::ImageInput::open(path);
+  EXPECT_TRUE(in) << path;
+  if (!in) return e;
+  e.spec = in->spec();
+  const size_t n = size_t(e.spec.width) * size_t(e.spec.height);
+  for (int c = 0; c < e.spec.nchannels; ++c) {
+    e.planes.emplace_back(n);
+    e.ids.emplace_back();
+    EXPECT_TRUE(in->read_image(0, 0, c, c + 1, OIIO::TypeDesc::FLOAT, e.planes.back().data()));
+    if (e.spec.channelformat(c) == OIIO::TypeDesc::UINT) {
+      e.ids.back().resize(n);
+      EXPECT_TRUE(in->read_image(0, 0, c, c + 1, OIIO::TypeDesc::UINT, e.ids.back().data()));
+    }
+  }
+  return e;
+}
+
+TEST(OutputLayout, BlenderInputKeepsItsLayoutPassesAndMetadata) {
+  ScratchDir dir;
+  Scene sc{32, 16};
+  WriteBlenderInput(dir / "in.exr", sc);
+  auto r = RunDcm({"reconstruct", dir / "in.exr", "--preset", "blender", "-o", dir / "out.exr", "-v"}, dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("alpha ViewLayer.Combined.A from the inputs"));
+  const Exr in = ReadExr(dir / "in.exr"), out = ReadExr(dir / "out.exr");
+  // Every input channel, in the input's order, with its stored type.
+  ASSERT_EQ(out.names(), in.names());
+  for (int c = 0; c < in.spec.nchannels; ++c)
+    EXPECT_EQ(out.spec.channelformat(c), in.spec.channelformat(c) == OIIO::TypeDesc::UINT ? OIIO::TypeDesc::UINT
+                                         : in.spec.channelformat(c) == OIIO::TypeDesc::HALF ? OIIO::TypeDesc::HALF
+                                                                                            : OIIO::TypeDesc::FLOAT)
+        << in.spec.channelnames[size_t(c)];
+  EXPECT_EQ(out.spec.alpha_channel, out.spec.channelindex("ViewLayer.Combined.A"));
+  // The passes and the alpha are the input's, bit for bit (dense mode: every
+  // pixel of them is known; docs/OUTPUT.md).
+  for (const auto& name : in.names()) {
+    if (name.rfind("ViewLayer.Combined.", 0) == 0 && name != "ViewLayer.Combined.A") continue;
+    EXPECT_EQ(out.Plane(name), in.Plane(name)) << name;
+  }
+  const int id = in.spec.channelindex("ViewLayer.Custom.id");
+  EXPECT_EQ(out.ids.at(size_t(id)), in.ids.at(size_t(id)));
+  // The beauty is the reconstruction: close to the input, not a copy of it
+  // everywhere (the engine evaluated a few percent of the pixels).
+  const auto& outR = out.Plane("ViewLayer.Combined.R");
+  const auto& inR = in.Plane("ViewLayer.Combined.R");
+  size_t differ = 0;
+  for (size_t i = 0; i < outR.size(); ++i) differ += outR[i] != inR[i];
+  EXPECT_GT(differ, 0u);
+  // The metadata: the renderer's, and dcm's provenance.
+  EXPECT_EQ(out.spec.get_string_attribute("Camera"), "Camera.001");
+  EXPECT_EQ(out.spec.get_string_attribute("cycles.ViewLayer.samples"), "128");
+  EXPECT_EQ(out.spec.get_string_attribute("studio:shot"), "sh010");
+  EXPECT_EQ(out.spec.get_string_attribute("dcm:version"), DCM_VERSION);
+  EXPECT_THAT(out.spec.get_string_attribute("dcm:command_line"), HasSubstr("reconstruct"));
+  EXPECT_THAT(out.spec.get_string_attribute("dcm:command_line"), HasSubstr("--preset blender"));
+  EXPECT_THAT(out.spec.get_string_attribute("dcm:settings"), HasSubstr("\"downsample\":1"));
+  EXPECT_EQ(out.spec.get_string_attribute("compression"), "zip");
+}
+
+TEST(OutputLayout, TypeCompressionAndChannels) {
+  ScratchDir dir;
+  Scene sc{32, 16};
+  WriteBlenderInput(dir / "in.exr", sc);
+  auto r = RunDcm({"reconstruct", dir / "in.exr", "--preset", "blender", "-o", dir / "half.exr", "-d", "half",
+                   "--compression", "piz"},
+                  dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const Exr half = ReadExr(dir / "half.exr");
+  EXPECT_EQ(half.spec.get_string_attribute("compression"), "piz");
+  // IDs keep their type: the UINT pass, and the float object IDs the
+  // preset reads (a half holds integers up to 2048 only).
+  for (int c = 0; c < half.spec.nchannels; ++c) {
+    const std::string& name = half.spec.channelnames[size_t(c)];
+    EXPECT_EQ(half.spec.channelformat(c), name == "ViewLayer.Custom.id"    ? OIIO::TypeDesc::UINT
+                                          : name == "ViewLayer.IndexOB.X" ? OIIO::TypeDesc::FLOAT
+                                                                           : OIIO::TypeDesc::HALF)
+        << name;
+  }
+
+  r = RunDcm({"reconstruct", dir / "in.exr", "--preset", "blender", "-o", dir / "ch.exr", "--ch",
+              "ViewLayer.Combined.A,ViewLayer.Combined.R,ViewLayer.Depth.Z"},
+             dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const Exr ch = ReadExr(dir / "ch.exr");
+  // OpenEXR stores channels sorted by name: --ch chooses them, not their order.
+  EXPECT_THAT(ch.names(),
+              UnorderedElementsAre("ViewLayer.Combined.A", "ViewLayer.Combined.R", "ViewLayer.Depth.Z"));
+}
+
+TEST(OutputLayout, BadFormatValuesAreUsageErrors) {
+  ScratchDir dir;
+  Scene sc{32, 16};
+  WriteBlenderInput(dir / "in.exr", sc);
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"-d", "double"}, "-d double"},
+      {{"--compression", "zip9"}, "--compression zip9"},
+      {{"--ch", "ViewLayer.Combined.R,Nope"}, "--ch Nope"},
+  };
+  for (const auto& [flags, message] : cases) {
+    std::vector<std::string> args = {"reconstruct", dir / "in.exr", "--preset", "blender", "-o", dir / "out.exr"};
+    args.insert(args.end(), flags.begin(), flags.end());
+    auto r = RunDcm(args, dir);
+    EXPECT_EQ(r.exitCode, 2) << message << ": " << r.err;
+    EXPECT_THAT(r.err, HasSubstr(message));
+    EXPECT_FALSE(std::filesystem::exists(dir / "out.exr")) << message;
+  }
+}
+
+TEST(OutputLayout, GenericAlpha) {
+  ScratchDir dir;
+  Scene sc{32, 16};
+  auto ch = sc.GenericChannels(false);
+  WriteExr(dir / "rgb.exr", sc.width, sc.height, ch);
+  ch.push_back(Fill("A", sc.width, sc.height, [](int x, int) { return float(x % 4) / 4.f; }));
+  WriteExr(dir / "rgba.exr", sc.width, sc.height, ch);
+
+  auto r = RunDcm({"reconstruct", dir / "rgb.exr", "-o", dir / "a1.exr", "--alpha"}, dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const Exr a1 = ReadExr(dir / "a1.exr");
+  ASSERT_GE(a1.spec.channelindex("A"), 0);
+  EXPECT_EQ(a1.spec.channelindex("A"), a1.spec.channelindex("B") + 1);
+  for (float a : a1.Plane("A")) ASSERT_EQ(a, 1.f);
+
+  r = RunDcm({"reconstruct", dir / "rgba.exr", "-o", dir / "a.exr"}, dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(ReadExr(dir / "a.exr").Plane("A"), ReadExr(dir / "rgba.exr").Plane("A"));
+
+  r = RunDcm({"reconstruct", dir / "rgb.exr", "-o", dir / "none.exr"}, dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_LT(ReadExr(dir / "none.exr").spec.channelindex("A"), 0);
+}
+
+TEST(OutputLayout, PartsTakeTheFormatFromMerge) {
+  ScratchDir dir;
+  Scene sc{32, 16};
+  WriteExr(dir / "in.exr", sc.width, sc.height, sc.GenericChannels(false));
+  auto r = RunDcm({"reconstruct", dir / "in.exr", "--tile", "0/2", "-o", dir / "t0.exr", "-d", "half"}, dir);
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_THAT(r.err, HasSubstr("give them to `dcm merge`"));
+  for (const auto& [tile, name] : {std::pair{"0/2", "t0.exr"}, std::pair{"1/2", "t1.exr"}}) {
+    r = RunDcm({"reconstruct", dir / "in.exr", "--tile", tile, "-o", dir / name, "--quiet"}, dir);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+  }
+  r = RunDcm({"merge", dir / "t0.exr", dir / "t1.exr", "-o", dir / "m.exr", "--compression", "lzw"}, dir);
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_THAT(r.err, HasSubstr("--compression lzw"));
+  r = RunDcm({"merge", dir / "t0.exr", dir / "t1.exr", "-o", dir / "m.exr", "-d", "half", "--compression", "piz",
+              "--quiet"},
+             dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const Exr m = ReadExr(dir / "m.exr");
+  EXPECT_THAT(m.names(), UnorderedElementsAre("R", "G", "B"));
+  EXPECT_EQ(m.spec.format, OIIO::TypeDesc::HALF);
+  EXPECT_EQ(m.spec.get_string_attribute("compression"), "piz");
+}
+
+}  // namespace
+}  // namespace dcm::aov::test
