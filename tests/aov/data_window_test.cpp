@@ -124,7 +124,7 @@ INSTANTIATE_TEST_SUITE_P(
     Placements, DataWindow,
     ::testing::Values(Placement{"RenderRegion", {16, 8}, OIIO::ROI(0, 96, 0, 64)},
                       Placement{"Overscan", {-8, -6}, OIIO::ROI(0, 32, 0, 28)}),
-    [](const auto& info) { return std::string(info.param.name); });
+    [](const auto& param) { return std::string(param.param.name); });
 
 TEST(DataWindow, InputsWithDifferentWindowsFail) {
   ScratchDir dir;

@@ -118,9 +118,9 @@ Status ChannelSet::Add(const std::string& path) {
   windows_ = w;
   const int fileIndex = int(files_.size());
   for (int s = 0; s < int(f.specs.size()); ++s) {
-    const ImageSpec& sp = f.specs[size_t(s)];
-    for (int c = 0; c < sp.nchannels; ++c)
-      channels_.emplace(sp.channel_name(c), ChannelRef{fileIndex, s, c, sp.channelformat(c)});
+    const ImageSpec& spec = f.specs[size_t(s)];
+    for (int c = 0; c < spec.nchannels; ++c)
+      channels_.emplace(spec.channel_name(c), ChannelRef{fileIndex, s, c, spec.channelformat(c)});
   }
   files_.push_back(std::move(f));
   ScanCrypto(fileIndex);
@@ -165,12 +165,12 @@ void ChannelSet::ScanCrypto(int file) {
       }
       if (layer.channel.empty()) continue;  // metadata without channels: not usable
       for (int rank = 0; rank < 100; ++rank) {
-        const std::string prefix = layer.name + (rank < 10 ? "0" : "") + std::to_string(rank) + ".";
+        const std::string rankPrefix = layer.name + (rank < 10 ? "0" : "") + std::to_string(rank) + ".";
         bool found = false;
         for (const auto& [even, odd] : {std::pair("G", "A"), std::pair("g", "a"), std::pair("green", "alpha")})
-          if (Has(prefix + even) && Has(prefix + odd)) {
-            layer.coverage.push_back(prefix + even);
-            layer.coverage.push_back(prefix + odd);
+          if (Has(rankPrefix + even) && Has(rankPrefix + odd)) {
+            layer.coverage.push_back(rankPrefix + even);
+            layer.coverage.push_back(rankPrefix + odd);
             found = true;
             break;
           }
