@@ -60,6 +60,7 @@ Engine::Engine(SampleProvider& provider, const ReconstructionOptions& opt, const
   grain_ = size_t(blocksPerTile) * size_t(blocksPerTile);
   request_.split = settings.split;
   request_.variance = settings.noisy;
+  stats_.settings = settings;
 }
 
 Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
