@@ -115,8 +115,8 @@ struct ResolvedSettings {
   /// Noisy samples are replaced by their local fits before interpolation.
   bool denoise = false;
   int denoiseRadius = 0;  ///< pixels the fits reach: one elementary block
-  float denoiseGate = 0.f;  ///< sd within which the fits average: max(noiseSignificance, detail::kDenoiseGateMinSd)
-  float lazyCorrectionGate = 0.f;  ///< max(noiseSignificance, detail::kLazyCorrectionMinSd)
+  float denoiseGate = 0.f;  ///< sd within which the fits average: max(noiseSignificance, kDenoiseGateMinSd of lib/src/settings.h)
+  float lazyCorrectionGate = 0.f;  ///< max(noiseSignificance, kLazyCorrectionMinSd of lib/src/settings.h)
 };
 
 struct ReconstructionStats {
