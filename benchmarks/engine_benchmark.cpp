@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <map>
+#include <string>
 #include <vector>
 
 #include "analytic_provider.h"
@@ -72,7 +74,7 @@ void BM_Reconstruct(benchmark::State& state, ReconstructionOptions options) {
   TableProvider provider(n, testing::FurnishedScene(n, n));
   const long rssBefore = MaxRssKiB();
   double engine = 0, exact = 0;
-  StageTimes stages;
+  std::map<std::string, double> stages;  // seconds per stage, summed over the iterations
   for (auto _ : state) {
     Reconstruction r;
     const Status s = Reconstruct(provider, options, &r);
@@ -80,23 +82,11 @@ void BM_Reconstruct(benchmark::State& state, ReconstructionOptions options) {
     state.SetIterationTime(r.stats.timeEngineS);
     engine += r.stats.timeEngineS;
     exact = r.stats.exactFraction();
-    const StageTimes& t = r.stats.stageTimes;
-    stages.surfaces += t.surfaces, stages.refinement += t.refinement, stages.borders += t.borders;
-    stages.directions += t.directions, stages.simpleComplex += t.simpleComplex, stages.lazy += t.lazy;
-    stages.finest += t.finest, stages.interpolation += t.interpolation, stages.denoising += t.denoising;
-    stages.output += t.output;
+    for (const auto& [name, seconds] : r.stats.stageTimes.Named()) stages[std::string(name)] += seconds;
   }
   // Engine milliseconds per reconstruction, per stage (ReconstructionStats::stageTimes).
   const double perRun = 1e3 / double(std::max<int64_t>(1, int64_t(state.iterations())));
-  state.counters["surf_ms"] = stages.surfaces * perRun;
-  state.counters["refine_ms"] = stages.refinement * perRun;
-  state.counters["border_ms"] = stages.borders * perRun;
-  state.counters["dir_ms"] = stages.directions * perRun;
-  state.counters["simple_ms"] = stages.simpleComplex * perRun;
-  state.counters["lazy_ms"] = stages.lazy * perRun;
-  state.counters["finest_ms"] = stages.finest * perRun;
-  state.counters["interp_ms"] = stages.interpolation * perRun;
-  state.counters["out_ms"] = stages.output * perRun;
+  for (const auto& [name, seconds] : stages) state.counters[name + "_ms"] = seconds * perRun;
   const double mpix = double(n) * n / 1e6;
   state.counters["Mpix/s"] = benchmark::Counter(mpix * double(state.iterations()) / engine);
   state.counters["Mpix/s/thread"] = benchmark::Counter(mpix * double(state.iterations()) / engine / options.threads);

@@ -73,27 +73,31 @@ void Engine::WriteSmooth(const Leaf& leaf) {
     for (int ch = 0; ch < 3; ++ch) c[k][ch] = v.a[ch], c[k][3 + ch] = v.b[ch];
   }
   const double sx = b.x1 > b.x0 ? 1.0 / (b.x1 - b.x0) : 0.0, sy = b.y1 > b.y0 ? 1.0 / (b.y1 - b.y0) : 0.0;
-  const int channels = settings_.split ? 6 : 3;  // (L_i, L_c) or L
-  for (int y = b.y0; y <= ye; ++y) {
-    const double v = (y - b.y0) * sy;
-    double left[6], right[6];
-    for (int ch = 0; ch < channels; ++ch) {
-      left[ch] = v == 0 ? c[0][ch] : (1 - v) * c[0][ch] + v * c[2][ch];
-      right[ch] = v == 0 ? c[1][ch] : (1 - v) * c[1][ch] + v * c[3][ch];
-    }
-    for (int x = b.x0; x <= xe; ++x) {
-      const int64_t i = store_.Index(x, y);
-      if (store_.IsExact(i) || store_.IsFilled(i)) continue;
-      const double u = (x - b.x0) * sx;
-      Value out;
+  // The channel count as a constant: the loops over channels unroll.
+  auto fill = [&]<int channels>() {
+    for (int y = b.y0; y <= ye; ++y) {
+      const double v = (y - b.y0) * sy;
+      double left[channels], right[channels];
       for (int ch = 0; ch < channels; ++ch) {
-        const float f = float(u == 0 ? left[ch] : (1 - u) * left[ch] + u * right[ch]);
-        if (ch < 3) out.a[ch] = f;
-        else out.b[ch - 3] = f;
+        left[ch] = v == 0 ? c[0][ch] : (1 - v) * c[0][ch] + v * c[2][ch];
+        right[ch] = v == 0 ? c[1][ch] : (1 - v) * c[1][ch] + v * c[3][ch];
       }
-      store_.SetInterpolated(i, out);
+      for (int x = b.x0; x <= xe; ++x) {
+        const int64_t i = store_.Index(x, y);
+        if (store_.IsExact(i) || store_.IsFilled(i)) continue;
+        const double u = (x - b.x0) * sx;
+        float f[6] = {};
+        for (int ch = 0; ch < channels; ++ch) f[ch] = float(u == 0 ? left[ch] : (1 - u) * left[ch] + u * right[ch]);
+        Value out;
+        out.a = RGB{f[0], f[1], f[2]};
+        out.b = RGB{f[3], f[4], f[5]};
+        store_.SetInterpolated(i, out);
+      }
     }
-  }
+  };
+  // (L_i, L_c) or L
+  if (settings_.split) fill.template operator()<6>();
+  else fill.template operator()<3>();
 }
 
 void Engine::WritePreview(int level, std::vector<Block>& splitSmooth, std::vector<EdgeBlock>& edges) {

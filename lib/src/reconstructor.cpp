@@ -60,6 +60,7 @@ Engine::Engine(SampleProvider& provider, const ReconstructionOptions& opt, const
   grain_ = size_t(blocksPerTile) * size_t(blocksPerTile);
   request_.split = settings.split;
   request_.variance = settings.noisy;
+  stats_.settings = settings;
 }
 
 Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
@@ -143,6 +144,7 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
 
 void Engine::RecordLeaves(Reconstruction* out) {
   out->blocks.clear();
+  out->blocks.reserve(smoothLeaves_.size() + orientedLeaves_.size() + fallbackLeaves_.size());
   auto record = [&](const Leaf& l) {
     const Block& b = l.block;
     out->blocks.push_back({b.x0, b.y0, b.x1, b.y1, b.level, l.type, l.direction});

@@ -52,19 +52,24 @@ void SampleStore::SetGuides(GuideImage guides, ObjectTest test, float creaseAngl
       *out = (double(a.x) * b.x + double(a.y) * b.y + double(a.z) * b.z) / (la * lb);
       return true;
     };
-    crease_.assign(normal.size(), 0);
-    for (int y = 0; y < height_; ++y)
+    crease_.resize(normal.size());
+    tbb::parallel_for(0, height_, [&](int y) {
       for (int x = 0; x < width_; ++x) {
         const size_t i = size_t(Index(x, y));
         double d = 0;
-        if (x + 1 < width_ && dot(i, i + 1, &d) && d < cosMax) crease_[i] |= 1;
-        if (y + 1 < height_ && dot(i, i + size_t(width_), &d) && d < cosMax) crease_[i] |= 2;
+        uint8_t marks = 0;
+        if (x + 1 < width_ && dot(i, i + 1, &d) && d < cosMax) marks |= 1;
+        if (y + 1 < height_ && dot(i, i + size_t(width_), &d) && d < cosMax) marks |= 2;
+        crease_[i] = marks;
       }
+    });
   }
   tauZero_.clear();
   if (split_ && tau_.size() == size_t(width_) * size_t(height_)) {
     tauZero_.resize(tau_.size());
-    for (size_t i = 0; i < tau_.size(); ++i) tauZero_[i] = TauZero(tau_[i]) ? 1 : 0;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, tau_.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t i = r.begin(); i < r.end(); ++i) tauZero_[i] = TauZero(tau_[i]) ? 1 : 0;
+    });
   }
   regions_ = CellRegions{};
   if (!crease_.empty()) {
@@ -107,6 +112,35 @@ void SampleStore::SetGuides(GuideImage guides, ObjectTest test, float creaseAngl
                           tauZero_.empty() ? nullptr : tauZero_.data(), regions_.labels.empty() ? nullptr : &regions_);
 }
 
+bool SurfaceTest::ChangeInCell(int x0, int y0, int x1, int y1) const {
+  // The cell's labels, row-major from its origin (ox, oy), stride e + 1.
+  const uint32_t* cell = nullptr;
+  int ox = 0, oy = 0, stride = 0;
+  if (regionLabels_) {
+    const int e = regionSize_, cx = x0 / e, cy = y0 / e;
+    cell = regionLabels_ + size_t(cy * regionCellsX_ + cx) * size_t((e + 1) * (e + 1));
+    ox = cx * e, oy = cy * e, stride = e + 1;
+  }
+  // Same() and no crease between i and j; `li`, `lj` index the cell's labels.
+  auto same = [&](int64_t i, int64_t j, int li, int lj, uint8_t creaseBit) {
+    if (tauZero_ && tauZero_[i] != tauZero_[j]) return false;
+    const bool surface = (!objectId_ || objectId_[i] == objectId_[j]) ? (!cell || cell[li] == cell[lj])
+                                                                       : (shaderId_ && shaderId_[i] == shaderId_[j]);
+    return surface && !(crease_ && (crease_[std::min(i, j)] & creaseBit));
+  };
+  for (int y = y0; y <= y1; ++y) {
+    const int64_t row = int64_t(y) * width_;
+    const int lrow = (y - oy) * stride - ox;
+    for (int x = x0; x <= x1; ++x) {
+      const int64_t i = row + x;
+      const int li = lrow + x;
+      if (x < x1 && !same(i, i + 1, li, li + 1, 1)) return true;
+      if (y < y1 && !same(i, i + width_, li, li + stride, 2)) return true;
+    }
+  }
+  return false;
+}
+
 Status Engine::LoadGuides() {
   GuideRequest want;
   want.objectId = settings_.objectIds;
@@ -146,6 +180,7 @@ Status Engine::LoadGuides() {
 bool Engine::HasSurfaceChange(const Block& b) const {
   const SurfaceTest& s = store_.surfaces();
   if (!s.enabled()) return false;
+  if (s.HoldsInOneCell(b.x0, b.y0, b.x1, b.y1)) return s.ChangeInCell(b.x0, b.y0, b.x1, b.y1);
   for (int y = b.y0; y <= b.y1; ++y)
     for (int x = b.x0; x <= b.x1; ++x) {
       const int64_t i = store_.Index(x, y);

@@ -60,6 +60,18 @@ class SurfaceTest {
     return true;  // not neighbours (the wrap of a degenerate block's loop)
   }
 
+  /// The pixels [x0, x1] x [y0, y1] lie in one cell of the regions (always
+  /// so without regions): ChangeInCell applies.
+  bool HoldsInOneCell(int x0, int y0, int x1, int y1) const {
+    if (!regionLabels_) return true;
+    const int e = regionSize_;
+    return x1 <= x0 / e * e + e && y1 <= y0 / e * e + e;
+  }
+  /// Whether SameAdjacent fails for some pair of 4-neighbours inside
+  /// [x0, x1] x [y0, y1], which HoldsInOneCell: the same answer as testing
+  /// each pair, with the cell's labels found once.
+  bool ChangeInCell(int x0, int y0, int x1, int y1) const;
+
  private:
   bool SameRegion(int64_t i, int64_t j) const;
 

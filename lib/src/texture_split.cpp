@@ -1,6 +1,8 @@
 // The texture split (paper 3.3): where tau lets L_i = L_t / tau be recovered.
 #include "texture_split.h"
 
+#include <tbb/parallel_for.h>
+
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -14,9 +16,12 @@ bool TauRecoverable(RGB tau) {
 }
 
 void RequestNonFiniteTau(const std::vector<RGB>& tau, SampleStore& store) {
-  for (int64_t i = 0; i < int64_t(tau.size()); ++i)
-    if (!IsFinite(tau[size_t(i)]))
-      store.Request(int(i % store.width()), int(i / store.width()), SampleReason::kFallback);
+  // In parallel: the requests are sorted before they are evaluated.
+  tbb::parallel_for(0, store.height(), [&](int y) {
+    const RGB* row = tau.data() + store.Index(0, y);
+    for (int x = 0; x < store.width(); ++x)
+      if (!IsFinite(row[x])) store.Request(x, y, SampleReason::kFallback);
+  });
 }
 
 }  // namespace dcm::detail

@@ -270,6 +270,41 @@ TEST(DcmReconstruct, VerboseSaysWhichTestsAreOff) {
   EXPECT_THAT(r.err, HasSubstr("no tau: the texture split is off"));
 }
 
+TEST(DcmReconstruct, StatsHaveTheTimePerStageAndTheResolvedSettings) {
+  ScratchDir dir;
+  Scene sc{64, 48};
+  WriteExr(dir / "in.exr", sc.width, sc.height, sc.GenericChannels(true));
+  auto r = RunDcm({"reconstruct", dir / "in.exr", "-o", dir / "out.exr", "--stats", dir / "s.json", "-v",
+                   "--downsample", "2"},
+                  dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const auto s = ReadJson(dir / "s.json");
+  // Every stage, each timed apart, the provider's time excluded: together
+  // at most the engine time (the level loop between stages is not counted).
+  const std::set<std::string> stages = {"surfaces", "refinement",    "borders",   "directions", "simple_complex",
+                                        "lazy",     "finest",        "interpolation", "denoising", "output"};
+  ASSERT_TRUE(s["stage_times_s"].is_object());
+  std::set<std::string> reported;
+  double sum = 0;
+  for (const auto& [name, seconds] : s["stage_times_s"].items()) {
+    reported.insert(name);
+    ASSERT_TRUE(seconds.is_number()) << name;
+    EXPECT_GE(double(seconds), 0.0) << name;
+    sum += double(seconds);
+  }
+  EXPECT_EQ(reported, stages);
+  EXPECT_GT(sum, 0.0);
+  EXPECT_LE(sum, double(s["time_s"]));
+  // The settings the stages used: the supersampled input (--downsample 2,
+  // no variance) takes the supersampled rules' contrast threshold.
+  ASSERT_TRUE(bool(s["used"]["supersampled_rules"]));
+  EXPECT_EQ(double(s["settings"]["contrast_threshold"]), double(s["options"]["contrast_threshold_supersampled"]));
+  EXPECT_EQ(s["settings"]["directions"], s["options"]["directions_supersampled"]);
+  EXPECT_FALSE(bool(s["settings"]["noisy"]));
+  EXPECT_FALSE(s["settings"].contains("split"));  // "used" reports it
+  EXPECT_THAT(r.err, HasSubstr("time per stage: surfaces "));
+}
+
 TEST(DcmReconstruct, PresetAndMapOnTheCommandLine) {
   ScratchDir dir;
   Scene sc{32, 16};

@@ -95,7 +95,38 @@ nlohmann::json StatsToJson(const ReconstructionStats& s) {
   j["used"] = {{"split", s.usedSplit}, {"object_id", s.usedObjectId}, {"shader_id", s.usedShaderId},
                {"supersampled_rules", s.usedSupersampledRules},
                {"normals", s.usedNormals}};
+  nlohmann::json stages = nlohmann::json::object();
+  for (const auto& [name, seconds] : s.stageTimes.Named()) stages[std::string(name)] = seconds;
+  j["stage_times_s"] = stages;
+  // What "used" says already (split, guides, supersampled rules) is not repeated.
+  const ResolvedSettings& r = s.settings;
+  j["settings"] = {{"noisy", r.noisy},
+                   {"elementary_block", r.elementaryBlock},
+                   {"contrast_metric", std::string(ToString(r.contrastMetric))},
+                   {"contrast_threshold", Decimal(r.contrastThreshold)},
+                   {"contrast_significance", Decimal(r.contrastSignificance)},
+                   {"directions", r.directions},
+                   {"thin_objects", std::string(ToString(r.thinObjects))},
+                   {"crossing_fill_reach", r.crossingFillReach},
+                   {"smooth_refinement", std::string(ToString(r.smoothRefinement))},
+                   {"object_test", std::string(ToString(r.objectTest))},
+                   {"crease_angle", Decimal(r.creaseAngle)},
+                   {"denoise", r.denoise},
+                   {"denoise_radius", r.denoiseRadius},
+                   {"denoise_gate", Decimal(r.denoiseGate)},
+                   {"lazy_correction_gate", Decimal(r.lazyCorrectionGate)}};
   return j;
+}
+
+std::string StageTimesLine(const ReconstructionStats& s) {
+  std::string line = "time per stage:";
+  char buf[64];
+  for (const auto& [name, seconds] : s.stageTimes.Named()) {
+    std::snprintf(buf, sizeof buf, " %s %.3f s,", std::string(name).c_str(), seconds);
+    line += buf;
+  }
+  std::snprintf(buf, sizeof buf, " engine %.3f s", s.timeEngineS);
+  return line + buf;
 }
 
 nlohmann::json RunToJson(const Reconstruction& r, const std::string& method, const ReconstructionOptions& o,

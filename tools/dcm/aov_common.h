@@ -18,6 +18,7 @@
 #include "common/output_guard.h"
 #include "common/output_transaction.h"
 #include "common/progress.h"
+#include "common/stats_json.h"
 #include "common/tiles.h"
 #include "dcm/aov/aov_provider.h"
 #include "dcm/reconstructor.h"
@@ -174,9 +175,9 @@ inline Status ResolvePart(const aov::AovProvider& provider, const TileFlags& til
   return ResolveRegion(tiles, size.x, size.y, TileAlignment(options), region, tile);
 }
 
-/// Runs the engine with progress on stderr: on the whole frame, or with
-/// `region` on that part of the output frame (ReconstructRegion, which
-/// fills `info`).
+/// Runs the engine with progress on stderr (and the time per stage with -v):
+/// on the whole frame, or with `region` on that part of the output frame
+/// (ReconstructRegion, which fills `info`).
 inline Status Run(aov::AovProvider& provider, ReconstructionOptions options, const EngineFlags& engine,
                   Reconstruction* result, std::vector<Point2i>* pending, const Bounds2i* region = nullptr,
                   RegionInfo* info = nullptr) {
@@ -185,6 +186,7 @@ inline Status Run(aov::AovProvider& provider, ReconstructionOptions options, con
   Status st = region ? ReconstructRegion(provider, options, *region, result, info, pending)
                      : Reconstruct(provider, options, result, pending);
   progress.Done();
+  if (st.ok() && engine.verbose) std::cerr << toolkit::StageTimesLine(result->stats) << "\n";
   return st;
 }
 

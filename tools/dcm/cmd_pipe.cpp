@@ -107,6 +107,7 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
   if (Status fin = provider->Finish(); !fin.ok()) return Fail(fin.message());
   const double wallS = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const ReconstructionStats& stats = rec.stats;
+  if (f.engine.verbose) std::cerr << toolkit::StageTimesLine(stats) << "\n";
   const std::string method = options.fullEvaluation ? "full" : f.engine.method;
 
   toolkit::Metadata meta;

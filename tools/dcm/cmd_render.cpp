@@ -287,6 +287,7 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
   progress.Done();
   const Reconstruction& rec = run.rec;
   const ReconstructionStats& stats = rec.stats;
+  if (f.engine.verbose) std::cerr << toolkit::StageTimesLine(stats) << "\n";
   if (full && !reference) reference = full->rec.image;
 
   const std::string method = options.fullEvaluation ? "full" : f.engine.method;

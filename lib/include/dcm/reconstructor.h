@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "dcm/color.h"
@@ -61,6 +62,61 @@ struct StageTimes {
   double interpolation = 0;  ///< fallback interiors, thin objects (3.1), checkerboard, final interpolation
   double denoising = 0;      ///< fits of noisy samples
   double output = 0;         ///< downsampling and the record of leaves
+
+  /// Each stage's snake_case name (the stats' stage_times_s keys) and time,
+  /// in the order the engine runs them.
+  std::array<std::pair<std::string_view, double>, 10> Named() const {
+    return {{{"surfaces", surfaces},
+             {"refinement", refinement},
+             {"borders", borders},
+             {"directions", directions},
+             {"simple_complex", simpleComplex},
+             {"lazy", lazy},
+             {"finest", finest},
+             {"interpolation", interpolation},
+             {"denoising", denoising},
+             {"output", output}}};
+  }
+};
+
+/// The values the stages of one reconstruction use, resolved once from the
+/// options and the provider's capabilities (the rules that pick a regime:
+/// noisy samples, supersampled rules, texture split, guides).
+struct ResolvedSettings {
+  /// Samples carry their variance and the tests weigh it: a provider that
+  /// reports variance, noiseSignificance > 0.
+  bool noisy = false;
+  /// Interpolate (L_i, L_c) and re-apply tau (paper 3.3): asked for, the
+  /// provider gives tau and the split radiance, and not the full baseline.
+  bool split = false;
+  /// ReconstructionOptions::ElementaryBlockFor the samples.
+  int elementaryBlock = 16;
+  /// ReconstructionOptions::SupersampledRules: supersampled, not noisy.
+  bool supersampledRules = false;
+  ContrastMetric contrastMetric = ContrastMetric::kMitchell;  ///< ContrastMetricFor the rules
+  float contrastThreshold = 0.f;                               ///< ContrastThresholdFor the rules
+  /// The contrast test's significance: noiseSignificance with noisy
+  /// samples, 0 (the paper's test) without.
+  float contrastSignificance = 0.f;
+  int directions = 8;                                       ///< DirectionsFor the rules
+  ThinObjectTest thinObjects = ThinObjectTest::kOff;        ///< ThinObjectsFor the rules
+  int crossingFillReach = 0;                                ///< CrossingFillReachFor the rules (0: off)
+  /// The smooth blocks' refinement: kCentreProbe becomes kNever where the
+  /// guides show every hard shadow and the samples are not noisy.
+  SmoothRefinement smoothRefinement = SmoothRefinement::kAlways;
+  /// Guides the engine asks for: object IDs (an object test and a provider
+  /// that has them), shader IDs (with them, for the tests that read both),
+  /// normals (a provider that has them and creaseAngle > 0).
+  bool objectIds = false, shaderIds = false, normals = false;
+  /// The surface test's rule: the options' with object IDs, kNone without.
+  ObjectTest objectTest = ObjectTest::kNone;
+  /// The crease angle between work pixels (WorkCreaseAngle), 0 without normals.
+  float creaseAngle = 0.f;
+  /// Noisy samples are replaced by their local fits before interpolation.
+  bool denoise = false;
+  int denoiseRadius = 0;  ///< pixels the fits reach: one elementary block
+  float denoiseGate = 0.f;  ///< sd within which the fits average: max(noiseSignificance, kDenoiseGateMinSd of lib/src/settings.h)
+  float lazyCorrectionGate = 0.f;  ///< max(noiseSignificance, kLazyCorrectionMinSd of lib/src/settings.h)
 };
 
 struct ReconstructionStats {
@@ -79,6 +135,7 @@ struct ReconstructionStats {
   double timeProviderS = 0;  ///< in the provider's Evaluate() (the illumination)
   double timeEngineS = 0;    ///< everything else
   StageTimes stageTimes;     ///< timeEngineS per stage
+  ResolvedSettings settings;  ///< what the stages used
   bool usedSplit = false, usedObjectId = false, usedShaderId = false, usedNormals = false;
   bool usedSupersampledRules = false;  ///< ReconstructionOptions::SupersampledRules
   double exactFraction() const { return totalPixels ? double(exactPixels) / double(totalPixels) : 0.0; }
