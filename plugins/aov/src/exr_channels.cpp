@@ -118,9 +118,9 @@ Status ChannelSet::Add(const std::string& path) {
   windows_ = w;
   const int fileIndex = int(files_.size());
   for (int s = 0; s < int(f.specs.size()); ++s) {
-    const ImageSpec& spec = f.specs[size_t(s)];
-    for (int c = 0; c < spec.nchannels; ++c)
-      channels_.emplace(spec.channel_name(c), ChannelRef{fileIndex, s, c, spec.channelformat(c)});
+    const ImageSpec& part = f.specs[size_t(s)];
+    for (int c = 0; c < part.nchannels; ++c)
+      channels_.emplace(part.channel_name(c), ChannelRef{fileIndex, s, c, part.channelformat(c)});
   }
   files_.push_back(std::move(f));
   ScanCrypto(fileIndex);
