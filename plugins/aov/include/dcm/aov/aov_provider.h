@@ -110,7 +110,7 @@ struct AovOptions {
   /// the Blender preset R + G + B of the guide's direct glossy light) exceeds
   /// this is a highlight: highlight and other pixels of one surface become
   /// different surfaces. 1.5 is R + G + B of a mean of 0.5, a highlight as
-  /// bright as mid-grey on the display (docs/AOV.md, session 8).
+  /// bright as mid-grey on the display (calibration: docs/TUNING.md).
   float highlightLevel = 1.5f;
   /// Dense mode, one noisy render and no variance channel: the variance is
   /// estimated from the data, as the mean over a 5x5 window on the same
