@@ -29,98 +29,13 @@
 #include <nlohmann/json.hpp>
 
 #include "common/image_io.h"
-
-#ifndef DCM_BINARY
-#error "DCM_BINARY must name the dcm executable"
-#endif
+#include "dcm_process.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-
-/// A fresh folder, removed at the end of the test.
-class TempDir {
- public:
-  TempDir() {
-    std::string tmpl = (fs::temp_directory_path() / "dcm_hostile_XXXXXX").string();
-    if (!::mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
-    path_ = tmpl;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  std::string operator/(const std::string& name) const { return (path_ / name).string(); }
-  const fs::path& path() const { return path_; }
-  /// Names in the folder that look like a temporary file of dcm.
-  std::vector<std::string> Temporaries() const {
-    std::vector<std::string> t;
-    for (const auto& e : fs::recursive_directory_iterator(path_))
-      if (e.path().filename().string().find("dcmtmp") != std::string::npos) t.push_back(e.path().string());
-    return t;
-  }
-
- private:
-  fs::path path_;
-};
-
-std::string ReadAll(const std::string& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-struct Result {
-  bool exited = false;  ///< false: killed by a signal
-  int code = -1;        ///< exit code, or the signal number
-  std::string output;   ///< stdout and stderr
-};
-
-/// Starts `dcm args...` in `cwd` with stdout and stderr into `log`; returns its pid.
-pid_t StartDcm(const fs::path& cwd, const std::vector<std::string>& args, const std::string& log) {
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    if (::chdir(cwd.c_str()) != 0) _exit(127);
-    FILE* f = std::freopen(log.c_str(), "w", stdout);
-    if (!f || ::dup2(::fileno(stdout), 2) < 0) _exit(127);
-    std::vector<char*> argv;
-    std::string bin = DCM_BINARY;
-    argv.push_back(bin.data());
-    std::vector<std::string> copy = args;
-    for (auto& a : copy) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    ::execv(bin.c_str(), argv.data());
-    _exit(127);
-  }
-  return pid;
-}
-
-Result Wait(pid_t pid, const std::string& log) {
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  Result r;
-  r.exited = WIFEXITED(status);
-  r.code = r.exited ? WEXITSTATUS(status) : WTERMSIG(status);
-  r.output = ReadAll(log);
-  return r;
-}
-
-/// Runs `dcm args...` in `dir` to its end.
-Result RunDcm(const TempDir& dir, const std::vector<std::string>& args) {
-  const std::string log = (dir.path().parent_path() / (dir.path().filename().string() + ".log")).string();
-  Result r = Wait(StartDcm(dir.path(), args, log), log);
-  std::error_code ec;
-  fs::remove(log, ec);
-  return r;
-}
-
-std::string Describe(const Result& r) {
-  return (r.exited ? "exit code " + std::to_string(r.code) : "killed by signal " + std::to_string(r.code)) +
-         ", output:\n" + r.output;
-}
+using namespace dcm::testing;
 
 /// A smooth 32x32 RGB image (a dense input of `dcm reconstruct`).
 void WriteInput(const std::string& path, float offset = 0.f) {
@@ -144,8 +59,8 @@ void ExpectRefused(const TempDir& dir, const std::vector<std::string>& args, con
                    const std::vector<std::string>& flags, const std::string& what) {
   const std::string before = ReadAll(dir / protectedFile);
   ASSERT_FALSE(before.empty());
-  const Result r = RunDcm(dir, args);
-  EXPECT_TRUE(r.exited && r.code == 2) << what << ": " << Describe(r);
+  const Result r = RunDcm(dir.path(), args);
+  EXPECT_TRUE(r.exited && r.code == 2) << what << ": " << r.Describe();
   for (const auto& f : flags) EXPECT_NE(r.output.find(f), std::string::npos) << what << ": no '" << f << "' in\n" << r.output;
   EXPECT_TRUE(r.output.find("same file") != std::string::npos || r.output.find("files") != std::string::npos)
       << what << ": " << r.output;
@@ -190,8 +105,8 @@ TEST(HostileOutput, MergeOntoAPartIsRefused) {
   WriteInput(dir / "in.exr");
   for (const char* tile : {"0/2", "1/2"}) {
     const std::string part = std::string("part") + tile[0] + ".exr";
-    const Result r = RunDcm(dir, {"reconstruct", "in.exr", "--tile", tile, "-o", part, "--quiet"});
-    ASSERT_TRUE(r.exited && r.code == 0) << Describe(r);
+    const Result r = RunDcm(dir.path(), {"reconstruct", "in.exr", "--tile", tile, "-o", part, "--quiet"});
+    ASSERT_TRUE(r.exited && r.code == 0) << r.Describe();
   }
   for (const auto& [how, name] : Aliases(dir, "part1.exr"))
     ExpectRefused(dir, {"merge", "part0.exr", "part1.exr", "-o", name, "--quiet"}, "part1.exr", {"part", "-o"}, how);
@@ -215,15 +130,15 @@ TEST(HostileOutput, TwoOutputsOntoOneFileAreRefused) {
   TempDir dir;
   WriteInput(dir / "in.exr");
   for (const std::string stats : {"out.exr", "./out.exr"}) {
-    const Result r = RunDcm(dir, {"reconstruct", "in.exr", "-o", "out.exr", "--stats", stats, "--quiet"});
-    EXPECT_TRUE(r.exited && r.code == 2) << Describe(r);
+    const Result r = RunDcm(dir.path(), {"reconstruct", "in.exr", "-o", "out.exr", "--stats", stats, "--quiet"});
+    EXPECT_TRUE(r.exited && r.code == 2) << r.Describe();
     EXPECT_TRUE(r.output.find("-o") != std::string::npos && r.output.find("--stats") != std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(dir / "out.exr"));
   }
   // --progressive writes level_N.exr in its folder: -o there is refused too.
-  const Result r = RunDcm(dir, {"reconstruct", "in.exr", "-o", "levels/level_2.exr", "--progressive", "levels",
+  const Result r = RunDcm(dir.path(), {"reconstruct", "in.exr", "-o", "levels/level_2.exr", "--progressive", "levels",
                                 "--quiet"});
-  EXPECT_TRUE(r.exited && r.code == 2) << Describe(r);
+  EXPECT_TRUE(r.exited && r.code == 2) << r.Describe();
   EXPECT_NE(r.output.find("--progressive"), std::string::npos) << r.output;
 }
 
@@ -238,8 +153,8 @@ TEST(HostileOutput, SpecialAndLongOutputNames) {
     devNull = dir / "null";
     ASSERT_EQ(::mknod(devNull.c_str(), S_IFCHR | 0666, ::makedev(1, 3)), 0) << std::strerror(errno);
   }
-  Result r = RunDcm(dir, {"reconstruct", "in.exr", "-o", "out.exr", "--stats", devNull, "--quiet"});
-  EXPECT_TRUE(r.exited && r.code == 0) << Describe(r);
+  Result r = RunDcm(dir.path(), {"reconstruct", "in.exr", "-o", "out.exr", "--stats", devNull, "--quiet"});
+  EXPECT_TRUE(r.exited && r.code == 0) << r.Describe();
   struct stat st {};
   ASSERT_EQ(::stat(devNull.c_str(), &st), 0);
   EXPECT_TRUE(S_ISCHR(st.st_mode)) << devNull << " is no longer a character device";
@@ -247,8 +162,8 @@ TEST(HostileOutput, SpecialAndLongOutputNames) {
 
   // A name of 250 characters: its temporary file must stay within NAME_MAX (255).
   const std::string longName = std::string(246, 'n') + ".exr";
-  r = RunDcm(dir, {"reconstruct", "in.exr", "-o", longName, "--quiet"});
-  EXPECT_TRUE(r.exited && r.code == 0) << Describe(r);
+  r = RunDcm(dir.path(), {"reconstruct", "in.exr", "-o", longName, "--quiet"});
+  EXPECT_TRUE(r.exited && r.code == 0) << r.Describe();
   EXPECT_TRUE(fs::is_regular_file(dir / longName));
 
   // A symbolic link as the destination is followed: the file it names gets
@@ -258,8 +173,8 @@ TEST(HostileOutput, SpecialAndLongOutputNames) {
     std::ofstream(dir / "real/old.exr") << "old";
   }
   fs::create_symlink("real/old.exr", dir / "link.exr");
-  r = RunDcm(dir, {"reconstruct", "in.exr", "-o", "link.exr", "--quiet"});
-  EXPECT_TRUE(r.exited && r.code == 0) << Describe(r);
+  r = RunDcm(dir.path(), {"reconstruct", "in.exr", "-o", "link.exr", "--quiet"});
+  EXPECT_TRUE(r.exited && r.code == 0) << r.Describe();
   EXPECT_TRUE(fs::is_symlink(dir / "link.exr"));
   int w = 0, h = 0;
   std::vector<dcm::RGB> px;
@@ -268,8 +183,8 @@ TEST(HostileOutput, SpecialAndLongOutputNames) {
 
   // A folder as the output is refused, and stays a folder.
   fs::create_directory(dir / "folder.exr");
-  r = RunDcm(dir, {"reconstruct", "in.exr", "-o", "folder.exr", "--quiet"});
-  EXPECT_TRUE(r.exited && r.code == 1) << Describe(r);
+  r = RunDcm(dir.path(), {"reconstruct", "in.exr", "-o", "folder.exr", "--quiet"});
+  EXPECT_TRUE(r.exited && r.code == 1) << r.Describe();
   EXPECT_NE(r.output.find("folder"), std::string::npos) << r.output;
   EXPECT_TRUE(fs::is_directory(dir / "folder.exr"));
   EXPECT_TRUE(dir.Temporaries().empty());
@@ -282,9 +197,9 @@ TEST(HostileOutput, ALaterOutputFailingLeavesNone) {
     std::ofstream(dir / "out.exr") << "an earlier result";
   }
   // --stats is written last, into a folder that does not exist.
-  const Result r = RunDcm(dir, {"reconstruct", "in.exr", "-o", "out.exr", "--sample-map", "map.png", "--stats",
+  const Result r = RunDcm(dir.path(), {"reconstruct", "in.exr", "-o", "out.exr", "--sample-map", "map.png", "--stats",
                                 "missing/stats.json", "--quiet"});
-  EXPECT_TRUE(r.exited && r.code == 1) << Describe(r);
+  EXPECT_TRUE(r.exited && r.code == 1) << r.Describe();
   EXPECT_EQ(ReadAll(dir / "out.exr"), "an earlier result") << "the EXR was replaced by a run that failed";
   EXPECT_FALSE(fs::exists(dir / "map.png"));
   EXPECT_TRUE(dir.Temporaries().empty());
@@ -345,11 +260,11 @@ void InterruptMidRun(int sig) {
   // Mid-run: the provider sleeps 0.3 s per batch of samples.
   std::this_thread::sleep_for(std::chrono::milliseconds(700));
   ASSERT_EQ(::kill(dcm, sig), 0);
-  const Result r = Wait(dcm, log);
+  const Result r = WaitDcm(dcm, log);
   std::error_code ec;
   fs::remove(log, ec);
-  EXPECT_FALSE(r.exited) << strsignal(sig) << ": " << Describe(r);
-  EXPECT_EQ(r.code, sig) << Describe(r);
+  EXPECT_FALSE(r.exited) << strsignal(sig) << ": " << r.Describe();
+  EXPECT_EQ(r.code, sig) << r.Describe();
   EXPECT_TRUE(dir.Temporaries().empty()) << strsignal(sig);
   for (const char* out : {"out.exr", "stats.json", "map.png"}) EXPECT_FALSE(fs::exists(dir / out)) << out;
   EXPECT_TRUE(!fs::exists(dir / "levels") || fs::is_empty(dir / "levels")) << "progressive levels left";
@@ -388,10 +303,10 @@ TEST(HostileSignals, SignalDuringCommitLeavesAllOutputs) {
   EXPECT_EQ(::waitpid(dcm, &status, WNOHANG), 0) << "dcm did not wait for the FIFO's reader";
   EXPECT_TRUE(fs::exists(dir / "map.png")) << "the EXR appeared without the sample map";
   ASSERT_EQ(::kill(dcm, SIGTERM), 0);
-  const Result r = Wait(dcm, log);
+  const Result r = WaitDcm(dcm, log);
   std::error_code ec;
   fs::remove(log, ec);
-  EXPECT_FALSE(r.exited) << Describe(r);
+  EXPECT_FALSE(r.exited) << r.Describe();
   EXPECT_TRUE(fs::exists(dir / "out.exr") && fs::exists(dir / "map.png"));
   EXPECT_TRUE(fs::is_fifo(fifo)) << "the FIFO was replaced";
   EXPECT_TRUE(dir.Temporaries().empty());
@@ -399,9 +314,9 @@ TEST(HostileSignals, SignalDuringCommitLeavesAllOutputs) {
 
 TEST(HostileSamples, HugeFiniteSamplesGiveFinitePixels) {
   TempDir dir;
-  const Result r = RunDcm(dir, {"pipe", "--provider-cmd", ProviderCmd("huge", dir / "provider.pid"), "-o",
+  const Result r = RunDcm(dir.path(), {"pipe", "--provider-cmd", ProviderCmd("huge", dir / "provider.pid"), "-o",
                                 "out.exr", "--stats", "stats.json"});
-  ASSERT_TRUE(r.exited && r.code == 0) << Describe(r);
+  ASSERT_TRUE(r.exited && r.code == 0) << r.Describe();
   EXPECT_NE(r.output.find("clamped"), std::string::npos) << r.output;
   int w = 0, h = 0;
   std::vector<dcm::RGB> px;

@@ -26,9 +26,7 @@
 #include <tuple>
 #include <vector>
 
-#ifndef DCM_BINARY
-#error "DCM_BINARY must name the dcm executable"
-#endif
+#include "dcm_process.h"
 
 #if defined(__SANITIZE_ADDRESS__)
 #define DCM_TEST_ASAN 1
@@ -41,6 +39,7 @@
 namespace {
 
 namespace fs = std::filesystem;
+using namespace dcm::testing;
 
 /// The address space dcm may use here: 1 GiB. The control scene below
 /// renders within it with one thread and two malloc arenas (it needs between
@@ -51,47 +50,10 @@ namespace fs = std::filesystem;
 /// AddressSanitizer reserves terabytes of shadow memory: no limit under it.
 constexpr rlim_t kAddressSpace = rlim_t(1) << 30;
 
-class TempDir {
- public:
-  TempDir() {
-    std::string tmpl = (fs::temp_directory_path() / "dcm_memory_XXXXXX").string();
-    if (!::mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
-    path_ = tmpl;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  fs::path path() const { return path_; }
-  std::string Write(const std::string& name, const std::string& bytes) const {
-    std::ofstream out(path_ / name, std::ios::binary);
-    out.write(bytes.data(), std::streamsize(bytes.size()));
-    return (path_ / name).string();
-  }
-
- private:
-  fs::path path_;
-};
-
-struct Result {
-  bool exited = false;  ///< false: killed by a signal
-  int code = -1;        ///< exit code, or the signal number
-  std::string output;   ///< stdout and stderr
-  std::string Describe() const {
-    return (exited ? "exit code " + std::to_string(code) : "killed by signal " + std::to_string(code)) +
-           ", output:\n" + output;
-  }
-};
-
 /// Runs `dcm args...` in `cwd` with the address space limited to
 /// kAddressSpace and `env` ("NAME=value") added to the environment.
 Result RunLimited(const fs::path& cwd, const std::vector<std::string>& args, const std::vector<std::string>& env = {}) {
-  const fs::path log = cwd / ".dcm_test_output.log";
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    if (::chdir(cwd.c_str()) != 0) _exit(127);
-    FILE* f = std::freopen(log.c_str(), "w", stdout);
-    if (!f || ::dup2(::fileno(stdout), 2) < 0) _exit(127);
+  return RunDcm(cwd, args, [&env] {
     // glibc reserves 64 MiB of address space per malloc arena (one per thread).
     ::setenv("MALLOC_ARENA_MAX", "2", 1);
     for (const std::string& e : env) ::putenv(const_cast<char*>(e.c_str()));
@@ -99,25 +61,7 @@ Result RunLimited(const fs::path& cwd, const std::vector<std::string>& args, con
     const rlimit limit{kAddressSpace, kAddressSpace};
     if (::setrlimit(RLIMIT_AS, &limit) != 0) _exit(126);
 #endif
-    std::vector<std::string> copy = args;
-    std::string bin = DCM_BINARY;
-    std::vector<char*> argv{bin.data()};
-    for (auto& a : copy) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    ::execv(bin.c_str(), argv.data());
-    _exit(127);
-  }
-  Result r;
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  r.exited = WIFEXITED(status);
-  r.code = r.exited ? WEXITSTATUS(status) : WTERMSIG(status);
-  std::ifstream in(log, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  r.output = s.str();
-  return r;
+  });
 }
 
 /// The failure every lying file must give: exit 1 (not a signal, not a

@@ -21,89 +21,13 @@
 #include <string>
 #include <vector>
 
-#ifndef DCM_BINARY
-#error "DCM_BINARY must name the dcm executable"
-#endif
+#include "dcm_process.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-/// A fresh folder, removed at the end of the test.
-class TempDir {
- public:
-  TempDir() {
-    std::string tmpl = (fs::temp_directory_path() / "dcm_robustness_XXXXXX").string();
-    if (!::mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
-    path_ = tmpl;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  fs::path path() const { return path_; }
-  std::string Write(const std::string& name, const std::string& bytes) const {
-    const fs::path p = path_ / name;
-    std::ofstream out(p, std::ios::binary);
-    out.write(bytes.data(), std::streamsize(bytes.size()));
-    return p.string();
-  }
-  std::set<std::string> Files() const {
-    std::set<std::string> names;
-    for (const auto& e : fs::directory_iterator(path_)) names.insert(e.path().filename().string());
-    return names;
-  }
-
- private:
-  fs::path path_;
-};
-
-std::string ReadAll(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-struct Result {
-  bool exited = false;  ///< false: killed by a signal
-  int code = -1;        ///< exit code, or the signal number
-  std::string output;   ///< stdout and stderr
-  std::string Describe() const {
-    return (exited ? "exit code " + std::to_string(code) : "killed by signal " + std::to_string(code) + " (" +
-                                                              strsignal(code) + ")") +
-           ", output:\n" + output;
-  }
-};
-
-/// Runs `dcm args...` in `cwd`, stdout and stderr into one capture.
-Result RunDcm(const fs::path& cwd, const std::vector<std::string>& args) {
-  const fs::path log = cwd / ".dcm_test_output.log";
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    if (::chdir(cwd.c_str()) != 0) _exit(127);
-    FILE* f = std::freopen(log.c_str(), "w", stdout);
-    if (!f || ::dup2(::fileno(stdout), 2) < 0) _exit(127);
-    std::vector<char*> argv;
-    std::string bin = DCM_BINARY;
-    argv.push_back(bin.data());
-    std::vector<std::string> copy = args;
-    for (auto& a : copy) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    ::execv(bin.c_str(), argv.data());
-    _exit(127);
-  }
-  Result r;
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  r.exited = WIFEXITED(status);
-  r.code = r.exited ? WEXITSTATUS(status) : WTERMSIG(status);
-  r.output = ReadAll(log);
-  std::error_code ec;
-  fs::remove(log, ec);
-  return r;
-}
+using namespace dcm::testing;
 
 /// Whether `text` contains a match of `pattern`, where '*' stands for any
 /// characters and '#' for one or more digits; everything else is literal.
