@@ -56,10 +56,10 @@ Status OutputWindows(const aov::AovProvider& provider, int n, Bounds2i* display,
   *data = provider.DataWindow();
   if (n <= 1) return Status::Ok();
   const bool whole = *display == *data;
-  // A region must sit on the N-pixel lattice of its frame; a whole frame
-  // only needs its origin there (CheckDownsample checked its size).
-  std::vector<int> onLattice = {display->min.x, display->min.y, data->min.x, data->min.y};
-  if (!whole) onLattice.insert(onLattice.end(), {display->max.x, display->max.y, data->max.x, data->max.y});
+  // Both windows must sit on the N-pixel lattice of the frame: no output
+  // pixel is a partial box (the Python module has no CheckDownsample before).
+  const std::vector<int> onLattice = {display->min.x, display->min.y, data->min.x, data->min.y,
+                                      display->max.x, display->max.y, data->max.x, data->max.y};
   for (int v : onLattice)
     if (v % n != 0)
       return Status::Error("--downsample " + std::to_string(n) + ": the inputs' data window (" +
