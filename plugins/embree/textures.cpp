@@ -133,6 +133,11 @@ Status CheckDeclaredTextureSize(const std::string& path, const std::string& what
     return Status::Ok();  // the texture system's own message follows
   }
   const OIIO::ImageSpec& spec = in->spec();
+  // An empty image (a TGA may declare 0 columns) divides by zero in OpenImageIO 2.4's texture lookups.
+  if (spec.width <= 0 || spec.height <= 0 || spec.depth <= 0 || spec.nchannels <= 0)
+    return Status::Error(what + ": texture '" + path + "' declares an empty image (" + std::to_string(spec.width) +
+                         "x" + std::to_string(spec.height) + " pixels, " + std::to_string(spec.nchannels) +
+                         " channels)");
   std::error_code ec;
   const auto fileBytes = std::filesystem::file_size(path, ec);
   if (ec) return Status::Ok();

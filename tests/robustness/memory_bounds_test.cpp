@@ -212,6 +212,21 @@ TEST(MemoryBounds, UncompressedTextureDeclaring100000Squared) {
   ExpectRefused(Render(dir), dir, {"huge.ppm", "declares 100000x100000 pixels", "stored raw"});
 }
 
+TEST(MeshLoaderFindings, TextureOfZeroColumnsIsRefused) {
+  // fuzz_texture's finding: a TGA declaring 0x8 pixels reached OpenImageIO's
+  // bicubic lookup, which divides by the width (SIGFPE).
+  TempDir dir;
+  std::string tga(18, '\0');
+  tga[2] = 3;   // uncompressed grey
+  tga[14] = 8;  // height 8; width (bytes 12-13) 0
+  tga[16] = 8;  // bits per pixel
+  dir.Write("empty.tga", tga);
+  dir.Write("scene.json", Scene("", "empty.tga"));
+  const Result r = Render(dir);
+  EXPECT_TRUE(r.exited && r.code == 1) << r.Describe();
+  EXPECT_NE(r.output.find("empty.tga' declares an empty image (0x8"), std::string::npos) << r.Describe();
+}
+
 /// A small generic AOV EXR (id, shader, R, G, B; 32x32 half, PIZ: one chunk
 /// of 32 scanlines) whose data and display windows are then patched to
 /// declare side x side pixels, with an offset table of one entry per 32
