@@ -72,9 +72,13 @@ Status CheckDeclaredMeshSize(const std::string& path, const std::string& what) {
       break;
     }
     if (key == "format") {
-      std::string f;
-      ls >> f;
-      binary = f.rfind("binary", 0) == 0;
+      // Assimp 5.2.5 reads on forever after a malformed format line (fuzz_mesh).
+      std::string f, version;
+      ls >> f >> version;
+      if ((f != "ascii" && f != "binary_little_endian" && f != "binary_big_endian") || version != "1.0")
+        return Status::Error(what + ": mesh '" + path + "': PLY format line '" + line +
+                             "' is not 'format ascii|binary_little_endian|binary_big_endian 1.0'");
+      binary = f != "ascii";
     } else if (key == "element") {
       Element e;
       std::string count;
@@ -86,7 +90,9 @@ Status CheckDeclaredMeshSize(const std::string& path, const std::string& what) {
       if (err != std::errc() || p != count.data() + count.size())
         return Status::Error(what + ": mesh '" + path + "': PLY element '" + e.name + "' has no count");
       elements.push_back(e);
-    } else if (key == "property" && !elements.empty()) {
+    } else if (key == "property") {
+      if (elements.empty())
+        return Status::Error(what + ": mesh '" + path + "': PLY property before any element ('" + line + "')");
       std::string type;
       ls >> type;
       // A list takes at least its count (it may be empty); a scalar its size

@@ -212,6 +212,30 @@ TEST(MemoryBounds, UncompressedTextureDeclaring100000Squared) {
   ExpectRefused(Render(dir), dir, {"huge.ppm", "declares 100000x100000 pixels", "stored raw"});
 }
 
+TEST(MeshLoaderFindings, MalformedPlyFormatLineIsRefused) {
+  // fuzz_mesh's finding: after 'format ascii ,.0' Assimp read on for more
+  // than a minute. The format line, and a property before any element, are refused.
+  TempDir dir;
+  const std::string body = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                           "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                           "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  dir.Write("badformat.ply", "ply\nformat ascii ,.0\n" + body);
+  dir.Write("scene.json", Scene("badformat.ply"));
+  Result r = Render(dir);
+  EXPECT_TRUE(r.exited && r.code == 1) << r.Describe();
+  EXPECT_NE(r.output.find("badformat.ply': PLY format line 'format ascii ,.0'"), std::string::npos) << r.Describe();
+  dir.Write("early.ply", "ply\nformat ascii 1.0\nproperty list uchar int vertex_indices\n" + body);
+  dir.Write("scene.json", Scene("early.ply"));
+  r = Render(dir);
+  EXPECT_TRUE(r.exited && r.code == 1) << r.Describe();
+  EXPECT_NE(r.output.find("PLY property before any element"), std::string::npos) << r.Describe();
+  // The same mesh with a well-formed header renders.
+  dir.Write("good.ply", "ply\nformat ascii 1.0\n" + body);
+  dir.Write("scene.json", Scene("good.ply"));
+  r = Render(dir);
+  EXPECT_TRUE(r.exited && r.code == 0) << r.Describe();
+}
+
 TEST(MeshLoaderFindings, TextureOfZeroColumnsIsRefused) {
   // fuzz_texture's finding: a TGA declaring 0x8 pixels reached OpenImageIO's
   // bicubic lookup, which divides by the width (SIGFPE).
