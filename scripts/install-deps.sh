@@ -27,6 +27,8 @@ packages=(
   python3-numpy python3-matplotlib python3-openimageio python3-pil
   # scripts/tiles-benchmark.sh: wall time and peak memory per process
   time
+  # docs/ENGINE.md: instruction counts of the engine benchmark (callgrind)
+  valgrind
 )
 for arg in "$@"; do
   case "$arg" in
