@@ -1,5 +1,7 @@
 #include "test_util.h"
 
+#include "../support/exr_declared_size.h"
+
 #include <unistd.h>
 #include <sys/wait.h>
 
@@ -139,32 +141,8 @@ void MakeHugeExr(const std::string& path, int side) {
   std::string d((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   in.close();
   fs::remove(small);
-  // Header: magic, version, then attributes (name\0 type\0 int32 size, value)
-  // up to an empty name.
-  size_t p = 8;
-  while (d[p] != 0) {
-    const size_t nameEnd = d.find('\0', p);
-    const std::string name = d.substr(p, nameEnd - p);
-    const size_t typeEnd = d.find('\0', nameEnd + 1);
-    int32_t size = 0;
-    std::memcpy(&size, &d[typeEnd + 1], 4);
-    if (name == "dataWindow" || name == "displayWindow") {
-      const int32_t maxv = side - 1;
-      std::memcpy(&d[typeEnd + 5 + 8], &maxv, 4);
-      std::memcpy(&d[typeEnd + 5 + 12], &maxv, 4);
-    }
-    p = typeEnd + 5 + size_t(size);
-  }
-  const std::string header = d.substr(0, p + 1);
-  uint64_t chunkAt = 0;
-  std::memcpy(&chunkAt, &d[p + 1], 8);
-  const std::string chunk = d.substr(chunkAt);
-  const uint64_t chunks = (uint64_t(side) + 15) / 16;  // zip: 16 scanlines a chunk
-  const uint64_t newAt = header.size() + 8 * chunks;
   std::ofstream out(path, std::ios::binary);
-  out << header;
-  for (uint64_t i = 0; i < chunks; ++i) out.write(reinterpret_cast<const char*>(&newAt), 8);
-  out << chunk;
+  out << dcm::testing::DeclareExrSize(d, side, 16);  // zip: 16 scanlines a chunk
 }
 
 namespace {

@@ -26,6 +26,7 @@
 #include <tuple>
 #include <vector>
 
+#include "../support/exr_declared_size.h"
 #include "dcm_process.h"
 
 #if defined(__SANITIZE_ADDRESS__)
@@ -273,27 +274,7 @@ std::string LyingExr(const fs::path& dir, int side) {
   std::ifstream in(small, std::ios::binary);
   std::string d((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   fs::remove(small);
-  // Header attributes: name\0 type\0 int32 size, value; up to an empty name.
-  size_t p = 8;
-  while (d[p] != 0) {
-    const size_t nameEnd = d.find('\0', p), typeEnd = d.find('\0', nameEnd + 1);
-    int32_t size = 0;
-    std::memcpy(&size, &d[typeEnd + 1], 4);
-    const std::string name = d.substr(p, nameEnd - p);
-    if (name == "dataWindow" || name == "displayWindow") {
-      const int32_t maxv = side - 1;
-      std::memcpy(&d[typeEnd + 5 + 8], &maxv, 4);
-      std::memcpy(&d[typeEnd + 5 + 12], &maxv, 4);
-    }
-    p = typeEnd + 5 + size_t(size);
-  }
-  const std::string header = d.substr(0, p + 1);
-  uint64_t chunkAt = 0;
-  std::memcpy(&chunkAt, &d[p + 1], 8);
-  const uint64_t chunks = (uint64_t(side) + 31) / 32, newAt = header.size() + 8 * chunks;
-  std::string lying = header;
-  for (uint64_t i = 0; i < chunks; ++i) lying.append(reinterpret_cast<const char*>(&newAt), 8);
-  return lying + d.substr(chunkAt);
+  return DeclareExrSize(d, side, n);  // PIZ: 32 scanlines a chunk
 }
 
 TEST(MemoryBounds, AovExrDeclaring9400Squared) {
