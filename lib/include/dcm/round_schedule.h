@@ -1,0 +1,94 @@
+// Rounds that cost something: a renderer that pays a fixed latency per batch of
+// exact samples (a Blender render call, a POV-Ray process) is asked for its exact
+// pixels in a few large rounds chosen from a cheap preview, instead of one round
+// per step of the refinement.
+#pragma once
+
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+#include "dcm/reconstructor.h"
+#include "dcm/sample_provider.h"
+#include "dcm/status.h"
+
+namespace dcm {
+
+/// What exact samples cost a provider: `latencyS` per Evaluate() call (a
+/// round: process start-up, scene sync, a render call over the whole frame)
+/// and `perSampleS` per pixel evaluated. Zero: unknown or negligible.
+struct RoundCost {
+  double latencyS = 0;
+  double perSampleS = 0;
+};
+
+/// How the engine asks for its exact samples.
+enum class RoundSchedule : uint8_t {
+  /// As the refinement goes: each step's pixels in one call per batchSize
+  /// pixels (the paper's order; about 20 rounds at 512^2). Right for providers
+  /// without a latency (the internal tracer, EXR AOVs, in-process callbacks).
+  kLevels,
+  /// Plan on a preview: the engine runs on cheap stand-in samples (a
+  /// low-resolution or few-samples render) to choose its exact pixels; the
+  /// provider evaluates them in one call; the engine runs again on the exact
+  /// samples and asks for the pixels whose choice changed; and so on, up to
+  /// `maxRounds` calls. Pixels still wanted after the last round keep their
+  /// preview value (reported as preview stand-ins).
+  kPreview,
+};
+std::string_view ToString(RoundSchedule);
+Status Parse(std::string_view, RoundSchedule*);
+
+/// The schedule to use for a provider of cost `cost`: kPreview where a round
+/// costs more than evaluating `latencySamplesThreshold` samples (or the
+/// per-sample cost is unknown and the latency is not zero), else kLevels.
+RoundSchedule ChooseSchedule(const RoundCost& cost, double latencySamplesThreshold = 1000);
+
+struct PreviewScheduleOptions {
+  /// Calls to the exact provider at most (>= 1).
+  int maxRounds = 3;
+  /// Stop early when a round would evaluate fewer than this share of the
+  /// working pixels; those keep their preview value. 0: only `maxRounds` stops.
+  double minRoundShare = 0;
+};
+
+/// What a preview-planned reconstruction did.
+struct PreviewScheduleStats {
+  int rounds = 0;                       ///< calls to the exact provider
+  std::vector<int64_t> pixelsPerRound;  ///< exact pixels evaluated in each call
+  int64_t previewStandIns = 0;          ///< wanted pixels left at their preview value
+  int engineRuns = 0;                   ///< reconstructions run (one more than the rounds, at most)
+  double timeEngineS = 0;               ///< in the engine runs (preview evaluation included)
+  double timeExactS = 0;                ///< in the exact provider's Evaluate()
+};
+
+/// Reconstructs `exact`'s image, choosing the exact pixels from `preview`
+/// (RoundSchedule::kPreview). `exact` gives the guides (asked once) and the
+/// exact samples; `preview` gives stand-in samples for any pixel, cheaply
+/// (its guides are not used). The samples the engine sees in the final run
+/// are exact except the reported stand-ins; `out->stats` are that run's.
+Status ReconstructWithPreview(SampleProvider& exact, SampleProvider& preview,
+                              const ReconstructionOptions& options,
+                              const PreviewScheduleOptions& schedule, Reconstruction* out,
+                              PreviewScheduleStats* scheduleStats = nullptr);
+
+/// A provider of stand-in samples from a dense image at `scale` times coarser
+/// resolution than the working image (1: the same), upsampled bilinearly:
+/// L, and L_i/L_c when given (empty vectors: not given). For previews that a
+/// renderer makes at low resolution.
+class ImagePreviewProvider : public SampleProvider {
+ public:
+  ImagePreviewProvider(int workWidth, int workHeight, int previewWidth, int previewHeight,
+                       std::vector<RGB> L, std::vector<RGB> Li = {}, std::vector<RGB> Lc = {});
+  ProviderCapabilities Capabilities() const override;
+  Status Guides(const Bounds2i& region, const GuideRequest& what, GuideImage* out) override;
+  Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what,
+                  std::span<ExactSample> out) override;
+
+ private:
+  RGB Lookup(const std::vector<RGB>& image, const Point2i& p) const;
+  int workWidth_, workHeight_, previewWidth_, previewHeight_;
+  std::vector<RGB> L_, Li_, Lc_;
+};
+
+}  // namespace dcm
