@@ -172,7 +172,7 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
 
 void AddRoundFlags(CLI::App* app, RoundFlags* f) {
   InGroup g(app, kGroupRounds);
-  app->add_option("--rounds", f->schedule,
+  app->add_option("--schedule", f->schedule,
                   "how the renderer is asked for exact pixels: levels (as the refinement goes, a call per step), "
                   "preview (chosen on a cheap preview, then a few large calls), auto (preview where a call costs "
                   "more than about 1000 samples; docs/ENGINE.md)")
@@ -192,7 +192,7 @@ Status ScheduleFor(const RoundFlags& flags, const RoundCost& cost, bool previewA
   }
   DCM_RETURN_IF_ERROR(Parse(flags.schedule, out));
   if (*out == RoundSchedule::kPreview && !previewAvailable)
-    return Status::Error("--rounds preview: the renderer gives no preview");
+    return Status::Error("--schedule preview: the renderer gives no preview");
   return Status::Ok();
 }
 

@@ -49,12 +49,12 @@ struct RoundFlags {
   int maxRounds = 3;              ///< calls to the renderer at most, with the preview schedule
 };
 
-/// Adds --rounds and --max-rounds (help group "Rounds").
+/// Adds --schedule and --max-rounds (help group "Rounds").
 void AddRoundFlags(CLI::App* app, RoundFlags* flags);
 
 /// The schedule the flags select for a renderer whose rounds cost `cost`:
 /// the one named, or with "auto" ChooseSchedule(cost); kPreview only where
-/// `previewAvailable` (a preview named without one is an error naming --rounds).
+/// `previewAvailable` (a preview asked for without one is an error naming --schedule).
 Status ScheduleFor(const RoundFlags& flags, const RoundCost& cost, bool previewAvailable, RoundSchedule* out);
 
 /// --downsample `n` on an input of `width` x `height` pixels: both must be
