@@ -237,18 +237,21 @@ Status PlanOutputLayout(const aov::AovProvider& provider, const std::vector<std:
 
 Status BuildOutputImage(const OutputLayout& layout, const std::vector<std::string>& inputs,
                         const ExrReconstruction& run, int downsample, const toolkit::Metadata& provenance,
-                        toolkit::OutputImage* out) {
+                        toolkit::OutputImage* out, const Bounds2i* region) {
   const Reconstruction& r = run.result;
   // The inputs' data window: the alpha's resolution.
   const int inWidth = layout.inputSize.x, inHeight = layout.inputSize.y;
   out->display = run.display;
   out->data = run.data;
+  if (region)
+    out->data = {{run.data.min.x + region->min.x, run.data.min.y + region->min.y},
+                 {run.data.min.x + region->max.x, run.data.min.y + region->max.y}};
   out->attributes = layout.attributes;
   toolkit::AddMetadata(provenance, &out->attributes);
   const size_t n = r.image.size();
-  if (n != size_t(run.data.area()))
+  if (n != size_t(out->data.area()))
     return Status::Error("the output has " + std::to_string(n) + " pixels, its data window " +
-                         std::to_string(run.data.area()));
+                         std::to_string(out->data.area()));
 
   // The input channels the layout reads. EXR compresses all channels of a
   // block of scanlines together: each part is decoded once, as float, and
@@ -327,6 +330,22 @@ Status BuildOutputImage(const OutputLayout& layout, const std::vector<std::strin
   }
   if (downsample > 1 && !passes.empty())
     DCM_RETURN_IF_ERROR(DownsamplePasses(&out->channels, passes, layout.cryptoLayers, inWidth, inHeight, downsample));
+  if (region) {
+    // The alpha and the passes cover the whole data window: cut them to the part.
+    const size_t W = size_t(run.data.width());
+    auto cut = [&](auto& plane) {
+      if (plane.size() != W * size_t(run.data.height())) return;  // the beauty: the part's already
+      std::remove_reference_t<decltype(plane)> mine;
+      mine.reserve(size_t(region->area()));
+      for (int y = region->min.y; y < region->max.y; ++y)
+        for (int x = region->min.x; x < region->max.x; ++x) mine.push_back(plane[size_t(y) * W + size_t(x)]);
+      plane = std::move(mine);
+    };
+    for (auto& ch : out->channels) {
+      cut(ch.values);
+      cut(ch.ids);
+    }
+  }
   return Status::Ok();
 }
 

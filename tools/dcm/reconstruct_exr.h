@@ -100,9 +100,12 @@ Status PlanOutputLayout(const aov::AovProvider& provider, const std::vector<std:
 /// The output image of `run` laid out as `layout` says: the beauty
 /// reconstructed, the alpha and passes read from `inputs` (with `downsample`
 /// > 1 the alpha box-filtered, the passes as DownsamplePasses filters them),
-/// the inputs' metadata plus `provenance`.
+/// the inputs' metadata plus `provenance`. With `region` (a part of the
+/// output's data window, --tile/--region), `run.result` holds that region
+/// only: the image's data window is the region, the alpha and the passes are
+/// cut to it.
 Status BuildOutputImage(const OutputLayout& layout, const std::vector<std::string>& inputs,
                         const ExrReconstruction& run, int downsample, const toolkit::Metadata& provenance,
-                        toolkit::OutputImage* out);
+                        toolkit::OutputImage* out, const Bounds2i* region = nullptr);
 
 }  // namespace dcm::cli
