@@ -24,6 +24,10 @@ constexpr double kZ = 1.6448536269514722;
 /// runs go down from a cheap picture, so that each one's samples are mostly
 /// reused by the next (a lower threshold refines a superset of the blocks).
 constexpr double kStartFactor = 4.0;
+/// With a budget, from higher still: a run the budget refuses leaves its
+/// samples spent, and the coarsest run's samples are the ones every later run
+/// needs (the corners, the probes), so the first run must fit.
+constexpr double kStartFactorBudget = 16.0;
 /// Below this threshold the next step is the full evaluation.
 constexpr double kMinThreshold = 1e-3;
 /// Threshold steps: at least this ratio (a large jump overshoots the cost),
@@ -349,12 +353,12 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   };
 
   const bool rules = UsesSupersampledRules(options, caps);
-  const double t0 = kStartFactor * double(options.ContrastThresholdFor(rules));
+  const double t0 = (limit > 0 ? kStartFactorBudget : kStartFactor) * double(options.ContrastThresholdFor(rules));
   auto meets = [&](const Run& r) { return goal.targetPsnr > 0 && r.estimate.low >= goal.targetPsnr; };
 
   std::optional<Run> best, tried;
   double t = t0 > 0 ? t0 : kMinThreshold;
-  double lastT = 0, lastLow = kNaN;
+  double lastT = 0, lastLow = kNaN, lastUsed = 0;
   std::optional<double> refused;  // the largest threshold the budget refused (-1: the full evaluation)
   for (;;) {
     DCM_RETURN_IF_ERROR(runAt(t, &tried));
@@ -370,14 +374,22 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
       t = -1;
       continue;
     }
-    double step = kDefaultStep;
-    // Secant of the lower bound in log threshold: the step that reaches the target.
-    if (goal.targetPsnr > 0 && lastT > 0 && std::isfinite(low) && std::isfinite(lastLow) && low > lastLow) {
-      const double slope = (low - lastLow) / (std::log(t) - std::log(lastT));
-      step = std::exp((goal.targetPsnr - low) / slope);
+    // Secants in log threshold: of the lower bound, the step that reaches the
+    // target; of the log exact pixels, the step that fills the budget. The
+    // smaller step of the two.
+    double toTarget = goal.targetPsnr > 0 ? kDefaultStep : 0, toBudget = limit > 0 ? kDefaultStep : 0;
+    const double used = double(cache.Distinct());
+    if (lastT > 0) {
+      const double dlogT = std::log(t) - std::log(lastT);
+      if (toTarget > 0 && std::isfinite(low) && std::isfinite(lastLow) && low > lastLow)
+        toTarget = std::exp((goal.targetPsnr - low) * dlogT / (low - lastLow));
+      if (toBudget > 0 && used > lastUsed)
+        toBudget = std::exp((std::log(double(limit)) - std::log(used)) * dlogT / (std::log(used) - std::log(lastUsed)));
     }
+    const double step = std::max(toTarget, toBudget);
     lastT = t;
     lastLow = low;
+    lastUsed = used;
     t = std::max(kMinThreshold, t * std::clamp(step, kMinStep, kMaxStep));
   }
   if (!best) {

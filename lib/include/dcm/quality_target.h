@@ -77,8 +77,9 @@ struct QualityReport {
 };
 
 /// Reconstructs with the contrast threshold that `goal` calls for: from four
-/// times the options' threshold down, until the estimate's lower bound
-/// reaches goal.targetPsnr (without a target: until the budget binds). The
+/// times the options' threshold (sixteen with a budget) down, until the
+/// estimate's lower bound reaches goal.targetPsnr or the next run would exceed
+/// the budget (then bisected between the two). The
 /// provider is evaluated at most once per pixel across the runs. Every other
 /// option is used as given. A target that the budget (or the smallest
 /// threshold, then the full evaluation) cannot reach is no error: `report`
