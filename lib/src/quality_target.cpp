@@ -33,6 +33,11 @@ constexpr double kMinThreshold = 1e-3;
 /// Threshold steps: at least this ratio (a large jump overshoots the cost),
 /// at most the other (small steps cost engine runs).
 constexpr double kMinStep = 0.5, kMaxStep = 0.85, kDefaultStep = 0.7;
+/// At most this many validation draws (each of the first's size): where the
+/// point estimate reaches the target and its bound does not.
+constexpr int kMaxDraws = 4;
+/// The share of the budget left that a run of the descent may spend.
+constexpr double kDescentShare = 0.6;
 /// Bisections between the last run within the budget and the one beyond.
 constexpr int kBudgetBisections = 3;
 
@@ -144,6 +149,11 @@ class CachingProvider : public SampleProvider {
     std::lock_guard<std::mutex> lock(mutex_);
     budgetHit_ = false;
   }
+  /// The largest number of distinct pixels from now on (0: none).
+  void SetLimit(int64_t limit) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    limit_ = limit;
+  }
 
  private:
   static uint8_t Mask(const SampleRequest& w) { return uint8_t(1 | (w.split ? 2 : 0) | (w.variance ? 4 : 0)); }
@@ -168,7 +178,6 @@ struct Validation {
   std::vector<Point2i> pixels;  ///< output pixels
   std::vector<double> weights;  ///< output pixels each stands for
   std::vector<RGB> exact;       ///< box mean of the exact working samples
-  int64_t workPixels = 0;
 };
 
 /// One output pixel drawn uniformly in each cell of a grid of about `count`
@@ -221,7 +230,6 @@ Status EvaluateValidation(CachingProvider& cache, const ReconstructionOptions& o
   for (const Point2i& p : v->pixels)
     for (int y = p.y * s; y < std::min(caps.height, (p.y + 1) * s); ++y)
       for (int x = p.x * s; x < std::min(caps.width, (p.x + 1) * s); ++x) work.push_back({x, y});
-  v->workPixels = int64_t(work.size());
   std::vector<ExactSample> samples(work.size());
   const Status st = cache.Evaluate(work, what, samples);
   if (st.pending() && pending) *pending = work;
@@ -301,19 +309,42 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   // The validation: a share of the output pixels, at most a quarter of the budget.
   const int64_t outPixels = int64_t(outW) * int64_t(outH);
   int64_t count = std::max<int64_t>(goal.minValidationPixels, int64_t(std::ceil(goal.validationFraction * double(outPixels))));
-  if (limit > 0) count = std::min(count, std::max<int64_t>(2, limit / 4 / (int64_t(s) * s)));
+  // Without a target the estimate is only reported: a twentieth of the budget.
+  if (limit > 0)
+    count = std::min(count, std::max<int64_t>(2, limit / (goal.targetPsnr > 0 ? 4 : 20) / (int64_t(s) * s)));
   count = std::min(count, outPixels);
-  Validation v;
-  v.pixels = DrawValidation(outW, outH, count, goal.seed, &v.weights);
   const bool split = caps.splitRadiance && options.textureSplit;
   const SampleRequest what{split, caps.variance};
-  if (Status st = EvaluateValidation(cache, options, what, &v, pending); !st.ok()) {
+  Validation v;
+  std::vector<uint8_t> drawn(size_t(outPixels), 0);  // output pixels validated, for the cost
+  int draws = 0;
+  // One more stratified draw of `count` pixels, with its own seed: the union
+  // of independent unbiased draws (equal total weights) is unbiased.
+  auto drawMore = [&]() -> Status {
+    Validation more;
+    more.pixels = DrawValidation(outW, outH, count, goal.seed + uint64_t(draws), &more.weights);
+    DCM_RETURN_IF_ERROR(EvaluateValidation(cache, options, what, &more, pending));
+    ++draws;
+    for (size_t k = 0; k < more.pixels.size(); ++k) {
+      const Point2i p = more.pixels[k];
+      uint8_t& mark = drawn[size_t(p.y) * size_t(outW) + size_t(p.x)];
+      if (!mark) {
+        const int bw = std::min(s, caps.width - p.x * s), bh = std::min(s, caps.height - p.y * s);
+        report->validationExactPixels += int64_t(bw) * bh;
+        ++report->validationPixels;
+        mark = 1;
+      }
+      v.pixels.push_back(p);
+      v.weights.push_back(more.weights[k]);
+      v.exact.push_back(more.exact[k]);
+    }
+    return Status::Ok();
+  };
+  if (Status st = drawMore(); !st.ok()) {
     if (cache.BudgetHit())
       return Status::Error("--budget " + Num(goal.budget) + ": too small for the validation pixels");
     return st;
   }
-  report->validationPixels = int64_t(v.pixels.size());
-  report->validationExactPixels = v.workPixels;
   report->totalPixels = total;
 
   // What every run cost, refused ones included.
@@ -353,7 +384,9 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   };
 
   const bool rules = UsesSupersampledRules(options, caps);
-  const double t0 = (limit > 0 ? kStartFactorBudget : kStartFactor) * double(options.ContrastThresholdFor(rules));
+  // Contrasts are at most 1 but for the display-weighted metric's brightest sets.
+  const double t0 = limit > 0 ? std::min(kStartFactorBudget * double(options.ContrastThresholdFor(rules)), 1.0)
+                              : kStartFactor * double(options.ContrastThresholdFor(rules));
   auto meets = [&](const Run& r) { return goal.targetPsnr > 0 && r.estimate.low >= goal.targetPsnr; };
 
   std::optional<Run> best, tried;
@@ -361,13 +394,30 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   double lastT = 0, lastLow = kNaN, lastUsed = 0;
   std::optional<double> refused;  // the largest threshold the budget refused (-1: the full evaluation)
   for (;;) {
+    // A run of the descent after the first may spend only part of what is
+    // left: one the budget refuses leaves the rest to the bisection below.
+    if (limit > 0 && best) {
+      const int64_t used = cache.Distinct();
+      cache.SetLimit(used + int64_t(kDescentShare * double(limit - used)));
+    }
     DCM_RETURN_IF_ERROR(runAt(t, &tried));
     if (!tried) {
       refused = t;
       break;
     }
-    const double low = tried->estimate.low;
     best = std::move(tried);
+    // The point estimate reaches the target but its bound does not: the
+    // validation is too small for how the error is spread (a few pixels
+    // carry most of it). More draws before more samples of the image.
+    while (goal.targetPsnr > 0 && !meets(*best) && best->estimate.psnr >= goal.targetPsnr && draws < kMaxDraws) {
+      cache.ClearBudgetHit();
+      if (Status st = drawMore(); !st.ok()) {
+        if (cache.BudgetHit()) break;
+        return st;
+      }
+      best->estimate = EstimateAt(v, goal, best->rec.image, best->rec.width);
+    }
+    const double low = best->estimate.low;
     if (meets(*best) || t < 0) break;
     if (t <= kMinThreshold) {
       // The threshold cannot go lower: the full evaluation reaches any target.
@@ -392,6 +442,7 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
     lastUsed = used;
     t = std::max(kMinThreshold, t * std::clamp(step, kMinStep, kMaxStep));
   }
+  cache.SetLimit(limit);
   if (!best) {
     // The first run did not fit: try thresholds above it (fewer edge blocks).
     for (double up = t0 * 4; !best && up <= t0 * 1024; up *= 4) {

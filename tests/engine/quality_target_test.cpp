@@ -69,7 +69,7 @@ TEST(QualityTarget, TargetIsMetWithEachPixelEvaluatedOnce) {
 
 TEST(QualityTarget, BudgetIsNeverExceeded) {
   const int N = 256;
-  for (double budget : {0.05, 0.08, 0.2}) {
+  for (double budget : {0.03, 0.08, 0.2}) {
     AnalyticProvider provider(N, N, FurnishedScene(N, N));
     QualityGoal goal;
     goal.budget = budget;
@@ -84,18 +84,18 @@ TEST(QualityTarget, BudgetIsNeverExceeded) {
 }
 
 TEST(QualityTarget, BudgetBelowTheCoarsestRunIsAnErrorWithinTheBudget) {
-  // 3 % of 256^2: the corners of the 16-pixel blocks, their centre probes and
-  // the validation need more.
+  // 1 % of 256^2 (655 pixels): the coarsest run alone needs about 1000 (the
+  // corners of the 16-pixel blocks, their centre probes, the blocks they split).
   const int N = 256;
   AnalyticProvider provider(N, N, FurnishedScene(N, N));
   QualityGoal goal;
-  goal.budget = 0.03;
+  goal.budget = 0.01;
   Reconstruction rec;
   QualityReport report;
   const Status st = ReconstructToQuality(provider, ReconstructionOptions{}, goal, &rec, &report);
   EXPECT_FALSE(st.ok());
   EXPECT_NE(st.message().find("--budget"), std::string::npos) << st.message();
-  EXPECT_LE(provider.TotalEvaluations(), int64_t(0.03 * N * N));
+  EXPECT_LE(provider.TotalEvaluations(), int64_t(0.01 * N * N));
 }
 
 TEST(QualityTarget, UnreachableTargetReportsWhatTheBudgetReached) {
@@ -135,8 +135,10 @@ TEST(QualityTarget, ProgressiveLevelsCarryAnEstimate) {
   const Outcome r = RunGoal(provider, o, goal);
   ASSERT_FALSE(r.report.levels.empty());
   EXPECT_GE(calls, int(r.report.levels.size()));
-  // The last level is the result.
-  EXPECT_DOUBLE_EQ(r.report.levels.back().estimate.psnr, r.report.estimate.psnr);
+  // Each level refines the one before: its estimate is no worse (the same
+  // validation pixels, more exact samples).
+  for (size_t k = 1; k < r.report.levels.size(); ++k)
+    EXPECT_GE(r.report.levels[k].estimate.psnr, r.report.levels[k - 1].estimate.psnr - 0.5) << "level " << k;
 }
 
 TEST(QualityTarget, BadGoalsNameTheFlag) {
