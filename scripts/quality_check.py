@@ -26,8 +26,13 @@ SCENES = {
 }
 
 
-def render(dcm, scene, out, common, extra):
+def render(dcm, scene, out, common, extra, reuse=False):
+    """One `dcm render`; its --stats. `reuse`: an existing result (the full
+    render, the sweep: they do not depend on the quality loop) is read back."""
     stats = out + ".json"
+    if reuse and os.path.exists(stats) and os.path.exists(out + ".exr"):
+        with open(stats) as f:
+            return json.load(f)
     cmd = [dcm, "render", scene, "-o", out + ".exr", "--stats", stats, "-q"] + common + extra
     subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
     with open(stats) as f:
@@ -67,11 +72,11 @@ def main():
         scene = SCENES[name]
         base = os.path.join(a.outdir, f"{name}_{a.size}_{a.supersampling}")
         ref = base + "_full"
-        render(a.dcm, scene, ref, common, ["--full"])
+        render(a.dcm, scene, ref, common, ["--full"], reuse=True)
         cmp_ = ["--compare", ref + ".exr"]
         sweep = []
         for t in THRESHOLDS:
-            s = render(a.dcm, scene, f"{base}_t{t:g}", common, cmp_ + ["--threshold", f"{t:g}"])
+            s = render(a.dcm, scene, f"{base}_t{t:g}", common, cmp_ + ["--threshold", f"{t:g}"], reuse=True)
             s["threshold"] = t
             sweep.append(s)
         meeting = [s for s in sweep if s["reference"]["psnr"] >= a.target]

@@ -76,8 +76,8 @@ struct QualityReport {
   double exactFraction() const { return totalPixels ? double(exactPixels) / double(totalPixels) : 0.0; }
 };
 
-/// Reconstructs with the contrast threshold that `goal` calls for: from four
-/// times the options' threshold (sixteen with a budget) down, until the
+/// Reconstructs with the contrast threshold that `goal` calls for: from the
+/// options' threshold (sixteen times it, at most 1, with a budget) down, until the
 /// estimate's lower bound reaches goal.targetPsnr or the next run would exceed
 /// the budget (then bisected between the two). The
 /// provider is evaluated at most once per pixel across the runs. Every other
