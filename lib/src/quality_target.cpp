@@ -188,7 +188,7 @@ struct Validation {
 /// cells over the output image (stratified: no region goes unchecked).
 std::vector<Point2i> DrawValidation(int outW, int outH, int64_t count, uint64_t seed, std::vector<double>* weights) {
   const double area = double(outW) * double(outH);
-  const int cell = std::max(1, int(std::floor(std::sqrt(area / double(std::max<int64_t>(1, count))))));
+  const int cell = std::max(1, int(std::lround(std::sqrt(area / double(std::max<int64_t>(1, count))))));
   SplitMix64 rng{seed};
   std::vector<Point2i> out;
   for (int y0 = 0; y0 < outH; y0 += cell) {
