@@ -10,11 +10,13 @@
 #include <limits>
 #include <mutex>
 #include <new>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "dcm/option_names.h"
+#include "dcm/quality_target.h"
 #include "dcm/reconstructor.h"
 #include "dcm/round_schedule.h"
 
@@ -53,10 +55,12 @@ struct DCMReconstructorImpl {
   int maxRounds = 3;
   int previewWidth = 0, previewHeight = 0;
   std::vector<dcm::RGB> previewL, previewLi, previewLc;
+  double targetPsnr = 0, budget = 0;  ///< "target_psnr", "budget" (0: none; dcm/quality_target.h)
 
   bool hasResult = false;
   dcm::Reconstruction result;
   dcm::PreviewScheduleStats schedule;
+  std::optional<dcm::QualityReport> quality;  ///< of the last result, with a target or budget
   std::vector<uint8_t> sampleMap;
 
   std::mutex errorMutex;
@@ -363,7 +367,15 @@ DCM_API void dcmSetInt(DCMReconstructor r, const char* name, int value) {
 DCM_API void dcmSetFloat(DCMReconstructor r, const char* name, float value) {
   if (!CheckArgs(r, name, "dcmSetFloat")) return;
   Guard(r, "dcmSetFloat", [&] {
-    if (float* f = dcm::FindFloatOption(r->options, name)) {
+    const std::string_view n(name);
+    if (n == "target_psnr" || n == "budget") {
+      const float hi = n == "budget" ? 1.f : 99.f;
+      if (!(value >= 0.f && value <= hi))
+        return SetError(r, DCM_ERROR_INVALID_ARGUMENT,
+                        std::string("option ") + name + ": must be in (0, " + (n == "budget" ? "1]" : "99] dB") +
+                            " (0: none), got " + std::to_string(value));
+      (n == "budget" ? r->budget : r->targetPsnr) = double(value);
+    } else if (float* f = dcm::FindFloatOption(r->options, name)) {
       *f = value;
     } else if (int* p = dcm::FindIntOption(r->options, name)) {
       if (!(std::nearbyint(value) == value) || std::fabs(value) > 1e9f)
@@ -399,7 +411,9 @@ DCM_API float dcmGetFloat(DCMReconstructor r, const char* name) {
   if (!CheckArgs(r, name, "dcmGetFloat")) return 0.f;
   float result = 0.f;
   Guard(r, "dcmGetFloat", [&] {
-    if (float* f = dcm::FindFloatOption(r->options, name)) result = *f;
+    if (std::string_view(name) == "target_psnr") result = float(r->targetPsnr);
+    else if (std::string_view(name) == "budget") result = float(r->budget);
+    else if (float* f = dcm::FindFloatOption(r->options, name)) result = *f;
     else if (int* p = dcm::FindIntOption(r->options, name)) result = float(*p);
     else SetError(r, DCM_ERROR_INVALID_ARGUMENT, UnknownOption("float", name));
   });
@@ -561,8 +575,17 @@ DCM_API DCMError dcmExecute(DCMReconstructor r) {
       };
     }
     r->schedule = {};
+    r->quality.reset();
     dcm::Status st;
-    if (!r->previewL.empty() && dcm::ChooseSchedule(r->roundCost) == dcm::RoundSchedule::kPreview) {
+    if (r->targetPsnr > 0 || r->budget > 0) {
+      // A quality goal runs the engine level by level (its runs share one sample cache).
+      dcm::QualityGoal goal;
+      goal.targetPsnr = r->targetPsnr;
+      goal.budget = r->budget;
+      dcm::QualityReport report;
+      st = dcm::ReconstructToQuality(provider, options, goal, &r->result, &report);
+      if (st.ok()) r->quality = std::move(report);
+    } else if (!r->previewL.empty() && dcm::ChooseSchedule(r->roundCost) == dcm::RoundSchedule::kPreview) {
       dcm::ImagePreviewProvider preview(r->width, r->height, r->previewWidth, r->previewHeight, r->previewL,
                                         r->previewLi, r->previewLc);
       dcm::PreviewScheduleOptions schedule;
@@ -648,6 +671,16 @@ DCM_API double dcmGetStat(DCMReconstructor r, const char* name) {
   if (n == "time_engine_s") return s.timeEngineS;
   if (n == "rounds") return double(r->schedule.rounds);
   if (n == "preview_stand_ins") return double(r->schedule.previewStandIns);
+  if (r->quality) {
+    const dcm::QualityReport& q = *r->quality;
+    if (n == "estimated_psnr") return q.estimate.psnr;
+    if (n == "estimated_psnr_low") return q.estimate.low;
+    if (n == "estimated_psnr_high") return q.estimate.high;
+    if (n == "validation_pixels") return double(q.validationPixels);
+    if (n == "quality_runs") return double(q.runs);
+    if (n == "target_reached") return q.targetReached ? 1.0 : 0.0;
+    if (n == "budget_bound") return q.budgetBound ? 1.0 : 0.0;
+  }
   Guard(r, "dcmGetStat", [&] { SetError(r, DCM_ERROR_INVALID_ARGUMENT, "dcmGetStat: unknown statistic '" + std::string(n) + "'"); });
   return 0.0;
 }

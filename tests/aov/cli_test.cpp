@@ -453,6 +453,104 @@ INSTANTIATE_TEST_SUITE_P(BeautyAndSplit, PlanRoundTrip, ::testing::Combine(::tes
                                   std::to_string(std::get<1>(p.param));
                          });
 
+// --target-psnr through `dcm plan` rounds: the validation pixels, then each
+// run of the search, are asked for as the engine's own samples are; the
+// result is the dense run's, bit for bit, with the same estimate.
+TEST(DcmPlan, RoundTripToATargetMatchesDense) {
+  ScratchDir dir;
+  Scene sc{72, 56};
+  WriteExr(dir / "dense.exr", sc.width, sc.height, sc.GenericChannels(false));
+  WriteExr(dir / "guides.exr", sc.width, sc.height, sc.GenericChannels(false, /*guidesOnly=*/true));
+  const std::vector<std::string> engine = {"--threads", "2", "--quiet", "--target-psnr", "20"};
+  auto dense = engine;
+  dense.insert(dense.begin(), {"reconstruct", dir / "dense.exr", "-o", dir / "dense_out.exr", "--stats", dir / "dense.json"});
+  auto r = RunDcm(dense, dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  std::vector<std::string> samples;
+  std::set<std::pair<int, int>> rendered;
+  bool done = false;
+  for (int round = 0; round < 256 && !done; ++round) {
+    std::vector<std::string> plan = {"plan", dir / "guides.exr", "--list", dir / "next.txt"};
+    for (const auto& s : samples) plan.insert(plan.end(), {"--samples", s});
+    plan.insert(plan.end(), engine.begin(), engine.end());
+    r = RunDcm(plan, dir);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    done = r.out == "done\n";
+    if (done) break;
+    const std::string s = dir / ("samples_" + std::to_string(round) + ".exr");
+    RenderList(sc, false, dir / "next.txt", s, &rendered);
+    samples.push_back(s);
+  }
+  ASSERT_TRUE(done) << "plan did not finish in 256 rounds";
+  std::printf("plan to a target: %zu rounds\n", samples.size());
+  std::vector<std::string> rec = {"reconstruct", dir / "guides.exr", "-o", dir / "sparse_out.exr", "--stats", dir / "sparse.json"};
+  for (const auto& s : samples) rec.insert(rec.end(), {"--samples", s});
+  rec.insert(rec.end(), engine.begin(), engine.end());
+  r = RunDcm(rec, dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const auto a = ReadRgbExr(dir / "dense_out.exr"), b = ReadRgbExr(dir / "sparse_out.exr");
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(RGB)), 0) << "not bit-identical";
+  const auto ds = ReadJson(dir / "dense.json"), ss = ReadJson(dir / "sparse.json");
+  EXPECT_EQ(ds["estimated_psnr"], ss["estimated_psnr"]);
+  EXPECT_EQ(ds["quality"]["exact_pixels"], ss["quality"]["exact_pixels"]);
+  // Every pixel rendered was needed: the plan asked for no more than the dense run evaluated.
+  EXPECT_EQ(int64_t(rendered.size()), int64_t(ds["quality"]["exact_pixels"]));
+}
+
+TEST(DcmReconstruct, TargetPsnrReportsTheEstimateBesideTheTruth) {
+  ScratchDir dir;
+  Scene sc{64, 48};
+  WriteExr(dir / "in.exr", sc.width, sc.height, sc.GenericChannels(true));
+  auto r = RunDcm({"reconstruct", dir / "in.exr", "-o", dir / "out.exr", "--stats", dir / "s.json", "--threads", "2",
+                   "--target-psnr", "40", "-v"},
+                  dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("estimated PSNR"));  // -v
+  const auto s = ReadJson(dir / "s.json");
+  ASSERT_TRUE(s.contains("estimated_psnr"));
+  EXPECT_EQ(double(s["estimated_psnr_confidence"]), 0.9);
+  EXPECT_TRUE(bool(s["quality"]["target_reached"]));
+  EXPECT_EQ(double(s["quality"]["target_psnr"]), 40.0);
+  EXPECT_TRUE(s["quality"]["budget"].is_null());
+  // The whole search's cost is the run's: every pixel evaluated, validation included.
+  EXPECT_EQ(s["exact_pixels"], s["quality"]["exact_pixels"]);
+  EXPECT_GT(int64_t(s["quality"]["validation_pixels"]), 0);
+  // Dense input: the truth beside the estimate, and it meets the target.
+  ASSERT_TRUE(s.contains("reference"));
+  if (!s["reference"]["psnr"].is_null()) {
+    EXPECT_GE(double(s["reference"]["psnr"]), 39.5);
+  }
+  auto in = OIIO::ImageInput::open(dir / "out.exr");
+  ASSERT_TRUE(in);
+  if (!s["estimated_psnr"].is_null()) {
+    EXPECT_FLOAT_EQ(in->spec().get_float_attribute("dcm:estimated_psnr", -1.f), float(s["estimated_psnr"]));
+  }
+}
+
+TEST(DcmReconstruct, TargetAndBudgetFlagsAreChecked) {
+  ScratchDir dir;
+  Scene sc{32, 32};
+  WriteExr(dir / "in.exr", sc.width, sc.height, sc.GenericChannels(false));
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"--target-psnr", "0"}, "--target-psnr"},
+      {{"--target-psnr", "120"}, "--target-psnr"},
+      {{"--budget", "0"}, "--budget"},
+      {{"--budget", "1.5"}, "--budget"},
+      {{"--target-psnr", "40", "--threshold", "0.1"}, "--target-psnr: not with --threshold"},
+      {{"--budget", "0.5", "--full"}, "--budget: not with --full"},
+      {{"--budget", "0.5", "--tile", "0/2"}, "--target-psnr and --budget estimate the whole frame"},
+  };
+  for (const auto& [flags, message] : cases) {
+    std::vector<std::string> args = {"reconstruct", dir / "in.exr", "-o", dir / "out.exr", "--quiet"};
+    args.insert(args.end(), flags.begin(), flags.end());
+    const auto r = RunDcm(args, dir);
+    EXPECT_EQ(r.exitCode, 2) << flags.front() << ": " << r.err;
+    EXPECT_THAT(r.err, HasSubstr(message));
+    EXPECT_FALSE(fs::exists(dir / "out.exr"));
+  }
+}
+
 // A farm's round trip: each tile plans and renders its own part (its window,
 // halo included) until its plan is done; the tiles reconstructed from all the
 // samples and merged are the dense frame, bit for bit.

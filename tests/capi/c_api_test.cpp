@@ -291,6 +291,27 @@ TEST(CApi, RoundCostPlansOnThePreviewInFewCalls) {
   dcmReleaseReconstructor(b);
 }
 
+TEST(CApi, TargetAndBudgetReportTheEstimateAndStayWithinTheBudget) {
+  Scene scene;
+  DCMReconstructor r = Make(scene);
+  dcmSetFloat(r, "target_psnr", 40.f);
+  dcmSetFloat(r, "budget", 0.4f);
+  EXPECT_EQ(dcmGetFloat(r, "target_psnr"), 40.f);
+  ASSERT_EQ(dcmExecute(r), DCM_ERROR_NONE) << TakeError(r);
+  // The ramp is reconstructed exactly: no validation pixel errs (+inf dB).
+  EXPECT_GE(dcmGetStat(r, "estimated_psnr_low"), 40.0);
+  EXPECT_EQ(dcmGetStat(r, "target_reached"), 1.0);
+  EXPECT_GT(dcmGetStat(r, "validation_pixels"), 1.0);
+  // Every pixel evaluated (validation included) is counted once, within the budget.
+  EXPECT_EQ(double(scene.evaluated.load()), dcmGetStat(r, "exact_pixels"));
+  EXPECT_LE(dcmGetStat(r, "exact_fraction"), 0.4);
+  dcmSetFloat(r, "target_psnr", 120.f);
+  EXPECT_NE(TakeError(r).find("target_psnr"), std::string::npos);
+  dcmSetFloat(r, "budget", -0.5f);
+  EXPECT_NE(TakeError(r).find("budget"), std::string::npos);
+  dcmReleaseReconstructor(r);
+}
+
 TEST(CApi, FullEvaluationEvaluatesEveryPixel) {
   Scene scene;
   DCMReconstructor r = Make(scene);

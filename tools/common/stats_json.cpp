@@ -1,6 +1,7 @@
 // Statistics and settings as JSON.
 #include "stats_json.h"
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -138,6 +139,35 @@ nlohmann::json RunToJson(const Reconstruction& r, const std::string& method, con
   j["working_resolution"] = {r.workWidth, r.workHeight};
   j["time_wall_s"] = wallS;
   return j;
+}
+
+void AddQualityJson(const QualityReport& r, double targetPsnr, double budget, nlohmann::json* j) {
+  auto orNull = [](double v) { return v > 0 ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  (*j)["estimated_psnr"] = r.estimate.psnr;
+  (*j)["estimated_psnr_low"] = r.estimate.low;
+  (*j)["estimated_psnr_high"] = r.estimate.high;
+  (*j)["estimated_psnr_confidence"] = r.confidence;
+  nlohmann::json levels = nlohmann::json::array();
+  for (const LevelEstimate& l : r.levels)
+    levels.push_back({{"level", l.level}, {"psnr", l.estimate.psnr}, {"low", l.estimate.low}, {"high", l.estimate.high}});
+  (*j)["quality"] = {{"target_psnr", orNull(targetPsnr)},
+                     {"budget", orNull(budget)},
+                     {"target_reached", r.targetReached},
+                     {"budget_bound", r.budgetBound},
+                     {"exact_pixels", r.exactPixels},
+                     {"exact_fraction", r.exactFraction()},
+                     {"validation_pixels", r.validationPixels},
+                     {"validation_exact_pixels", r.validationExactPixels},
+                     {"runs", r.runs},
+                     {"threshold", r.threshold < 0 ? nlohmann::json(nullptr) : nlohmann::json(r.threshold)},
+                     {"levels", levels}};
+}
+
+void AddQualityMetadata(const QualityReport& r, Metadata* m) {
+  for (const auto& [name, v] : {std::pair<const char*, double>{"dcm:estimated_psnr", r.estimate.psnr},
+                                {"dcm:estimated_psnr_low", r.estimate.low},
+                                {"dcm:estimated_psnr_high", r.estimate.high}})
+    if (std::isfinite(v)) m->floats.push_back({name, float(v)});
 }
 
 std::vector<std::string> SampleWarnings(const ReconstructionStats& s) {

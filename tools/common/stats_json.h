@@ -6,10 +6,13 @@
 #include <vector>
 
 #include "dcm/options.h"
+#include "dcm/quality_target.h"
 #include "dcm/reconstructor.h"
 #include "dcm/status.h"
 
 namespace dcm::toolkit {
+
+struct Metadata;
 
 /// The switches of a reconstruction (every field except the progress callback),
 /// with snake_case names and enums by their ToString() names.
@@ -31,6 +34,18 @@ std::string StageTimesLine(const ReconstructionStats& s);
 /// time_wall_s.
 nlohmann::json RunToJson(const Reconstruction& r, const std::string& method, const ReconstructionOptions& o,
                          double wallS);
+
+/// Adds what --target-psnr / --budget delivered to a --stats object:
+/// estimated_psnr, estimated_psnr_low, estimated_psnr_high (the interval at
+/// estimated_psnr_confidence) and quality {target_psnr, budget, target_reached,
+/// budget_bound, exact_pixels, exact_fraction, validation_pixels,
+/// validation_exact_pixels, runs, threshold, levels [{level, psnr, low, high}]};
+/// a target or budget of 0 is null (not asked).
+void AddQualityJson(const QualityReport& report, double targetPsnr, double budget, nlohmann::json* j);
+
+/// Adds dcm:estimated_psnr, dcm:estimated_psnr_low and dcm:estimated_psnr_high
+/// (finite values only) to EXR metadata.
+void AddQualityMetadata(const QualityReport& report, Metadata* metadata);
 
 /// The warnings a run's samples deserve, one sentence each: NaN/Inf samples
 /// (kept to their pixels) and huge finite ones (clamped to kMaxSampleMagnitude).

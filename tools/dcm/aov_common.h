@@ -11,6 +11,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -180,13 +181,20 @@ inline Status ResolvePart(const aov::AovProvider& provider, const TileFlags& til
 /// (ReconstructRegion, which fills `info`).
 inline Status Run(aov::AovProvider& provider, ReconstructionOptions options, const EngineFlags& engine,
                   Reconstruction* result, std::vector<Point2i>* pending, const Bounds2i* region = nullptr,
-                  RegionInfo* info = nullptr) {
+                  RegionInfo* info = nullptr, std::optional<QualityReport>* quality = nullptr) {
+  if (region && (engine.targetPsnr || engine.budget))
+    return Status::Error("--target-psnr and --budget estimate the whole frame; not with --tile or --region");
   toolkit::Progress progress(!engine.quiet);
   options.progress = [&progress](float f, std::string_view stage) { progress.Update(f, stage); };
+  std::optional<QualityReport> report;
   Status st = region ? ReconstructRegion(provider, options, *region, result, info, pending)
-                     : Reconstruct(provider, options, result, pending);
+                     : ReconstructFor(provider, options, engine, result, &report, pending);
   progress.Done();
   if (st.ok() && engine.verbose) std::cerr << toolkit::StageTimesLine(result->stats) << "\n";
+  if (st.ok() && engine.verbose && report) std::cerr << QualityLine(*report, engine) << "\n";
+  if (st.ok() && !engine.quiet && report)
+    if (const std::string w = QualityWarning(*report, engine); !w.empty()) std::cerr << "dcm: warning: " << w << "\n";
+  if (quality) *quality = std::move(report);
   return st;
 }
 

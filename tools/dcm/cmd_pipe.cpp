@@ -59,6 +59,8 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
     return Fail("-d, --compression and --ch shape the whole frame; give them to `dcm merge`", kExitUsage);
   if (partial && !f.engine.progressive.empty())
     return Fail("--progressive needs the whole frame; not with --tile or --region", kExitUsage);
+  if (partial && (f.engine.targetPsnr || f.engine.budget))
+    return Fail("--target-psnr and --budget estimate the whole frame; not with --tile or --region", kExitUsage);
 
   if (Status st = toolkit::CheckOutputs({}, {{"-o", f.output},
                                              {"--stats", f.stats},
@@ -100,7 +102,9 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
   options.progress = [&](float v, std::string_view stage) { progress.Update(v, stage); };
   Reconstruction rec;
   RegionInfo info;
-  Status st = partial ? ReconstructRegion(*provider, options, region, &rec, &info) : Reconstruct(*provider, options, &rec);
+  std::optional<QualityReport> quality;
+  Status st = partial ? ReconstructRegion(*provider, options, region, &rec, &info)
+                      : ReconstructFor(*provider, options, f.engine, &rec, &quality);
   progress.Done();
   if (!st.ok()) return Fail(st.message());
   // The child must end cleanly before anything is written.
@@ -108,6 +112,7 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
   const double wallS = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const ReconstructionStats& stats = rec.stats;
   if (f.engine.verbose) std::cerr << toolkit::StageTimesLine(stats) << "\n";
+  if (f.engine.verbose && quality) std::cerr << QualityLine(*quality, f.engine) << "\n";
   const std::string method = options.fullEvaluation ? "full" : f.engine.method;
 
   toolkit::Metadata meta;
@@ -118,6 +123,7 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
   meta.floats.push_back({"dcm:exact_fraction", float(stats.exactFraction())});
   meta.floats.push_back({"dcm:time_illum_s", float(stats.timeProviderS)});
   meta.floats.push_back({"dcm:time_dcm_s", float(stats.timeEngineS)});
+  if (quality) toolkit::AddQualityMetadata(*quality, &meta);
   if (partial) {
     // What decides the pixels besides the options: the provider command (so
     // every tile must run the same one) and what the provider announced. The
@@ -145,6 +151,7 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
     j["provider_name"] = caps.name;
     j["provider_cmd"] = f.command;
     if (partial) j["part"] = PartJson(tile, info);
+    if (quality) toolkit::AddQualityJson(*quality, f.engine.targetPsnr.value_or(0), f.engine.budget.value_or(0), &j);
     if (Status w = toolkit::WriteJson(f.stats, j); !w.ok()) return Fail(w.message());
   }
   if (Status w = outputs.Commit(); !w.ok()) return Fail(w.message());
@@ -161,6 +168,10 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
   std::printf("  time           provider %.2f s, DCM %.2f s, guides %.2f s, total %.2f s\n", stats.timeProviderS,
               stats.timeEngineS, stats.timeGuidesS, wallS);
   std::printf("  provider calls %lld\n", static_cast<long long>(stats.providerCalls));
+  if (quality) std::printf("  quality        %s\n", QualityLine(*quality, f.engine).c_str());
+  if (quality)
+    if (const std::string w = QualityWarning(*quality, f.engine); !w.empty())
+      std::cerr << "dcm " << cmd << ": warning: " << w << "\n";
   for (const auto& w : toolkit::SampleWarnings(stats)) std::cerr << "dcm " << cmd << ": warning: " << w << "\n";
   return kExitOk;
 }

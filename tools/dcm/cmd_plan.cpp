@@ -107,11 +107,16 @@ int RunPlan(const PlanFlags& f) {
   std::string tile;
   Bounds2i region;
   RegionInfo info;
+  if (IsPartial(f.tiles) && (f.engine.targetPsnr || f.engine.budget))
+    return aov_common::Fail(cmd, "--target-psnr and --budget estimate the whole frame; not with --tile or --region",
+                            kExitUsage);
+  std::optional<QualityReport> quality;
   if (IsPartial(f.tiles)) {
     st = aov_common::ResolvePart(*provider, f.tiles, options, "guides", &region, &tile);
     if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
   }
-  st = aov_common::Run(*provider, options, f.engine, &r, &pending, IsPartial(f.tiles) ? &region : nullptr, &info);
+  st = aov_common::Run(*provider, options, f.engine, &r, &pending, IsPartial(f.tiles) ? &region : nullptr, &info,
+                       &quality);
   if (!st.ok() && !st.pending()) return aov_common::Fail(cmd, st.message());
   const bool done = st.ok();
   std::vector<Point2i> next;
@@ -146,6 +151,8 @@ int RunPlan(const PlanFlags& f) {
       if (!done) j["part"].erase("window_stats");  // the engine did not finish the window
     }
     else if (done) j["result"] = toolkit::StatsToJson(r.stats);
+    if (done && quality)
+      toolkit::AddQualityJson(*quality, f.engine.targetPsnr.value_or(0), f.engine.budget.value_or(0), &j["result"]);
     if ((rc = outputs.Write(toolkit::WriteJson(f.stats, j)))) return rc;
   }
   if ((rc = outputs.Commit())) return rc;

@@ -234,6 +234,9 @@ int RunReconstruct(const ReconstructFlags& f) {
   if (!st.ok()) return aov_common::Fail(cmd, st.message());
   st = CheckDownsample(provider->width(), provider->height(), options.downsample, "the inputs' data window");
   if (!st.ok()) return aov_common::Fail(cmd, st.message(), kExitUsage);
+  if (IsPartial(f.tiles) && (f.engine.targetPsnr || f.engine.budget))
+    return aov_common::Fail(cmd, "--target-psnr and --budget estimate the whole frame; not with --tile or --region",
+                            kExitUsage);
   if (IsPartial(f.tiles)) return RunReconstructPart(g, options, *provider);
   // The output's channels are known from the headers: --ch is checked
   // before the engine runs.
@@ -257,6 +260,7 @@ int RunReconstruct(const ReconstructFlags& f) {
   toolkit::Metadata meta = ProvenanceMetadata(f, *provider, options);
   meta.floats.push_back({"dcm:exact_fraction", float(r.stats.exactFraction())});
   if (haveRef && std::isfinite(error.psnr)) meta.floats.push_back({"dcm:psnr", float(error.psnr)});
+  if (run.quality) toolkit::AddQualityMetadata(*run.quality, &meta);
 
   // All outputs appear together at Commit(), or none.
   toolkit::OutputImage image;
@@ -280,6 +284,7 @@ int RunReconstruct(const ReconstructFlags& f) {
       << " exact pixels (" << std::fixed << std::setprecision(2) << 100.0 * r.stats.exactFraction()
       << " %)";
     if (haveRef) s << ", PSNR " << PsnrText(error.psnr) << ", RMSE " << std::setprecision(5) << error.rmse;
+    if (run.quality) s << ", estimated PSNR " << PsnrText(run.quality->estimate.psnr);
     s << ", engine " << std::setprecision(3) << r.stats.timeEngineS << " s -> " << f.output;
     std::cout << s.str() << "\n";
     for (const auto& w : toolkit::SampleWarnings(r.stats)) std::cerr << "dcm " << cmd << ": warning: " << w << "\n";

@@ -87,12 +87,15 @@ struct Run {
   Reconstruction rec;
   double wallS = 0;
   embree::RayCounts rays;
+  std::optional<QualityReport> quality;  ///< with --target-psnr / --budget
 };
 
-Status RunOnce(embree::EmbreeProvider& provider, const ReconstructionOptions& options, Run* run) {
+/// One reconstruction as `engine` asks (to a target or budget when given).
+Status RunOnce(embree::EmbreeProvider& provider, const ReconstructionOptions& options, const EngineFlags& engine,
+               Run* run) {
   provider.ResetRayCounts();
   auto t0 = std::chrono::steady_clock::now();
-  Status st = Reconstruct(provider, options, &run->rec);
+  Status st = ReconstructFor(provider, options, engine, &run->rec, &run->quality);
   run->wallS = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   run->rays = provider.rayCounts();
   return st;
@@ -126,6 +129,8 @@ int RunRenderPart(const RenderFlags& f, const embree::Scene& scene, Reconstructi
     return usage("--with-reference, --reference-out and --compare need the whole frame; not with --tile or "
                  "--region (compare the merged frame)");
   if (!f.engine.progressive.empty()) return usage("--progressive needs the whole frame; not with --tile or --region");
+  if (f.engine.targetPsnr || f.engine.budget)
+    return usage("--target-psnr and --budget estimate the whole frame; not with --tile or --region");
   const ProviderCapabilities caps = provider.Capabilities();
   const Point2i frame = OutputSize(caps.width, caps.height, options.downsample);
   Bounds2i region;
@@ -286,17 +291,18 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
     fo.fullEvaluation = true;
     fo.progress = [&](float v, std::string_view stage) { progress.Update(v, "full render: " + std::string(stage)); };
     Run r;
-    if (Status st = RunOnce(*provider, fo, &r); !st.ok()) return Fail(st);
+    if (Status st = RunOnce(*provider, fo, EngineFlags{}, &r); !st.ok()) return Fail(st);
     full = std::move(r);
   }
 
   options.progress = [&](float v, std::string_view stage) { progress.Update(v, stage); };
   Run run;
-  if (Status st = RunOnce(*provider, options, &run); !st.ok()) return Fail(st);
+  if (Status st = RunOnce(*provider, options, f.engine, &run); !st.ok()) return Fail(st);
   progress.Done();
   const Reconstruction& rec = run.rec;
   const ReconstructionStats& stats = rec.stats;
   if (f.engine.verbose) std::cerr << toolkit::StageTimesLine(stats) << "\n";
+  if (f.engine.verbose && run.quality) std::cerr << QualityLine(*run.quality, f.engine) << "\n";
   if (full && !reference) reference = full->rec.image;
 
   const std::string method = options.fullEvaluation ? "full" : f.engine.method;
@@ -305,6 +311,7 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
   meta.floats.push_back({"dcm:exact_fraction", float(stats.exactFraction())});
   meta.floats.push_back({"dcm:time_illum_s", float(stats.timeProviderS)});
   meta.floats.push_back({"dcm:time_dcm_s", float(stats.timeEngineS)});
+  if (run.quality) toolkit::AddQualityMetadata(*run.quality, &meta);
   const Bounds2i whole{{0, 0}, {rec.width, rec.height}};
   if (Status st = toolkit::WriteRgbExr(f.output, whole, whole, rec.image, meta, false, f.exr); !st.ok())
     return Fail(st);
@@ -335,6 +342,8 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
     j["effects"] = effects;
     j["rays"] = RaysToJson(run.rays);
     if (error) j["reference"] = ErrorToJson(*error);
+    if (run.quality)
+      toolkit::AddQualityJson(*run.quality, f.engine.targetPsnr.value_or(0), f.engine.budget.value_or(0), &j);
     if (!f.preview.empty()) j["preview_transform"] = displayText;
     if (full) {
       j["full"] = {{"time_illum_s", full->rec.stats.timeProviderS},
@@ -357,7 +366,11 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
               static_cast<unsigned long long>(run.rays.total()), static_cast<unsigned long long>(run.rays.shadow),
               static_cast<unsigned long long>(run.rays.glossy), static_cast<unsigned long long>(run.rays.mirror),
               static_cast<unsigned long long>(run.rays.indirect));
+  if (run.quality) std::printf("  quality        %s\n", QualityLine(*run.quality, f.engine).c_str());
   for (const auto& w : toolkit::SampleWarnings(stats)) std::cerr << "dcm render: warning: " << w << "\n";
+  if (run.quality)
+    if (const std::string w = QualityWarning(*run.quality, f.engine); !w.empty())
+      std::cerr << "dcm render: warning: " << w << "\n";
   if (full) {
     std::printf("  full render    illumination %.2f s, total %.2f s, %llu rays\n", full->rec.stats.timeProviderS,
                 full->wallS, static_cast<unsigned long long>(full->rays.total()));

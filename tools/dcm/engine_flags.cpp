@@ -83,6 +83,14 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
         ->transform(PowerOfTwo(4, 64))
         ->default_str(G(d.directions));
     app->add_flag("--full", f->full, "evaluate every pixel exactly (the baseline)");
+    app->add_option("--target-psnr", f->targetPsnr,
+                    "refine until the estimated display-referred PSNR against the full render reaches DB (its 95 % "
+                    "lower bound; the threshold is chosen; docs/QUALITY.md)")
+        ->transform(FiniteNumber(0, 99, /*above=*/true));
+    app->add_option("--budget", f->budget,
+                    "evaluate at most this share of the pixels exactly, validation included (with --target-psnr: "
+                    "whichever binds first)")
+        ->transform(FiniteNumber(0, 1, /*above=*/true));
   }
   {
     InGroup g(app, kGroupGuides);
@@ -219,7 +227,54 @@ std::string SettingsSummary(const ReconstructionOptions& o, const ProviderCapabi
          "); smooth blocks: " + refine;
 }
 
+bool QualityGoalOf(const EngineFlags& f, QualityGoal* goal) {
+  *goal = QualityGoal{};
+  if (f.targetPsnr) goal->targetPsnr = *f.targetPsnr;
+  if (f.budget) goal->budget = *f.budget;
+  return f.targetPsnr || f.budget;
+}
+
+Status ReconstructFor(SampleProvider& provider, const ReconstructionOptions& options, const EngineFlags& flags,
+                      Reconstruction* out, std::optional<QualityReport>* quality, std::vector<Point2i>* pending) {
+  quality->reset();
+  QualityGoal goal;
+  if (!QualityGoalOf(flags, &goal)) return Reconstruct(provider, options, out, pending);
+  QualityReport report;
+  DCM_RETURN_IF_ERROR(ReconstructToQuality(provider, options, goal, out, &report, pending));
+  *quality = std::move(report);
+  return Status::Ok();
+}
+
+std::string QualityLine(const QualityReport& r, const EngineFlags& f) {
+  char buf[512];
+  const PsnrEstimate& e = r.estimate;
+  std::string target;
+  if (f.targetPsnr) target = "; --target-psnr " + G(*f.targetPsnr) + (r.targetReached ? " reached" : " NOT reached");
+  if (r.budgetBound) target += "; --budget " + G(*f.budget) + " bound";
+  std::snprintf(buf, sizeof buf,
+                "estimated PSNR %.2f dB (%.0f %% interval %.2f to %.2f%s), %.2f %% exact pixels in %d runs "
+                "(validation %.2f %%), threshold %s",
+                e.psnr, 100 * r.confidence, e.low, e.high, target.c_str(), 100 * r.exactFraction(), r.runs,
+                r.totalPixels ? 100.0 * double(r.validationExactPixels) / double(r.totalPixels) : 0.0,
+                r.threshold < 0 ? "none (full evaluation)" : G(r.threshold).c_str());
+  return buf;
+}
+
+std::string QualityWarning(const QualityReport& r, const EngineFlags& f) {
+  if (r.targetReached || !f.targetPsnr) return "";
+  const std::string within = r.budgetBound && f.budget ? " within --budget " + G(*f.budget) : "";
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "--target-psnr %s: not reached%s; estimated %.2f dB (lower bound %.2f) at %.2f %% exact pixels",
+                G(*f.targetPsnr).c_str(), within.c_str(), r.estimate.psnr, r.estimate.low, 100 * r.exactFraction());
+  return buf;
+}
+
 Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {
+  if ((f.targetPsnr || f.budget) && (f.threshold || f.full)) {
+    const std::string goal = f.targetPsnr ? "--target-psnr" : "--budget";
+    return Status::Error(goal + ": not with " + (f.full ? "--full" : "--threshold") +
+                         " (the target or the budget chooses the threshold)");
+  }
   if (f.method == "paper") *o = ReconstructionOptions::Paper();
   else if (f.method == "guo") *o = ReconstructionOptions::Guo();
   else *o = ReconstructionOptions{};

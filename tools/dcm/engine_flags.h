@@ -6,6 +6,7 @@
 #include <string>
 
 #include "dcm/options.h"
+#include "dcm/quality_target.h"
 #include "dcm/reconstructor.h"
 #include "dcm/round_schedule.h"
 #include "dcm/status.h"
@@ -17,6 +18,7 @@ namespace dcm::cli {
 struct EngineFlags {
   std::string method = "dcm";  ///< dcm | paper | guo
   std::optional<float> threshold, noiseSignificance, creaseAngle, probeLcShare;
+  std::optional<double> targetPsnr, budget;  ///< --target-psnr, --budget (dcm/quality_target.h)
   std::optional<int> block, minBlock, directions, tile;
   std::optional<int> neighbourDirections, fallbackShadingChanges, crossingFill, simpleSurfaceChanges;
   int downsample = 1;
@@ -64,6 +66,24 @@ Status CheckDownsample(int width, int height, int n, const std::string& what);
 
 /// The options the flags select. The message names the flag at fault.
 Status ToOptions(const EngineFlags& flags, ReconstructionOptions* options);
+
+/// The goal --target-psnr and --budget ask for; false when neither is given.
+bool QualityGoalOf(const EngineFlags& flags, QualityGoal* goal);
+
+/// Reconstructs `provider` as the flags ask: to --target-psnr / --budget
+/// (dcm::ReconstructToQuality, `quality` filled) or with the threshold
+/// (dcm::Reconstruct, `quality` reset).
+Status ReconstructFor(SampleProvider& provider, const ReconstructionOptions& options, const EngineFlags& flags,
+                      Reconstruction* out, std::optional<QualityReport>* quality,
+                      std::vector<Point2i>* pending = nullptr);
+
+/// "estimated PSNR 40.8 dB (90 % interval 40.3 to 41.4; --target-psnr 40
+/// reached), 6.12 % exact pixels in 7 runs (validation 1.00 %), threshold
+/// 0.061", for -v and the summaries.
+std::string QualityLine(const QualityReport& report, const EngineFlags& flags);
+
+/// The warning of a --target-psnr that was not reached, empty when it was.
+std::string QualityWarning(const QualityReport& report, const EngineFlags& flags);
 
 /// For -v: the settings that depend on the supersampling and on the
 /// provider, as the engine will use them on a provider with `caps`

@@ -88,7 +88,7 @@ Status ReconstructWholeExr(const std::string& cmd, aov::AovProvider& provider, c
   Reconstruction& r = out->result;
   std::vector<Point2i> pending;
   const auto t0 = std::chrono::steady_clock::now();
-  const Status st = aov_common::Run(provider, options, engine, &r, &pending);
+  const Status st = aov_common::Run(provider, options, engine, &r, &pending, nullptr, nullptr, &out->quality);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (st.pending()) return Status::Error(MissingSamplesMessage(provider, pending, ""));
   DCM_RETURN_IF_ERROR(st);
@@ -115,6 +115,8 @@ Status ReconstructWholeExr(const std::string& cmd, aov::AovProvider& provider, c
                                 {"texture", caps.texture},    {"split_radiance", caps.splitRadiance},
                                 {"variance", caps.variance},  {"hard_shadows_guided", caps.hardShadowsGuided}};
   if (out->haveReference) out->stats["reference"] = ErrorJson(out->error);
+  if (out->quality)
+    toolkit::AddQualityJson(*out->quality, engine.targetPsnr.value_or(0), engine.budget.value_or(0), &out->stats);
   return Status::Ok();
 }
 

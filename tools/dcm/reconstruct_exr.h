@@ -48,6 +48,7 @@ struct ExrReconstruction {
   std::vector<RGB> reference;     ///< --reference, or the full input (dense), at the output resolution
   toolkit::ImageError error;
   nlohmann::json stats;           ///< what --stats writes
+  std::optional<QualityReport> quality;  ///< with --target-psnr / --budget
 };
 
 /// Reconstructs the whole frame of `provider` as `dcm reconstruct` does:

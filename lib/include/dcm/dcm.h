@@ -181,8 +181,12 @@ DCM_API void dcmSetInt(DCMReconstructor r, const char* name, int value);
  *  rules, default 0.15), "noise_significance" (with a
  *  provider that reports variance), "probe_lc_share" (a finest edge block
  *  whose border changes only at surface changes is probed only where L_c
- *  exceeds this share of L at some border pixel, default 0.5). Integer
- *  options accept whole
+ *  exceeds this share of L at some border pixel, default 0.5),
+ *  "target_psnr" (dB in (0, 99]: refine until the estimated display-referred
+ *  PSNR against the full render, its 95 % lower bound, reaches it; the
+ *  threshold is then chosen; 0, the default: none) and "budget" (share of
+ *  the working pixels in (0, 1] evaluated at most, validation included; 0:
+ *  none); docs/QUALITY.md. Integer options accept whole
  *  numbers here too. */
 DCM_API void dcmSetFloat(DCMReconstructor r, const char* name, float value);
 
@@ -287,7 +291,11 @@ DCM_API const uint8_t* dcmGetSampleMap(DCMReconstructor r, int* width, int* heig
  *  "smooth_blocks", "simple_edge_blocks", "complex_edge_blocks",
  *  "fallback_blocks", "time_provider_s", "time_guides_s", "time_engine_s",
  *  "rounds" (calls planned on the preview; 0 without), "preview_stand_ins"
- *  (since API version 3).
+ *  (since API version 3); with "target_psnr" or "budget" set also
+ *  "estimated_psnr", "estimated_psnr_low", "estimated_psnr_high" (the 90 %
+ *  interval), "validation_pixels", "quality_runs", "target_reached" and
+ *  "budget_bound" (0/1), and "exact_pixels" counts every pixel evaluated
+ *  over the runs.
  *  0 and an error for an unknown name or before a result. */
 DCM_API double dcmGetStat(DCMReconstructor r, const char* name);
 

@@ -1,0 +1,100 @@
+// Quality asked for instead of a threshold: a PSNR to reach (--target-psnr)
+// or a share of exact pixels not to exceed (--budget), with an estimate of
+// the PSNR the result has against the full render and its uncertainty.
+//
+// The estimate comes from validation pixels drawn at random (stratified,
+// seeded) and evaluated exactly; they count in the exact pixels. The knob is
+// the contrast threshold, lowered until the estimate's lower bound reaches the
+// target or the next step would exceed the budget (docs/QUALITY.md).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "dcm/color.h"
+#include "dcm/options.h"
+#include "dcm/reconstructor.h"
+#include "dcm/sample_provider.h"
+#include "dcm/status.h"
+
+namespace dcm {
+
+/// What to deliver: a target, a budget, or both (whichever binds first).
+struct QualityGoal {
+  /// dB of display-referred PSNR against the full render, checked against
+  /// the estimate's lower bound; 0: no target.
+  double targetPsnr = 0;
+  /// Largest share of working pixels evaluated exactly, validation pixels and
+  /// every run's samples included; 0: no budget (1: the whole image).
+  double budget = 0;
+  /// Validation output pixels: this share of the output pixels, at least
+  /// minValidationPixels, at most a quarter of the budget.
+  double validationFraction = 0.01;
+  int64_t minValidationPixels = 512;
+  /// Seed of the validation pixels (the same seed, the same pixels).
+  uint64_t seed = 0x9e3779b97f4a7c15ull;
+  /// The display-referred encoding of a linear output pixel in which the
+  /// squared error is measured, each channel in [0,1] (PSNR peak 1). Empty:
+  /// sRGB of each channel clipped to [0,1], as the stats' PSNR
+  /// (tools/common/metrics.h). A host with a colour pipeline passes its own.
+  std::function<RGB(RGB)> display;
+
+  /// Checks the ranges ("--target-psnr: ..."); the message names the flag.
+  Status Validate() const;
+};
+
+/// The estimate of the PSNR of an image against the full render.
+struct PsnrEstimate {
+  double psnr = 0;  ///< from the mean squared error at the validation pixels; +inf with none
+  /// Bounds of the two-sided 90 % interval (CLT on the weighted mean of the
+  /// squared errors): `low` is also the one-sided 95 % lower bound.
+  double low = 0, high = 0;
+};
+
+/// One refinement level of the final run (progressive output).
+struct LevelEstimate {
+  int level = 0;
+  PsnrEstimate estimate;
+};
+
+/// What ReconstructToQuality delivered and what it cost.
+struct QualityReport {
+  PsnrEstimate estimate;         ///< of the result
+  double confidence = 0.90;      ///< of [low, high]
+  int64_t validationPixels = 0;  ///< output pixels compared
+  /// Working pixels evaluated exactly over every run, the validation's
+  /// included (each once): what the budget bounds.
+  int64_t exactPixels = 0;
+  int64_t validationExactPixels = 0;  ///< working pixels of the validation
+  int64_t totalPixels = 0;            ///< working pixels
+  double threshold = 0;               ///< contrast threshold of the result (-1: full evaluation)
+  int runs = 0;                       ///< reconstructions tried
+  bool targetReached = false;         ///< the lower bound reached the target (or no target)
+  bool budgetBound = false;           ///< the budget stopped the refinement
+  std::vector<LevelEstimate> levels;  ///< per refinement level of the final run, with options.onLevel
+  double exactFraction() const { return totalPixels ? double(exactPixels) / double(totalPixels) : 0.0; }
+};
+
+/// Reconstructs with the contrast threshold that `goal` calls for: from the
+/// options' threshold (sixteen times it, at most 1, with a budget) down, until the
+/// estimate's lower bound reaches goal.targetPsnr or the next run would exceed
+/// the budget (then bisected between the two). The
+/// provider is evaluated at most once per pixel across the runs. Every other
+/// option is used as given. A target that the budget (or the smallest
+/// threshold, then the full evaluation) cannot reach is no error: `report`
+/// says so (targetReached false) and the result is the best reached.
+/// With a provider that answers Status::Pending, returns that status and
+/// leaves the requested pixels in `pending` (a `dcm plan` round: repeat with
+/// the samples rendered). The result's stats count the cost of the whole
+/// search (exactPixels: every pixel evaluated, validation included; the
+/// times and provider calls of every run); its byReason, blocks and sample
+/// map are the final run's.
+Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOptions& options, const QualityGoal& goal,
+                            Reconstruction* out, QualityReport* report, std::vector<Point2i>* pending = nullptr);
+
+/// The estimate from per-pixel mean squared display errors `d` with weights
+/// `w` (the share of the image each stands for): exposed for tests.
+PsnrEstimate EstimatePsnr(const std::vector<double>& d, const std::vector<double>& w);
+
+}  // namespace dcm

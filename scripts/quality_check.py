@@ -1,0 +1,101 @@
+#!/usr/bin/python3
+"""Checks --target-psnr and --budget on the tracer's scenes (docs/QUALITY.md).
+
+For each scene: the full render (the reference), a sweep of global contrast
+thresholds (the frontier a user could reach knowing the best threshold), one
+run with --target-psnr T and one with --budget B (B: the exact fraction the
+best single threshold needs for T). Prints a Markdown table.
+
+usage: scripts/quality_check.py DCM OUTDIR [--size 256] [--supersampling 1] [--target 40]
+                                [--scenes room,mirror,...]
+"""
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+
+THRESHOLDS = [0.6, 0.45, 0.34, 0.26, 0.2, 0.15, 0.11, 0.08, 0.06, 0.045, 0.034, 0.025, 0.019, 0.014, 0.01]
+SCENES = {
+    "room": "examples/scenes/room.json",
+    "room-paper": "examples/scenes/room-paper.json",
+    "cactus": "examples/scenes/cactus/cactus.json",
+    "parquet": "examples/scenes/parquet.json",
+    "mirror": "examples/scenes/mirror.json",
+}
+
+
+def render(dcm, scene, out, common, extra, reuse=False):
+    """One `dcm render`; its --stats. `reuse`: an existing result (the full
+    render, the sweep: they do not depend on the quality loop) is read back."""
+    stats = out + ".json"
+    if reuse and os.path.exists(stats) and os.path.exists(out + ".exr"):
+        with open(stats) as f:
+            return json.load(f)
+    cmd = [dcm, "render", scene, "-o", out + ".exr", "--stats", stats, "-q"] + common + extra
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+    with open(stats) as f:
+        return json.load(f)
+
+
+def at_fraction(sweep, fraction):
+    """The sweep's PSNR at `fraction`, interpolated in log fraction."""
+    pts = sorted((s["exact_fraction"], s["reference"]["psnr"]) for s in sweep)
+    if fraction <= pts[0][0]:
+        return pts[0][1]
+    for (f0, p0), (f1, p1) in zip(pts, pts[1:]):
+        if f0 <= fraction <= f1:
+            if f1 == f0:
+                return max(p0, p1)
+            u = (math.log(fraction) - math.log(f0)) / (math.log(f1) - math.log(f0))
+            return p0 + u * (p1 - p0)
+    return pts[-1][1]
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("dcm")
+    ap.add_argument("outdir")
+    ap.add_argument("--size", type=int, default=256)
+    ap.add_argument("--supersampling", type=int, default=1)
+    ap.add_argument("--target", type=float, default=40.0)
+    ap.add_argument("--scenes", default=",".join(SCENES))
+    a = ap.parse_args()
+    os.makedirs(a.outdir, exist_ok=True)
+    common = ["--size", f"{a.size}x{a.size}", "--supersampling", str(a.supersampling)]
+    print(f"size {a.size}², supersampling {a.supersampling}, target {a.target:g} dB\n")
+    print("| scene | target | estimate [90 % interval] | true PSNR | exact | best threshold: exact (thr) | ratio "
+          "| budget | true PSNR at budget | sweep at that fraction | exact at budget |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    for name in a.scenes.split(","):
+        scene = SCENES[name]
+        base = os.path.join(a.outdir, f"{name}_{a.size}_{a.supersampling}")
+        ref = base + "_full"
+        render(a.dcm, scene, ref, common, ["--full"], reuse=True)
+        cmp_ = ["--compare", ref + ".exr"]
+        sweep = []
+        for t in THRESHOLDS:
+            s = render(a.dcm, scene, f"{base}_t{t:g}", common, cmp_ + ["--threshold", f"{t:g}"], reuse=True)
+            s["threshold"] = t
+            sweep.append(s)
+        meeting = [s for s in sweep if s["reference"]["psnr"] >= a.target]
+        best = min(meeting, key=lambda s: s["exact_fraction"]) if meeting else None
+        q = render(a.dcm, scene, f"{base}_target", common, cmp_ + ["--target-psnr", f"{a.target:g}"])
+        line = (f"| {name} | {a.target:g} | {q['estimated_psnr']:.2f} [{q['estimated_psnr_low']:.2f}, "
+                f"{q['estimated_psnr_high']:.2f}] | {q['reference']['psnr']:.2f} | {100 * q['exact_fraction']:.2f} % | ")
+        if best:
+            budget = round(best["exact_fraction"], 4)
+            b = render(a.dcm, scene, f"{base}_budget", common, cmp_ + ["--budget", f"{budget:g}"])
+            line += (f"{100 * best['exact_fraction']:.2f} % ({best['threshold']:g}) | "
+                     f"{q['exact_fraction'] / best['exact_fraction']:.2f} | {100 * budget:.2f} % | "
+                     f"{b['reference']['psnr']:.2f} | {at_fraction(sweep, b['exact_fraction']):.2f} | "
+                     f"{100 * b['exact_fraction']:.2f} % |")
+        else:
+            line += "none reaches it | | | | | |"
+        print(line)
+        sys.stdout.flush()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,167 @@
+// Reconstruction to a PSNR target or a budget (dcm/quality_target.h): the
+// target is met, the budget is never exceeded, each pixel is evaluated once,
+// and the estimate lies within its stated uncertainty of the truth.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "dcm/downsample.h"
+#include "dcm/quality_target.h"
+#include "run_helpers.h"
+
+namespace dcm::testing {
+namespace {
+
+struct Outcome {
+  Reconstruction rec;
+  QualityReport report;
+  double truePsnr = 0;
+};
+
+Outcome RunGoal(AnalyticProvider& provider, const ReconstructionOptions& o, const QualityGoal& goal) {
+  Outcome r;
+  const Status st = ReconstructToQuality(provider, o, goal, &r.rec, &r.report);
+  EXPECT_TRUE(st.ok()) << st.message();
+  int w = 0, h = 0;
+  const std::vector<RGB> full = provider.FullRender();
+  const std::vector<RGB> ref = BoxDownsample(full, r.rec.workWidth, r.rec.workHeight, o.downsample, &w, &h);
+  r.truePsnr = DisplayPsnr(r.rec.image, ref);
+  std::printf("target %.1f budget %.3f: estimate %.2f [%.2f, %.2f], true %.2f dB, exact %.2f %% (%d runs, threshold %g)\n",
+              goal.targetPsnr, goal.budget, r.report.estimate.psnr, r.report.estimate.low, r.report.estimate.high,
+              r.truePsnr, 100 * r.report.exactFraction(), r.report.runs, r.report.threshold);
+  return r;
+}
+
+TEST(QualityTarget, EstimateOfAConstantErrorIsExact) {
+  const PsnrEstimate e = EstimatePsnr({1e-4, 1e-4, 1e-4}, {1, 2, 3});
+  EXPECT_NEAR(e.psnr, 40.0, 1e-9);
+  EXPECT_NEAR(e.low, 40.0, 1e-9);
+  EXPECT_NEAR(e.high, 40.0, 1e-9);
+  // A spread widens the interval around the weighted mean (1e-4 + 3e-4) / 2.
+  const PsnrEstimate s = EstimatePsnr({1e-4, 3e-4}, {1, 1});
+  EXPECT_NEAR(s.psnr, 10 * std::log10(1 / 2e-4), 1e-9);
+  EXPECT_LT(s.low, s.psnr);
+  EXPECT_GT(s.high, s.psnr);
+  EXPECT_TRUE(std::isnan(EstimatePsnr({}, {}).psnr));
+}
+
+TEST(QualityTarget, TargetIsMetWithEachPixelEvaluatedOnce) {
+  const int N = 256;
+  for (double target : {35.0, 40.0}) {
+    AnalyticProvider provider(N, N, FurnishedScene(N, N));
+    QualityGoal goal;
+    goal.targetPsnr = target;
+    const Outcome r = RunGoal(provider, ReconstructionOptions{}, goal);
+    EXPECT_TRUE(r.report.targetReached);
+    // The lower bound reached the target; the truth may sit below the bound
+    // by chance (5 %) but not by more than the 0.5 dB.
+    EXPECT_GE(r.truePsnr, target - 0.5);
+    // The truth within the stated 90 % interval, widened by 0.25 dB for the
+    // choice of the stopping run on the same validation pixels.
+    EXPECT_GE(r.truePsnr, r.report.estimate.low - 0.25);
+    EXPECT_LE(r.truePsnr, r.report.estimate.high + 0.25);
+    EXPECT_EQ(provider.MaxEvaluationsOfOnePixel(), 1);
+    EXPECT_EQ(provider.TotalEvaluations(), r.report.exactPixels);
+    EXPECT_LT(r.report.exactFraction(), 1.0);
+  }
+}
+
+TEST(QualityTarget, BudgetIsNeverExceeded) {
+  const int N = 256;
+  for (double budget : {0.03, 0.08, 0.2}) {
+    AnalyticProvider provider(N, N, FurnishedScene(N, N));
+    QualityGoal goal;
+    goal.budget = budget;
+    const Outcome r = RunGoal(provider, ReconstructionOptions{}, goal);
+    EXPECT_LE(provider.TotalEvaluations(), int64_t(budget * N * N));
+    EXPECT_EQ(provider.TotalEvaluations(), r.report.exactPixels);
+    // The budget was used: more than half of it (the bisection stops within
+    // a factor 0.85^(1/8) of the threshold the budget allows).
+    EXPECT_GT(r.report.exactFraction(), budget / 2);
+    EXPECT_TRUE(std::isfinite(r.report.estimate.low));
+  }
+}
+
+TEST(QualityTarget, BudgetBelowTheCoarsestRunIsAnErrorWithinTheBudget) {
+  // 1 % of 256^2 (655 pixels): the coarsest run alone needs about 1000 (the
+  // corners of the 16-pixel blocks, their centre probes, the blocks they split).
+  const int N = 256;
+  AnalyticProvider provider(N, N, FurnishedScene(N, N));
+  QualityGoal goal;
+  goal.budget = 0.01;
+  Reconstruction rec;
+  QualityReport report;
+  const Status st = ReconstructToQuality(provider, ReconstructionOptions{}, goal, &rec, &report);
+  EXPECT_FALSE(st.ok());
+  EXPECT_NE(st.message().find("--budget"), std::string::npos) << st.message();
+  EXPECT_LE(provider.TotalEvaluations(), int64_t(0.01 * N * N));
+}
+
+TEST(QualityTarget, UnreachableTargetReportsWhatTheBudgetReached) {
+  const int N = 256;
+  AnalyticProvider provider(N, N, FurnishedScene(N, N));
+  QualityGoal goal;
+  goal.targetPsnr = 70;
+  goal.budget = 0.05;
+  const Outcome r = RunGoal(provider, ReconstructionOptions{}, goal);
+  EXPECT_FALSE(r.report.targetReached);
+  EXPECT_TRUE(r.report.budgetBound);
+  EXPECT_LE(provider.TotalEvaluations(), int64_t(0.05 * N * N));
+}
+
+TEST(QualityTarget, SupersampledTargetIsMetAtOutputResolution) {
+  const int N = 256;
+  AnalyticProvider provider(N, N, FurnishedScene(N, N));
+  ReconstructionOptions o;
+  o.downsample = 2;
+  QualityGoal goal;
+  goal.targetPsnr = 45;
+  const Outcome r = RunGoal(provider, o, goal);
+  EXPECT_EQ(r.rec.width, N / 2);
+  EXPECT_TRUE(r.report.targetReached);
+  EXPECT_GE(r.truePsnr, goal.targetPsnr - 0.5);
+  EXPECT_EQ(provider.MaxEvaluationsOfOnePixel(), 1);
+}
+
+TEST(QualityTarget, ProgressiveLevelsCarryAnEstimate) {
+  const int N = 128;
+  AnalyticProvider provider(N, N, FurnishedScene(N, N));
+  ReconstructionOptions o;
+  int calls = 0;
+  o.onLevel = [&](int, int, int, const std::vector<RGB>&) { ++calls; };
+  QualityGoal goal;
+  goal.targetPsnr = 35;
+  const Outcome r = RunGoal(provider, o, goal);
+  ASSERT_FALSE(r.report.levels.empty());
+  EXPECT_GE(calls, int(r.report.levels.size()));
+  // Each level refines the one before: its estimate is no worse (the same
+  // validation pixels, more exact samples).
+  for (size_t k = 1; k < r.report.levels.size(); ++k)
+    EXPECT_GE(r.report.levels[k].estimate.psnr, r.report.levels[k - 1].estimate.psnr - 0.5) << "level " << k;
+}
+
+TEST(QualityTarget, BadGoalsNameTheFlag) {
+  AnalyticProvider provider(64, 64, FurnishedScene(64, 64));
+  Reconstruction rec;
+  QualityReport report;
+  auto message = [&](QualityGoal g) {
+    const Status st = ReconstructToQuality(provider, ReconstructionOptions{}, g, &rec, &report);
+    EXPECT_FALSE(st.ok());
+    return st.message();
+  };
+  QualityGoal g;
+  g.targetPsnr = 120;
+  EXPECT_NE(message(g).find("--target-psnr"), std::string::npos);
+  g.targetPsnr = -1;
+  EXPECT_NE(message(g).find("--target-psnr"), std::string::npos);
+  g = {};
+  g.budget = 1.5;
+  EXPECT_NE(message(g).find("--budget"), std::string::npos);
+  g.budget = 1e-6;  // not even the validation fits
+  EXPECT_NE(message(g).find("--budget"), std::string::npos);
+  EXPECT_NE(message(QualityGoal{}).find("neither"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace dcm::testing
