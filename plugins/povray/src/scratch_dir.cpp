@@ -1,0 +1,79 @@
+// The scratch folder, and its removal from a signal handler.
+#include "scratch_dir.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <climits>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+
+namespace dcm::povray {
+
+namespace {
+
+constexpr int kPasses = 6;
+
+/// The folder registered for the signal handler: written before the flag is
+/// set, read only when it is.
+char g_scratch[PATH_MAX];
+std::atomic<bool> g_registered{false};
+
+/// Appends `s` to `buf` at `*len` (bounded, no allocation).
+bool Append(char* buf, size_t size, size_t* len, const char* s) {
+  const size_t n = std::strlen(s);
+  if (*len + n + 1 > size) return false;
+  std::memcpy(buf + *len, s, n + 1);
+  *len += n;
+  return true;
+}
+
+void UnlinkIn(const char* dir, const char* name) {
+  char path[PATH_MAX];
+  size_t len = 0;
+  if (Append(path, sizeof path, &len, dir) && Append(path, sizeof path, &len, "/") &&
+      Append(path, sizeof path, &len, name))
+    ::unlink(path);
+}
+
+}  // namespace
+
+std::string ScratchPixelList() { return "pixels.inc"; }
+std::string ScratchRender(int pass) { return "pass" + std::to_string(pass) + ".exr"; }
+std::string ScratchLog(int pass) { return "pass" + std::to_string(pass) + ".log"; }
+
+Status MakeScratch(std::string* path) {
+  const char* tmp = std::getenv("TMPDIR");
+  std::string base = tmp && *tmp ? tmp : "/tmp";
+  std::string pattern = base + "/dcm-povray.XXXXXX";
+  if (pattern.size() >= sizeof g_scratch) return Status::Error("the scratch folder's name is too long: " + pattern);
+  if (!::mkdtemp(pattern.data()))
+    return Status::Error("cannot make a scratch folder in " + base + ": " + std::strerror(errno));
+  std::memcpy(g_scratch, pattern.c_str(), pattern.size() + 1);
+  g_registered.store(true);
+  *path = pattern;
+  return Status::Ok();
+}
+
+void RemoveScratch(const std::string& path) {
+  if (path.empty()) return;
+  g_registered.store(false);
+  std::error_code ec;
+  std::filesystem::remove_all(path, ec);
+}
+
+void RemoveScratchOnSignal() {
+  if (!g_registered.load()) return;
+  UnlinkIn(g_scratch, "pixels.inc");
+  char name[] = "pass0.exr", log[] = "pass0.log";
+  for (int p = 0; p < kPasses; ++p) {
+    name[4] = log[4] = char('0' + p);
+    UnlinkIn(g_scratch, name);
+    UnlinkIn(g_scratch, log);
+  }
+  ::rmdir(g_scratch);
+}
+
+}  // namespace dcm::povray

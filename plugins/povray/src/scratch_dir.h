@@ -1,0 +1,28 @@
+// The private scratch folder of a POV-Ray run: the pixel lists POV-Ray reads
+// and the passes it writes. Only files of fixed names live in it, so that a
+// signal handler can remove them without listing the folder.
+#pragma once
+
+#include <string>
+
+#include "dcm/status.h"
+
+namespace dcm::povray {
+
+/// The file names a scratch folder may hold: the pixel list and one render
+/// and one log per pass (passes 0 to 5).
+std::string ScratchPixelList();                 ///< "pixels.inc" (the name scene files include)
+std::string ScratchRender(int pass);            ///< "pass4.exr"
+std::string ScratchLog(int pass);               ///< "pass4.log"
+
+/// Makes a folder only this user may enter, under $TMPDIR or /tmp, and
+/// registers it for RemoveScratchOnSignal(). One at a time.
+Status MakeScratch(std::string* path);
+
+/// Removes the folder and everything in it, and unregisters it.
+void RemoveScratch(const std::string& path);
+
+/// Removes the registered folder's files and the folder (async-signal-safe).
+void RemoveScratchOnSignal();
+
+}  // namespace dcm::povray
