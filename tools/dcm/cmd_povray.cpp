@@ -15,8 +15,13 @@
 // Compiles to nothing unless the dcm_povray library is linked (DCM_HAVE_POVRAY).
 #ifdef DCM_HAVE_POVRAY
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -105,6 +110,20 @@ void PreviewSamples(std::vector<RGB>* beauty, std::vector<RGB>* illumination, in
     }
 }
 
+/// Fails before any rendering when an output's folder cannot take a file: the
+/// output transaction would find out only after the whole render.
+Status CheckOutputFolders(std::initializer_list<std::pair<const char*, std::string>> outputs) {
+  for (const auto& [flag, path] : outputs) {
+    if (path.empty()) continue;
+    const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+    const std::string dir = parent.empty() ? "." : parent.string();
+    if (::access(dir.c_str(), W_OK | X_OK) != 0)
+      return Status::Error(std::string(flag) + ": cannot write '" + path + "': its folder " + dir + ": " +
+                           std::strerror(errno));
+  }
+  return Status::Ok();
+}
+
 int RunPovray(const PovrayFlags& f) {
   const auto t0 = Clock::now();
   int outW = 0, outH = 0;
@@ -125,6 +144,9 @@ int RunPovray(const PovrayFlags& f) {
       !st.ok())
     return Fail(st.message(), kExitUsage);
 
+  if (Status st = CheckOutputFolders({{"-o", f.output}, {"--stats", f.stats}, {"--sample-map", f.sampleMap}});
+      !st.ok())
+    return Fail(st.message());
   // Every output appears at Commit(), or none; a signal ends POV-Ray and
   // removes the scratch folder too.
   toolkit::OutputTransaction outputs;

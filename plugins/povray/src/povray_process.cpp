@@ -123,7 +123,8 @@ Status RunJobs(const PovrayEnv& env, std::span<const PovrayJob> jobs) {
       }
       progressed = true;
       if (!running[i].child->exitedCleanly())
-        return Status::Error(Failed(env, *running[i].job) + ": POV-Ray " + running[i].child->ExitDescription() +
+        return Status::Error(Failed(env, *running[i].job) + ": POV-Ray (" + env.executable + ") " +
+                             running[i].child->ExitDescription() +
                              ": " + LogExcerpt(env.scratch + "/" + ScratchLog(running[i].job->pass)));
       running.erase(running.begin() + std::ptrdiff_t(i));
     }

@@ -67,11 +67,13 @@ void RemoveScratch(const std::string& path) {
 void RemoveScratchOnSignal() {
   if (!g_registered.load()) return;
   UnlinkIn(g_scratch, "pixels.inc");
-  char name[] = "pass0.exr", log[] = "pass0.log";
+  // POV-Ray's state file while it renders pass N is passN.pov-state.
+  char name[] = "pass0.exr", log[] = "pass0.log", state[] = "pass0.pov-state";
   for (int p = 0; p < kPasses; ++p) {
-    name[4] = log[4] = char('0' + p);
+    name[4] = log[4] = state[4] = char('0' + p);
     UnlinkIn(g_scratch, name);
     UnlinkIn(g_scratch, log);
+    UnlinkIn(g_scratch, state);
   }
   ::rmdir(g_scratch);
 }

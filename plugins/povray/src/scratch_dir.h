@@ -9,8 +9,9 @@
 
 namespace dcm::povray {
 
-/// The file names a scratch folder may hold: the pixel list and one render
-/// and one log per pass (passes 0 to 5).
+/// The file names a scratch folder may hold: the pixel list, and per pass
+/// (0 to 5) a render, a log and POV-Ray's state file while it renders
+/// (passN.pov-state).
 std::string ScratchPixelList();                 ///< "pixels.inc" (the name scene files include)
 std::string ScratchRender(int pass);            ///< "pass4.exr"
 std::string ScratchLog(int pass);               ///< "pass4.log"
