@@ -47,10 +47,11 @@ for size in $sizes; do
         lit=$(json "$out/dcm_$size.json" povray.lit_invocations)
         all=$(json "$out/dcm_$size.json" povray.invocations)
         standins=$(json "$out/dcm_$size.json" povray.preview_stand_ins)
+        inproc=$(json "$out/dcm_$size.json" time_wall_s)
         line=$(awk -v s="$size" -v r="$r" -v f="$tf" -v d="$td" -v p="$psnr" -v e="$frac" -v l="$lit" -v a="$all" \
-            -v si="$standins" -v l1="$l1" -v l2="$(load)" \
-            'BEGIN { printf "%5d  %d  full %7.2f s  dcm %6.2f s  %5.2fx  %6.2f dB  exact %5.2f %%  stand-ins %5d  POV-Ray %d (%d lit)  load %s/%s\n",
-                     s, r, f, d, f / d, p, 100 * e, si, a, l, l1, l2 }')
+            -v si="$standins" -v l1="$l1" -v l2="$(load)" -v ip="$inproc" \
+            'BEGIN { printf "%5d  %d  full %7.2f s  dcm %6.2f s  %5.2fx  %6.2f dB  exact %5.2f %%  stand-ins %5d  POV-Ray %d (%d lit)  load %s/%s  in-process %.2f s\n",
+                     s, r, f, d, f / d, p, 100 * e, si, a, l, l1, l2, ip }')
         echo "$line"
         echo "$line" >>"$res"
         r=$((r + 1))

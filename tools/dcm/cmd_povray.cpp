@@ -79,33 +79,29 @@ Status ParseSize(const std::string& s, int* w, int* h) {
   return Status::Ok();
 }
 
-/// The preview's samples at its pixels from the lit passes it rendered:
-/// `beauty` and `illumination` (either may be empty), with tau at the
-/// working pixel under the preview pixel's centre. Both passes: L_c = L -
-/// L_i*tau, never below zero (tau is sampled half a pixel away from the
-/// preview's ray at a texture edge). One pass: the other from L = L_i*tau,
-/// L_c = 0 (the preview then has no highlights; the exact rounds have them).
-void PreviewSamples(std::vector<RGB>* beauty, std::vector<RGB>* illumination, int pw, int ph, int W, int H,
-                    const std::vector<RGB>& tau, std::vector<RGB>* Lc) {
-  const bool haveL = !beauty->empty(), haveLi = !illumination->empty();
+/// The preview's L_i and L_c at its pixels from the lit passes it rendered
+/// (`beauty`, `Li`: either may be empty), with tau at the working pixel under
+/// the preview pixel's centre. Both passes: L_c = L - L_i*tau, never below
+/// zero (tau is sampled half a pixel away from the preview's ray at a texture
+/// edge). One pass: L_c = 0 (the preview has no highlights; the exact rounds
+/// do), and from the beauty alone L_i = L/tau.
+void PreviewSplit(const std::vector<RGB>& beauty, std::vector<RGB>* Li, int pw, int ph, int W, int H,
+                  const std::vector<RGB>& tau, std::vector<RGB>* Lc) {
   const size_t n = size_t(pw) * size_t(ph);
-  beauty->resize(n);
-  illumination->resize(n);
+  const bool haveL = !beauty.empty(), haveLi = !Li->empty();
+  Li->resize(n);
   Lc->assign(n, RGB{});
+  if (!haveL) return;
   for (int y = 0; y < ph; ++y)
     for (int x = 0; x < pw; ++x) {
       const int fx = std::min(W - 1, int((x + 0.5) * W / pw)), fy = std::min(H - 1, int((y + 0.5) * H / ph));
       const size_t i = size_t(y) * size_t(pw) + size_t(x);
       const RGB t = tau[size_t(fy) * size_t(W) + size_t(fx)];
-      RGB& L = (*beauty)[i];
-      RGB& Li = (*illumination)[i];
-      if (haveL && haveLi) {
-        const RGB d = L - Li * t;
+      if (haveLi) {
+        const RGB d = beauty[i] - (*Li)[i] * t;
         (*Lc)[i] = RGB{std::max(0.f, d.r), std::max(0.f, d.g), std::max(0.f, d.b)};
-      } else if (haveLi) {
-        L = Li * t;
       } else {
-        for (int c = 0; c < 3; ++c) Li[c] = t[c] > 1e-4f ? L[c] / t[c] : 0.f;
+        for (int c = 0; c < 3; ++c) (*Li)[i][c] = t[c] > 1e-4f ? beauty[i][c] / t[c] : 0.f;
       }
     }
 }
@@ -198,7 +194,7 @@ int RunPovray(const PovrayFlags& f) {
       if (st = provider->Guides(Bounds2i{{0, 0}, {W, H}}, want, &g); !st.ok()) return Fail(st.message());
       std::vector<RGB> L, Li, Lc;
       for (size_t i = 0; i < lit.size(); ++i) (lit[i] == povray::Pass::kBeauty ? L : Li) = std::move(preview[i]);
-      PreviewSamples(&L, &Li, pw, ph, W, H, g.texture, &Lc);
+      PreviewSplit(L, &Li, pw, ph, W, H, g.texture, &Lc);
       povray::PovrayPreview previewProvider(*provider, pw, ph, std::move(Li), std::move(Lc));
       PreviewScheduleOptions so;
       so.maxRounds = f.rounds;
