@@ -232,7 +232,9 @@ int RunPovray(const PovrayFlags& f) {
   p["preview_scale"] = full || schedule != RoundSchedule::kPreview ? 0 : f.previewScale;
   p["preview_pixels"] = previewPixels;
   p["preview_passes"] = full || schedule != RoundSchedule::kPreview ? "" : f.previewPasses;
+  // The engine counts the stand-ins among its exact pixels (exact_pixels).
   p["preview_stand_ins"] = sched.previewStandIns;
+  p["exact_pixels_rendered"] = rec.stats.exactPixels - sched.previewStandIns;
   p["processes_at_a_time"] = f.processes;
   nlohmann::json phases;
   phases[full ? "full_s" : "guides_and_preview_s"] = denseS;
