@@ -110,7 +110,6 @@ PovrayEnv PovrayProvider::Env() const {
 
 Status PovrayProvider::RenderGuides(std::span<const Pass> also, int alsoWidth, int alsoHeight,
                                     std::vector<std::vector<RGB>>* alsoOut) {
-  const auto t0 = Clock::now();
   const int w = options_.width, h = options_.height;
   std::vector<PovrayJob> jobs;
   for (Pass p : also) {
@@ -144,7 +143,6 @@ Status PovrayProvider::RenderGuides(std::span<const Pass> also, int alsoWidth, i
   haveGuides_ = true;
   rendered_.assign(size_t(w) * size_t(h), 0);
   samples_.resize(size_t(w) * size_t(h));
-  stats_.guidesS = Since(t0);
   return Status::Ok();
 }
 

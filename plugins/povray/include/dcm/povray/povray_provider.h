@@ -46,7 +46,6 @@ struct PovrayOptions {
 struct PovrayRunStats {
   int invocations = 0;          ///< POV-Ray processes, all passes
   int litInvocations = 0;       ///< of which the beauty and illumination passes
-  double guidesS = 0;           ///< wall time of RenderGuides()
   std::vector<double> roundS;   ///< wall time of each Evaluate() call
   std::vector<int64_t> roundPixels;  ///< pixels asked in each Evaluate() call
 };
@@ -56,7 +55,7 @@ struct PovrayRunStats {
 class PovrayProvider final : public SampleProvider {
  public:
   /// Checks that the scene is readable and mentions the convention's names
-  /// (Pass, Sparse, PixX), finds POV-Ray and makes the private scratch folder
+  /// (Pass, Sparse, NPix, PixX, PixY), finds POV-Ray and makes the private scratch folder
   /// for the renders and the pixel lists (removed by the destructor and, on
   /// SIGINT, SIGTERM or SIGHUP, by SignalCleanup()).
   static Status Open(const PovrayOptions& options, std::unique_ptr<PovrayProvider>* out);
