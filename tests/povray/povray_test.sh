@@ -12,7 +12,8 @@
 # errors: a missing scene, a scene without the pass convention, POV-Ray that
 #   fails (/bin/false) or crashes in the exact round, an output folder that
 #   does not exist, SIGTERM during a render: exit 1 with a message naming the
-#   file and the step, no output, no scratch folder left, no POV-Ray left.
+#   file and the step, no output, no scratch folder left, no POV-Ray left;
+#   SIGKILL of dcm: POV-Ray ends with it (plugins/pipe's supervisor).
 # Exit 77 (ctest: skipped) where povray is not installed.
 set -uo pipefail
 
@@ -122,6 +123,17 @@ EOS
   sleep 0.2
   clean "SIGTERM" "$out"
   ok "SIGTERM during a render: no output, no scratch, no POV-Ray"
+  # SIGKILL: nothing of dcm runs to clean up, but its supervisor takes POV-Ray along.
+  "$dcm" povray "$scene" -o "$out" --size 320x240 --full -q 2>"$tmp/err" &
+  pid=$!
+  for _ in $(seq 100); do pgrep -f "$scene" >/dev/null && break; sleep 0.05; done
+  pgrep -f "$scene" >/dev/null || fail "SIGKILL: POV-Ray never started"
+  kill -KILL $pid
+  wait $pid 2>/dev/null
+  for _ in $(seq 60); do pgrep -f "$scene" >/dev/null || break; sleep 0.05; done
+  if pgrep -f "$scene" >/dev/null; then fail "SIGKILL: POV-Ray still runs 3 s after dcm died: $(pgrep -af "$scene")"; fi
+  [[ ! -e $out ]] || fail "SIGKILL: the output $out exists"
+  ok "SIGKILL of dcm during a render: POV-Ray ends with it, no output"
   ;;
 *) fail "unknown mode $mode" ;;
 esac
