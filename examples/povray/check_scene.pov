@@ -56,6 +56,7 @@ background { rgb 0 }
     #case (3) texture { pigment { Pig } finish { emission 1 ambient 0 diffuse 0 specular 0 } } #break
     #case (4) texture { pigment { rgb 1 } finish { ambient Amb diffuse Dif specular 0 reflection 0 } } #break
     #case (5) texture { pigment { P_Normal } finish { emission 1 ambient 0 diffuse 0 specular 0 } } #break
+    #case (6) texture { pigment { rgb (Spec > 0 | Refl > 0) } finish { emission 1 ambient 0 diffuse 0 specular 0 } } #break
     #else
       texture { pigment { Pig }
         finish { ambient Amb diffuse Dif specular Spec roughness Rough reflection Refl } }

@@ -229,6 +229,8 @@ int RunPovray(const PovrayFlags& f) {
   p["lit_invocations"] = runs.litInvocations;
   p["rounds"] = runs.roundS.size();
   p["round_pixels"] = runs.roundPixels;
+  p["illumination_pixels"] = runs.illuminationPixels;
+  p["highlight_mask"] = !full && provider->haveHighlightMask();
   p["preview_scale"] = full || schedule != RoundSchedule::kPreview ? 0 : f.previewScale;
   p["preview_pixels"] = previewPixels;
   p["preview_passes"] = full || schedule != RoundSchedule::kPreview ? "" : f.previewPasses;

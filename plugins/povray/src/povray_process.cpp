@@ -40,7 +40,7 @@ std::string CommandLine(const PovrayEnv& env, const PovrayJob& job) {
   // append(), not operator+ on literals: GCC 12 warns (-Wrestrict) on those.
   std::string c = "cd ";
   for (const std::string& word :
-       {ShellQuote(env.scratch), std::string("&& exec"), ShellQuote(env.executable), std::string("-D -A +FE"),
+       {ShellQuote(JobFolder(env, job)), std::string("&& exec"), ShellQuote(env.executable), std::string("-D -A +FE"),
         "+W" + std::to_string(job.width), "+H" + std::to_string(job.height), ShellQuote("+L" + Dirname(env.scene)),
         "Declare=Pass=" + std::to_string(job.pass)})
     c.append(word).append(" ");
@@ -72,6 +72,10 @@ std::string Failed(const PovrayEnv& env, const PovrayJob& job) {
 }
 
 }  // namespace
+
+std::string JobFolder(const PovrayEnv& env, const PovrayJob& job) {
+  return job.folder.empty() ? env.scratch : env.scratch + "/" + job.folder;
+}
 
 Status FindExecutable(const std::string& name, std::string* path) {
   if (name.empty()) return Status::Error("--povray: empty");
@@ -125,7 +129,7 @@ Status RunJobs(const PovrayEnv& env, std::span<const PovrayJob> jobs) {
       if (!running[i].child->exitedCleanly())
         return Status::Error(Failed(env, *running[i].job) + ": POV-Ray (" + env.executable + ") " +
                              running[i].child->ExitDescription() +
-                             ": " + LogExcerpt(env.scratch + "/" + ScratchLog(running[i].job->pass)));
+                             ": " + LogExcerpt(JobFolder(env, *running[i].job) + "/" + ScratchLog(running[i].job->pass)));
       running.erase(running.begin() + std::ptrdiff_t(i));
     }
     // POV-Ray polls its own renderer in 50-100 ms steps; 5 ms here costs nothing.
@@ -135,10 +139,10 @@ Status RunJobs(const PovrayEnv& env, std::span<const PovrayJob> jobs) {
 }
 
 Status ReadRender(const PovrayEnv& env, const PovrayJob& job, std::vector<RGB>* rgb) {
-  const std::string path = env.scratch + "/" + ScratchRender(job.pass);
+  const std::string path = JobFolder(env, job) + "/" + ScratchRender(job.pass);
   auto fail = [&](const std::string& why) {
     return Status::Error(Failed(env, job) + ": " + why + " (POV-Ray's log: " +
-                         LogExcerpt(env.scratch + "/" + ScratchLog(job.pass)) + ")");
+                         LogExcerpt(JobFolder(env, job) + "/" + ScratchLog(job.pass)) + ")");
   };
   auto in = OIIO::ImageInput::open(path);
   if (!in) return fail("it wrote no readable image: " + OIIO::geterror());

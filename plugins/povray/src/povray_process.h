@@ -12,9 +12,11 @@
 namespace dcm::povray {
 
 /// One POV-Ray process: pass `pass` at `width` x `height`, written to
-/// ScratchRender(pass) with its log in ScratchLog(pass).
+/// ScratchRender(pass) with its log in ScratchLog(pass), in the scratch
+/// folder or its subfolder `folder` (its own pixels.inc).
 struct PovrayJob {
   int pass = 0;
+  std::string folder;  ///< "" or ScratchSubfolder()
   int width = 0, height = 0;
   std::vector<std::string> args;  ///< more POV-Ray options (+SR2, Declare=Sparse=1, ...)
   std::string what;               ///< "pass 4 (illumination)", for messages
@@ -40,6 +42,9 @@ Status FindExecutable(const std::string& name, std::string* path);
 /// of scene.pov failed: POV-Ray exited with status 1: Parse Error: ..."),
 /// the others killed.
 Status RunJobs(const PovrayEnv& env, std::span<const PovrayJob> jobs);
+
+/// The folder `job` runs in.
+std::string JobFolder(const PovrayEnv& env, const PovrayJob& job);
 
 /// Reads R, G, B of the render of `job` (half-float EXR) and checks its size.
 Status ReadRender(const PovrayEnv& env, const PovrayJob& job, std::vector<RGB>* rgb);

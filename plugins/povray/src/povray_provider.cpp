@@ -68,6 +68,29 @@ Status ToIds(const std::vector<RGB>& rgb, int width, const std::string& what, st
   return Status::Ok();
 }
 
+/// Writes `pixels` as the scene's Sparse mode reads them: folder/pixels.inc.
+Status WritePixelList(const std::string& folder, std::span<const Point2i> pixels) {
+  const std::string path = folder + "/" + ScratchPixelList();
+  const size_t n = pixels.size();
+  std::ofstream inc(path);
+  inc << "#declare NPix = " << n << ";\n#declare PixX = array[" << n << "] {";
+  for (size_t i = 0; i < n; ++i) inc << (i ? (i % 24 ? "," : ",\n") : "\n") << pixels[i].x;
+  inc << "\n}\n#declare PixY = array[" << n << "] {";
+  for (size_t i = 0; i < n; ++i) inc << (i ? (i % 24 ? "," : ",\n") : "\n") << pixels[i].y;
+  inc << "\n}\n";
+  inc.close();
+  if (!inc) return Status::Error("cannot write the pixel list " + path);
+  return Status::Ok();
+}
+
+/// Where face k of n is in the render of a list: output pixel
+/// (k mod w, k div w + 1) of an image w = min(n, frame width) wide, since
+/// POV-Ray 3.7 traces face row r - 1 for output row r.
+size_t FaceOutput(size_t k, size_t n, int frameWidth) {
+  const size_t w = std::min(n, size_t(frameWidth));
+  return (k / w + 1) * w + k % w;
+}
+
 }  // namespace
 
 std::string_view PassName(Pass pass) {
@@ -78,6 +101,7 @@ std::string_view PassName(Pass pass) {
     case Pass::kTexture: return "texture";
     case Pass::kIllumination: return "illumination";
     case Pass::kNormal: return "normal";
+    case Pass::kHighlight: return "highlight mask";
   }
   return "unknown";
 }
@@ -116,7 +140,8 @@ Status PovrayProvider::RenderGuides(std::span<const Pass> also, int alsoWidth, i
     jobs.push_back(DenseJob(p, alsoWidth, alsoHeight));
     stats_.litInvocations += p == Pass::kBeauty || p == Pass::kIllumination;
   }
-  for (Pass p : {Pass::kObjectId, Pass::kShaderId, Pass::kTexture, Pass::kNormal}) jobs.push_back(DenseJob(p, w, h));
+  for (Pass p : {Pass::kObjectId, Pass::kShaderId, Pass::kTexture, Pass::kNormal, Pass::kHighlight})
+    jobs.push_back(DenseJob(p, w, h));
   const PovrayEnv env = Env();
   stats_.invocations += int(jobs.size());
   DCM_RETURN_IF_ERROR(RunJobs(env, jobs));
@@ -130,6 +155,18 @@ Status PovrayProvider::RenderGuides(std::span<const Pass> also, int alsoWidth, i
   DCM_RETURN_IF_ERROR(ReadRender(env, jobs[g + 1], &shader));
   DCM_RETURN_IF_ERROR(ReadRender(env, jobs[g + 2], &tau_));
   DCM_RETURN_IF_ERROR(ReadRender(env, jobs[g + 3], &slope));
+  std::vector<RGB> mask;
+  DCM_RETURN_IF_ERROR(ReadRender(env, jobs[g + 4], &mask));
+  // The mask is optional: a scene without pass 6 renders something else than
+  // 0 and 1 there, and every exact pixel then gets its L_i rendered.
+  haveHighlightMask_ = true;
+  highlight_.resize(mask.size());
+  for (size_t i = 0; i < mask.size() && haveHighlightMask_; ++i) {
+    const RGB c = mask[i];
+    haveHighlightMask_ = (c.r == 0 || c.r == 1) && c.g == c.r && c.b == c.r;
+    highlight_[i] = c.r == 1;
+  }
+  if (!haveHighlightMask_) highlight_.clear();
   DCM_RETURN_IF_ERROR(ToIds(id, w, PassText(Pass::kObjectId) + " of " + env.sceneName, &objectId_));
   DCM_RETURN_IF_ERROR(ToIds(shader, w, PassText(Pass::kShaderId) + " of " + env.sceneName, &shaderId_));
   // slope gives v = 1 - angle/180 deg along each axis: N = -cos(pi v). No
@@ -197,58 +234,76 @@ Status PovrayProvider::Evaluate(std::span<const Point2i> pixels, const SampleReq
                                 std::span<ExactSample> out) {
   if (pixels.empty()) return Status::Ok();
   const auto t0 = Clock::now();
-  const int W = options_.width, H = options_.height;
+  const int W = options_.width;
   const PovrayEnv env = Env();
-  // The pixel list as the scene's Sparse mode reads it.
   const size_t n = pixels.size();
-  {
-    std::ofstream inc(scratch_ + "/" + ScratchPixelList());
-    inc << "#declare NPix = " << n << ";\n#declare PixX = array[" << n << "] {";
-    for (size_t i = 0; i < n; ++i) inc << (i ? (i % 24 ? "," : ",\n") : "\n") << pixels[i].x;
-    inc << "\n}\n#declare PixY = array[" << n << "] {";
-    for (size_t i = 0; i < n; ++i) inc << (i ? (i % 24 ? "," : ",\n") : "\n") << pixels[i].y;
-    inc << "\n}\n";
-    inc.close();
-    if (!inc)
-      return Status::Error("cannot write the pixel list " + scratch_ + "/" + ScratchPixelList());
+  auto index = [W](Point2i p) { return size_t(p.y) * size_t(W) + size_t(p.x); };
+  // The pixels whose L_i must be rendered: those with highlights or
+  // reflection (L_c may be non-zero) and those whose tau is too dark to
+  // divide by; elsewhere L_c = 0 and L_i = L/tau.
+  std::vector<size_t> needLi;
+  if (what.split)
+    for (size_t k = 0; k < n; ++k) {
+      const size_t i = index(pixels[k]);
+      const RGB t = tau_[i];
+      const bool matte = haveHighlightMask_ && !highlight_[i] &&
+                         (objectId_[i] == 0 || std::min({t.r, t.g, t.b}) >= kMinDivisibleTau);
+      if (!matte) needLi.push_back(k);
+    }
+  std::vector<Point2i> liPixels;
+  for (size_t k : needLi) liPixels.push_back(pixels[k]);
+  const bool ownList = !needLi.empty() && needLi.size() < n;
+  DCM_RETURN_IF_ERROR(WritePixelList(scratch_, pixels));
+  if (ownList) {
+    std::error_code ec;
+    std::filesystem::create_directory(scratch_ + "/" + ScratchSubfolder(), ec);
+    if (ec) return Status::Error("cannot make " + scratch_ + "/" + ScratchSubfolder() + ": " + ec.message());
+    DCM_RETURN_IF_ERROR(WritePixelList(scratch_ + "/" + ScratchSubfolder(), liPixels));
   }
-  // One mesh_camera face per pixel: face k is output pixel (k mod sw,
-  // k div sw + 1), since POV-Ray 3.7 traces face row r - 1 for output row r;
-  // rows from the second (+SR2, 1-based) are rendered.
-  const int sw = int(std::min<size_t>(n, size_t(W)));
-  const int sh = int((n + size_t(sw) - 1) / size_t(sw)) + 1;
-  const std::vector<std::string> args = {"+SR2", "Declare=Sparse=1", "Declare=FullW=" + std::to_string(W),
-                                         "Declare=FullH=" + std::to_string(H)};
-  std::vector<PovrayJob> jobs;
-  for (Pass p : {Pass::kBeauty, Pass::kIllumination}) {
-    if (p == Pass::kIllumination && !what.split) continue;
-    PovrayJob job = DenseJob(p, sw, sh);
-    job.args = args;
-    job.what = PassText(p) + " for " + std::to_string(n) + " pixels";
-    jobs.push_back(std::move(job));
+  std::vector<PovrayJob> jobs = {SparseJob(Pass::kBeauty, pixels.size())};
+  if (!needLi.empty()) {
+    jobs.push_back(SparseJob(Pass::kIllumination, needLi.size()));
+    if (ownList) jobs.back().folder = ScratchSubfolder();
   }
   stats_.invocations += int(jobs.size());
   stats_.litInvocations += int(jobs.size());
   DCM_RETURN_IF_ERROR(RunJobs(env, jobs));
   std::vector<RGB> L, Li;
   DCM_RETURN_IF_ERROR(ReadRender(env, jobs[0], &L));
-  if (what.split) DCM_RETURN_IF_ERROR(ReadRender(env, jobs[1], &Li));
+  if (jobs.size() > 1) DCM_RETURN_IF_ERROR(ReadRender(env, jobs[1], &Li));
   for (size_t k = 0; k < n; ++k) {
-    const size_t at = (k / size_t(sw) + 1) * size_t(sw) + k % size_t(sw);
     ExactSample& s = out[k];
-    const Point2i p = pixels[k];
-    const size_t i = size_t(p.y) * size_t(W) + size_t(p.x);
-    s.L = L[at];
+    const size_t i = index(pixels[k]);
+    s = ExactSample{};
+    s.L = L[FaceOutput(k, n, W)];
     if (what.split) {
-      s.Li = Li[at];
-      s.Lc = s.L - s.Li * tau_[i];
+      // L_i = L/tau on matte surfaces (L_c = 0); the background is black.
+      const RGB t = tau_[i];
+      if (objectId_[i] != 0) s.Li = RGB{s.L.r / t.r, s.L.g / t.g, s.L.b / t.b};
     }
     rendered_[i] = 1;
-    samples_[i] = s;
   }
+  for (size_t j = 0; j < needLi.size(); ++j) {
+    ExactSample& s = out[needLi[j]];
+    s.Li = Li[FaceOutput(j, needLi.size(), W)];
+    s.Lc = s.L - s.Li * tau_[index(pixels[needLi[j]])];
+  }
+  for (size_t k = 0; k < n; ++k) samples_[index(pixels[k])] = out[k];
   stats_.roundS.push_back(Since(t0));
   stats_.roundPixels.push_back(int64_t(n));
+  stats_.illuminationPixels += int64_t(needLi.size());
   return Status::Ok();
+}
+
+PovrayJob PovrayProvider::SparseJob(Pass pass, size_t n) const {
+  // One mesh_camera face per pixel, rows from the second (+SR2, 1-based): see FaceOutput().
+  const int W = options_.width;
+  const int sw = int(std::min<size_t>(n, size_t(W)));
+  PovrayJob job = DenseJob(pass, sw, int((n + size_t(sw) - 1) / size_t(sw)) + 1);
+  job.args = {"+SR2", "Declare=Sparse=1", "Declare=FullW=" + std::to_string(W),
+              "Declare=FullH=" + std::to_string(options_.height)};
+  job.what = PassText(pass) + " for " + std::to_string(n) + " pixels";
+  return job;
 }
 
 }  // namespace dcm::povray

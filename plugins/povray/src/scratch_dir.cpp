@@ -14,7 +14,7 @@ namespace dcm::povray {
 
 namespace {
 
-constexpr int kPasses = 6;
+constexpr int kPasses = 7;
 
 /// The folder registered for the signal handler: written before the flag is
 /// set, read only when it is.
@@ -41,6 +41,7 @@ void UnlinkIn(const char* dir, const char* name) {
 }  // namespace
 
 std::string ScratchPixelList() { return "pixels.inc"; }
+std::string ScratchSubfolder() { return "li"; }
 std::string ScratchRender(int pass) { return "pass" + std::to_string(pass) + ".exr"; }
 std::string ScratchLog(int pass) { return "pass" + std::to_string(pass) + ".log"; }
 
@@ -64,17 +65,28 @@ void RemoveScratch(const std::string& path) {
   std::filesystem::remove_all(path, ec);
 }
 
-void RemoveScratchOnSignal() {
-  if (!g_registered.load()) return;
-  UnlinkIn(g_scratch, "pixels.inc");
+/// Unlinks the fixed names in `dir` (async-signal-safe).
+static void RemoveFilesIn(const char* dir) {
+  UnlinkIn(dir, "pixels.inc");
   // POV-Ray's state file while it renders pass N is passN.pov-state.
   char name[] = "pass0.exr", log[] = "pass0.log", state[] = "pass0.pov-state";
   for (int p = 0; p < kPasses; ++p) {
     name[4] = log[4] = state[4] = char('0' + p);
-    UnlinkIn(g_scratch, name);
-    UnlinkIn(g_scratch, log);
-    UnlinkIn(g_scratch, state);
+    UnlinkIn(dir, name);
+    UnlinkIn(dir, log);
+    UnlinkIn(dir, state);
   }
+}
+
+void RemoveScratchOnSignal() {
+  if (!g_registered.load()) return;
+  char sub[PATH_MAX];
+  size_t len = 0;
+  if (Append(sub, sizeof sub, &len, g_scratch) && Append(sub, sizeof sub, &len, "/li")) {
+    RemoveFilesIn(sub);
+    ::rmdir(sub);
+  }
+  RemoveFilesIn(g_scratch);
   ::rmdir(g_scratch);
 }
 

@@ -13,6 +13,9 @@ namespace dcm::povray {
 /// (0 to 5) a render, a log and POV-Ray's state file while it renders
 /// (passN.pov-state).
 std::string ScratchPixelList();                 ///< "pixels.inc" (the name scene files include)
+/// "li": the folder of the illumination pass's own pixel list, when it
+/// renders fewer pixels than the beauty pass (the same file names inside).
+std::string ScratchSubfolder();
 std::string ScratchRender(int pass);            ///< "pass4.exr"
 std::string ScratchLog(int pass);               ///< "pass4.log"
 

@@ -25,12 +25,21 @@ enum class Pass : int {
   kTexture = 3,       ///< tau: the diffuse pigment, emission only
   kIllumination = 4,  ///< L_i: every pigment white, diffuse and ambient only
   kNormal = 5,        ///< slope patterns along x, y, z in R, G, B
+  /// 1 where the texture has highlights or reflection (L_c may be non-zero),
+  /// else 0, emission only. Optional: without it every exact pixel's L_i is
+  /// rendered; with it only those marked (elsewhere L_i = L/tau).
+  kHighlight = 6,
 };
+
+/// The least tau (every channel) that L_i = L/tau is derived from on a matte
+/// surface: below it the half-float L holds too few bits of L_i.
+inline constexpr float kMinDivisibleTau = 0.01f;
 
 /// "beauty", "object ID", ... for messages.
 std::string_view PassName(Pass pass);
 
 struct PovrayEnv;  // src/povray_process.h
+struct PovrayJob;
 
 struct PovrayOptions {
   std::string scene;              ///< the .pov file
@@ -48,6 +57,7 @@ struct PovrayRunStats {
   int litInvocations = 0;       ///< of which the beauty and illumination passes
   std::vector<double> roundS;   ///< wall time of each Evaluate() call
   std::vector<int64_t> roundPixels;  ///< pixels asked in each Evaluate() call
+  int64_t illuminationPixels = 0;    ///< of those, rendered in the illumination pass too
 };
 
 /// The provider. Not thread safe (Capabilities().threadSafe is false): the
@@ -63,7 +73,8 @@ class PovrayProvider final : public SampleProvider {
   PovrayProvider(const PovrayProvider&) = delete;
   PovrayProvider& operator=(const PovrayProvider&) = delete;
 
-  /// Renders the guide passes (object and shader IDs, tau, normal) in full,
+  /// Renders the guide passes (object and shader IDs, tau, normal, the
+  /// highlight mask) in full,
   /// `concurrency` processes at a time, and checks that the ID passes hold
   /// one integer per pixel (a scene that ignores `Pass` does not). In the
   /// same batch of processes, first (they take longest), it renders `also`
@@ -80,7 +91,9 @@ class PovrayProvider final : public SampleProvider {
   /// The guides of RenderGuides() (which must have run) for `region`.
   Status Guides(const Bounds2i& region, const GuideRequest& what, GuideImage* out) override;
   /// Renders the beauty and illumination passes for `pixels` through the
-  /// mesh camera, in two processes at the same time: one round.
+  /// mesh camera, in two processes at the same time: one round. The
+  /// illumination pass renders only the pixels the highlight mask marks (or
+  /// whose tau is below kMinDivisibleTau), from its own pixel list.
   Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what,
                   std::span<ExactSample> out) override;
 
@@ -93,6 +106,8 @@ class PovrayProvider final : public SampleProvider {
   const std::vector<uint32_t>& objectIds() const { return objectId_; }
   const std::vector<uint32_t>& shaderIds() const { return shaderId_; }
   const std::vector<RGB>& texture() const { return tau_; }
+  /// Whether the scene rendered the highlight mask (pass 6).
+  bool haveHighlightMask() const { return haveHighlightMask_; }
   /// The scratch folder (for messages and tests).
   const std::string& scratch() const { return scratch_; }
 
@@ -100,6 +115,8 @@ class PovrayProvider final : public SampleProvider {
   explicit PovrayProvider(PovrayOptions options) : options_(std::move(options)) {}
   /// Where and how the processes run.
   PovrayEnv Env() const;
+  /// The job rendering `pass` for a list of `n` pixels (pixels.inc).
+  PovrayJob SparseJob(Pass pass, size_t n) const;
 
   PovrayOptions options_;
   std::string povrayPath_;  ///< the executable found
@@ -109,6 +126,8 @@ class PovrayProvider final : public SampleProvider {
   std::vector<uint32_t> objectId_, shaderId_;
   std::vector<RGB> tau_;
   std::vector<Vec3f> normal_;
+  bool haveHighlightMask_ = false;
+  std::vector<uint8_t> highlight_;  ///< per pixel, with the mask
   std::vector<uint8_t> rendered_;
   std::vector<ExactSample> samples_;
 };
