@@ -127,8 +127,6 @@ int RunPovray(const PovrayFlags& f) {
   ReconstructionOptions options;
   if (Status st = ToOptions(f.engine, &options); !st.ok()) return Fail(st.message(), kExitUsage);
   if (Status st = toolkit::CheckExrFormat(f.exr); !st.ok()) return Fail(st.message(), kExitUsage);
-  if (!f.engine.progressive.empty())
-    return Fail("--progressive: the preview schedule runs the engine several times; not with dcm povray", kExitUsage);
   RoundSchedule schedule{};
   if (Status st = Parse(f.schedule, &schedule); !st.ok()) return Fail("--schedule: " + st.message(), kExitUsage);
   const bool full = options.fullEvaluation;
@@ -319,6 +317,10 @@ Registration reg("povray", "Render a POV-Ray scene (the pass convention of docs/
                    AddExrFormatFlags(app, &f->exr);
                    AddEngineFlags(app, &f->engine);
                    app->get_option("--full")->description("render the beauty pass in full (the baseline)");
+                   app->get_option("--downsample")
+                       ->description("render N times --size per axis and box-filter the result down (antialiasing)");
+                   // The preview schedule runs the engine several times: no level images.
+                   app->remove_option(app->get_option("--progressive"));
                    return [f] { return RunPovray(*f); };
                  });
 
