@@ -182,7 +182,11 @@ int RunPovray(const PovrayFlags& f) {
     if (!st.ok()) return Fail(st.message());
     denseS = Since(td);
     if (f.engine.verbose)
-      std::cerr << "dcm povray: engine settings: " << SettingsSummary(options, provider->Capabilities()) << "\n";
+      std::cerr << "dcm povray: engine settings: " << SettingsSummary(options, provider->Capabilities()) << "\n"
+                << "dcm povray: highlight mask (pass 6): "
+                << (provider->haveHighlightMask() ? "found, L_i rendered only where it marks"
+                                                  : "not in the scene, L_i rendered for every exact pixel")
+                << "\n";
     const auto te = Clock::now();
     if (schedule == RoundSchedule::kPreview) {
       previewPixels = int64_t(pw) * ph;
