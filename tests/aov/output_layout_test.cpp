@@ -188,6 +188,33 @@ TEST(OutputLayout, GenericAlpha) {
   EXPECT_LT(ReadExr(dir / "none.exr").spec.channelindex("A"), 0);
 }
 
+TEST(OutputLayout, TilesOfABlenderInputMergeToTheWholeOutput) {
+  ScratchDir dir;
+  Scene sc{32, 16};
+  WriteBlenderInput(dir / "in.exr", sc);
+  auto r = RunDcm({"reconstruct", dir / "in.exr", "--preset", "blender", "-o", dir / "whole.exr", "--quiet"}, dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  for (const auto& [tile, name] : {std::pair{"0/2", "t0.exr"}, std::pair{"1/2", "t1.exr"}}) {
+    r = RunDcm({"reconstruct", dir / "in.exr", "--preset", "blender", "--tile", tile, "-o", dir / name, "--quiet"}, dir);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+  }
+  r = RunDcm({"merge", dir / "t0.exr", dir / "t1.exr", "-o", dir / "m.exr", "--quiet"}, dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const Exr whole = ReadExr(dir / "whole.exr"), merged = ReadExr(dir / "m.exr");
+  // The layout, the types, every channel's values (the UINT IDs beyond 2^24
+  // too) and the renderer's metadata are the whole run's.
+  ASSERT_EQ(merged.names(), whole.names());
+  for (int c = 0; c < whole.spec.nchannels; ++c) {
+    EXPECT_EQ(merged.spec.channelformat(c), whole.spec.channelformat(c)) << whole.names()[size_t(c)];
+    EXPECT_EQ(merged.planes[size_t(c)], whole.planes[size_t(c)]) << whole.names()[size_t(c)];
+    EXPECT_EQ(merged.ids[size_t(c)], whole.ids[size_t(c)]) << whole.names()[size_t(c)];
+  }
+  EXPECT_EQ(merged.spec.alpha_channel, merged.spec.channelindex("ViewLayer.Combined.A"));
+  EXPECT_EQ(merged.spec.get_string_attribute("Camera"), "Camera.001");
+  EXPECT_EQ(merged.spec.get_string_attribute("studio:shot"), "sh010");
+  EXPECT_EQ(merged.spec.get_string_attribute("dcm:raw_channels"), "") << "a part's bookkeeping stays in the parts";
+}
+
 TEST(OutputLayout, PartsTakeTheFormatFromMerge) {
   ScratchDir dir;
   Scene sc{32, 16};
@@ -207,8 +234,12 @@ TEST(OutputLayout, PartsTakeTheFormatFromMerge) {
              dir);
   ASSERT_EQ(r.exitCode, 0) << r.err;
   const Exr m = ReadExr(dir / "m.exr");
-  EXPECT_THAT(m.names(), UnorderedElementsAre("R", "G", "B"));
-  EXPECT_EQ(m.spec.format, OIIO::TypeDesc::HALF);
+  // The parts carry the input's passes; -d half stores the beauty as half
+  // and leaves the IDs as they were (a part records them as raw).
+  EXPECT_THAT(m.names(), UnorderedElementsAre("R", "G", "B", "id", "shader"));
+  for (const char* c : {"R", "G", "B"}) EXPECT_EQ(m.spec.channelformat(m.spec.channelindex(c)), OIIO::TypeDesc::HALF) << c;
+  for (const char* c : {"id", "shader"})
+    EXPECT_EQ(m.spec.channelformat(m.spec.channelindex(c)), OIIO::TypeDesc::FLOAT) << c;
   EXPECT_EQ(m.spec.get_string_attribute("compression"), "piz");
 }
 

@@ -79,7 +79,19 @@ void SumJson(nlohmann::json& sum, const nlohmann::json& add) {
 
 bool IsPartAttribute(const std::string& name) {
   return name == kAttrTile || name == kAttrRegion || name == kAttrFingerprint || name == kAttrSettings ||
-         name == kAttrPartStats;
+         name == kAttrPartStats || name == kAttrRawChannels;
+}
+
+std::vector<std::string> SplitCommas(const std::string& text) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  while (start < text.size()) {
+    size_t end = text.find(',', start);
+    if (end == std::string::npos) end = text.size();
+    if (end > start) out.push_back(text.substr(start, end - start));
+    start = end + 1;
+  }
+  return out;
 }
 
 }  // namespace
@@ -143,6 +155,19 @@ Status WritePartExr(const std::string& path, int frameWidth, int frameHeight, co
   return WriteRgbExr(path, frame, region, pixels, metadata, alpha);
 }
 
+Status WritePartImage(const std::string& path, OutputImage image, const Metadata& metadata) {
+  if (image.data.empty() || Intersect(image.data, image.display) != image.data)
+    return Status::Error("cannot write '" + path + "': region " + RegionText(image.data) + " is not inside the " +
+                         std::to_string(image.display.width()) + "x" + std::to_string(image.display.height()) +
+                         " frame");
+  std::string raw;
+  for (const auto& c : image.channels)
+    if (c.raw || c.type == TypeDesc::UINT) raw += (raw.empty() ? "" : ",") + c.name;
+  AddMetadata(metadata, &image.attributes);
+  if (!raw.empty()) image.attributes.attribute(kAttrRawChannels, raw);
+  return WriteOutputExr(path, image, ExrFormat{});
+}
+
 Status ReadPart(const std::string& path, Part* part, bool withPixels) {
   std::error_code ec;
   if (!fs::exists(path, ec)) return Status::Error(Quote(path) + ": no such file");
@@ -176,18 +201,39 @@ Status ReadPart(const std::string& path, Part* part, bool withPixels) {
     return Status::Error(Quote(path) + ": region " + RegionText(data) + " lies outside its " +
                          std::to_string(spec.full_width) + "x" + std::to_string(spec.full_height) + " frame");
   part->channels = spec.channelnames;
+  part->types.clear();
+  for (int c = 0; c < spec.nchannels; ++c) {
+    const TypeDesc t = spec.channelformat(c);
+    part->types.push_back(t == TypeDesc::UINT ? TypeDesc::UINT : t == TypeDesc::HALF ? TypeDesc::HALF : TypeDesc::FLOAT);
+  }
+  part->rawChannels = SplitCommas(spec.get_string_attribute(kAttrRawChannels));
   part->pixels.clear();
+  part->ids.assign(size_t(spec.nchannels), {});
   if (withPixels) {
-    part->pixels.assign(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels), 0.f);
+    const size_t n = size_t(spec.width) * size_t(spec.height);
+    part->pixels.assign(n * size_t(spec.nchannels), 0.f);
     if (!in->read_image(0, 0, 0, spec.nchannels, TypeDesc::FLOAT, part->pixels.data()))
       return Status::Error("cannot read the pixels of " + Quote(path) + ": " + in->geterror());
+    // IDs above 2^24 do not survive float: UINT channels are read as they are.
+    for (int c = 0; c < spec.nchannels; ++c) {
+      if (part->types[size_t(c)] != TypeDesc::UINT) continue;
+      part->ids[size_t(c)].resize(n);
+      if (!in->read_image(0, 0, c, c + 1, TypeDesc::UINT, part->ids[size_t(c)].data()))
+        return Status::Error("cannot read channel '" + spec.channelnames[size_t(c)] + "' of " + Quote(path) + ": " +
+                             in->geterror());
+    }
   }
   part->metadata = {};
+  part->attributes.clear();
   for (const auto& p : spec.extra_attribs) {
     const std::string name = p.name().string();
-    if (IsPartAttribute(name) || (name.rfind("dcm:", 0) != 0 && name != "Software")) continue;
-    if (p.type() == TypeDesc::STRING) part->metadata.strings.push_back({name, p.get_string()});
-    else if (p.type() == TypeDesc::FLOAT) part->metadata.floats.push_back({name, p.get_float()});
+    if (IsPartAttribute(name)) continue;
+    if (name.rfind("dcm:", 0) == 0 || name == "Software") {
+      if (p.type() == TypeDesc::STRING) part->metadata.strings.push_back({name, p.get_string()});
+      else if (p.type() == TypeDesc::FLOAT) part->metadata.floats.push_back({name, p.get_float()});
+    } else if (!IsStructuralAttribute(name)) {
+      part->attributes.push_back(p);
+    }
   }
   return Status::Ok();
 }
@@ -209,15 +255,6 @@ Status MergeParts(const std::vector<std::string>& paths, MergedFrame* frame) {
       return Status::Error(Describe(p) + " belongs to a " + std::to_string(p.frameWidth) + "x" +
                            std::to_string(p.frameHeight) + " frame, " + Describe(first) + " to a " +
                            std::to_string(first.frameWidth) + "x" + std::to_string(first.frameHeight) + " frame");
-    if (p.channels != first.channels) {
-      auto join = [](const std::vector<std::string>& v) {
-        std::string s;
-        for (const auto& c : v) s += (s.empty() ? "" : ",") + c;
-        return s;
-      };
-      return Status::Error(Describe(p) + " has channels " + join(p.channels) + ", " + Describe(first) + " " +
-                           join(first.channels));
-    }
     if (p.fingerprint != first.fingerprint) {
       std::string detail;
       try {
@@ -230,6 +267,15 @@ Status MergeParts(const std::vector<std::string>& paths, MergedFrame* frame) {
       }
       return Status::Error(Describe(p) + " was made with other settings than " + Describe(first) +
                            " (fingerprint " + p.fingerprint + " vs " + first.fingerprint + ")" + detail);
+    }
+    if (p.channels != first.channels || p.types != first.types) {
+      auto join = [](const std::vector<std::string>& v) {
+        std::string s;
+        for (const auto& c : v) s += (s.empty() ? "" : ",") + c;
+        return s;
+      };
+      return Status::Error(Describe(p) + " has channels " + join(p.channels) + ", " + Describe(first) + " " +
+                           join(first.channels));
     }
     int index = 0, count = 0;
     if (!p.tile.empty()) ParseTile(p.tile, &index, &count);
@@ -253,16 +299,23 @@ Status MergeParts(const std::vector<std::string>& paths, MergedFrame* frame) {
   const size_t nch = first.channels.size();
   std::vector<uint8_t> covered(size_t(W) * size_t(H), 0);
   frame->pixels.assign(size_t(W) * size_t(H) * nch, 0.f);
+  frame->ids.assign(nch, {});
+  for (size_t c = 0; c < nch; ++c)
+    if (first.types[c] == TypeDesc::UINT) frame->ids[c].assign(size_t(W) * size_t(H), 0u);
   for (const Part& header : parts) {
     Part p;
     DCM_RETURN_IF_ERROR(ReadPart(header.path, &p));
-    if (p.region != header.region || p.channels != header.channels)
+    if (p.region != header.region || p.channels != header.channels || p.types != header.types)
       return Status::Error(Quote(p.path) + " changed while it was being merged");
     const int w = p.region.width();
     for (int y = 0; y < p.region.height(); ++y) {
       const size_t dst = (size_t(y + p.region.min.y) * size_t(W) + size_t(p.region.min.x));
       std::copy_n(p.pixels.begin() + ptrdiff_t(size_t(y) * size_t(w) * nch), size_t(w) * nch,
                   frame->pixels.begin() + ptrdiff_t(dst * nch));
+      for (size_t c = 0; c < nch; ++c)
+        if (!p.ids[c].empty())
+          std::copy_n(p.ids[c].begin() + ptrdiff_t(size_t(y) * size_t(w)), size_t(w),
+                      frame->ids[c].begin() + ptrdiff_t(dst));
       std::fill_n(covered.begin() + ptrdiff_t(dst), w, uint8_t(1));
     }
   }
@@ -301,7 +354,10 @@ Status MergeParts(const std::vector<std::string>& paths, MergedFrame* frame) {
   frame->width = W;
   frame->height = H;
   frame->channels = first.channels;
+  frame->types = first.types;
+  frame->rawChannels = first.rawChannels;
   frame->metadata = first.metadata;
+  frame->attributes = first.attributes;
   frame->stats = nullptr;
   bool allStats = true;
   nlohmann::json sum = nlohmann::json::object();
@@ -336,10 +392,17 @@ Status WriteMergedExr(const std::string& path, const MergedFrame& frame, const M
   for (size_t c = 0; c < nch; ++c) {
     OutputChannel ch;
     ch.name = frame.channels[c];
-    ch.values.resize(n);
-    for (size_t i = 0; i < n; ++i) ch.values[i] = frame.pixels[i * nch + c];
+    ch.type = c < frame.types.size() ? frame.types[c] : TypeDesc::FLOAT;
+    ch.raw = std::find(frame.rawChannels.begin(), frame.rawChannels.end(), ch.name) != frame.rawChannels.end();
+    if (ch.type == TypeDesc::UINT) {
+      ch.ids = frame.ids.at(c);
+    } else {
+      ch.values.resize(n);
+      for (size_t i = 0; i < n; ++i) ch.values[i] = frame.pixels[i * nch + c];
+    }
     image.channels.push_back(std::move(ch));
   }
+  image.attributes = frame.attributes;
   AddMetadata(frame.metadata, &image.attributes);
   AddMetadata(extra, &image.attributes);
   return WriteOutputExr(path, image, format);

@@ -26,6 +26,8 @@ inline constexpr const char* kAttrRegion = "dcm:region";            ///< "x,y,w,
 inline constexpr const char* kAttrFingerprint = "dcm:fingerprint";  ///< 16 hex digits
 inline constexpr const char* kAttrSettings = "dcm:part_settings";   ///< the JSON the fingerprint hashes
 inline constexpr const char* kAttrPartStats = "dcm:part_stats";     ///< counts over the part's pixels (JSON)
+/// The channels -d must leave alone (IDs, Cryptomatte hashes), comma-separated.
+inline constexpr const char* kAttrRawChannels = "dcm:raw_channels";
 
 /// 64-bit FNV-1a, continued from `seed`.
 uint64_t HashBytes(std::span<const char> bytes, uint64_t seed = 14695981039346656037ull);
@@ -55,18 +57,28 @@ std::string RegionText(const Bounds2i& region);
 Status WritePartExr(const std::string& path, int frameWidth, int frameHeight, const Bounds2i& region,
                     std::span<const RGB> pixels, const Metadata& metadata, bool alpha = false);
 
+/// Writes `image` as a part: display window = the frame, data window = the
+/// region, every channel in its stored type, `metadata` (the part attributes
+/// among them) added to its attributes, and the raw channels recorded
+/// (kAttrRawChannels) so that `dcm merge -d` leaves them alone; atomically.
+Status WritePartImage(const std::string& path, OutputImage image, const Metadata& metadata);
+
 /// One part as read back.
 struct Part {
   std::string path;
   int frameWidth = 0, frameHeight = 0;
   Bounds2i region;
   std::vector<std::string> channels;
-  std::vector<float> pixels;  ///< region-sized, channels interleaved
+  std::vector<OIIO::TypeDesc> types;  ///< each channel's stored type: FLOAT, HALF or UINT
+  std::vector<std::string> rawChannels;  ///< kAttrRawChannels
+  std::vector<float> pixels;  ///< region-sized, channels interleaved (UINT channels: see ids)
+  std::vector<std::vector<uint32_t>> ids;  ///< per channel: the UINT channels' values, region-sized
   std::string tile;           ///< "I/N" or empty
   std::string fingerprint;
   std::string settings;       ///< JSON text
   std::string partStats;      ///< JSON text or empty
-  Metadata metadata;          ///< every other string and float attribute
+  Metadata metadata;          ///< dcm's other attributes and Software
+  OIIO::ParamValueList attributes;  ///< the inputs' (renderer's) attributes, structural ones excluded
 };
 
 /// Reads a part (its pixels too unless `withPixels` is false); the message
@@ -77,8 +89,12 @@ Status ReadPart(const std::string& path, Part* part, bool withPixels = true);
 struct MergedFrame {
   int width = 0, height = 0;
   std::vector<std::string> channels;
+  std::vector<OIIO::TypeDesc> types;       ///< as Part::types
+  std::vector<std::string> rawChannels;    ///< as Part::rawChannels
   std::vector<float> pixels;  ///< width x height, channels interleaved
+  std::vector<std::vector<uint32_t>> ids;  ///< per channel: the UINT channels' values, width x height
   Metadata metadata;          ///< the first part's, without the part attributes
+  OIIO::ParamValueList attributes;  ///< the first part's inputs' attributes
   nlohmann::json stats;       ///< counts summed over the parts (null when a part has none)
 };
 

@@ -145,7 +145,17 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
   toolkit::Metadata meta = ProvenanceMetadata(f, provider, options);
   AddPartMetadata(tile, region, settings, r, info, &meta);
 
-  int rc = outputs.Write(toolkit::WritePartExr(f.output, frame.x, frame.y, region, r.image, meta, f.alpha));
+  // The part keeps the inputs' layout (beauty names, alpha, passes cut to
+  // the region, metadata) so that the merged frame is the whole run's.
+  OutputLayout layout;
+  if (st = PlanOutputLayout(provider, f.aov.inputs, f.alpha, options.downsample, &layout); !st.ok())
+    return aov_common::Fail(cmd, st.message());
+  ExrReconstruction run;
+  run.result = r;
+  run.display = run.data = {{0, 0}, {frame.x, frame.y}};
+  toolkit::OutputImage image;
+  st = BuildOutputImage(layout, f.aov.inputs, run, options.downsample, {}, &image, &region);
+  int rc = outputs.Write(st.ok() ? toolkit::WritePartImage(f.output, std::move(image), meta) : st);
   if (rc) return rc;
   if (!f.sampleMap.empty() && (rc = outputs.Write(toolkit::WriteSampleMap(f.sampleMap, r)))) return rc;
   if (!f.preview.empty() &&

@@ -170,6 +170,32 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
   app->add_flag("-q,--quiet", f->quiet, "no progress on stderr");
 }
 
+void AddRoundFlags(CLI::App* app, RoundFlags* f) {
+  InGroup g(app, kGroupRounds);
+  app->add_option("--schedule", f->schedule,
+                  "how the renderer is asked for exact pixels: levels (as the refinement goes, a call per step), "
+                  "preview (chosen on a cheap preview, then a few large calls), auto (preview where a call costs "
+                  "more than about 1000 samples; docs/ENGINE.md)")
+      ->check(CLI::IsMember({"auto", "levels", "preview"}))
+      ->capture_default_str();
+  app->add_option("--max-rounds", f->maxRounds,
+                  "with the preview schedule: calls to the renderer at most; pixels still wanted after them keep "
+                  "their preview value (counted in the stats)")
+      ->transform(Integer(1, 1000))
+      ->capture_default_str();
+}
+
+Status ScheduleFor(const RoundFlags& flags, const RoundCost& cost, bool previewAvailable, RoundSchedule* out) {
+  if (flags.schedule == "auto") {
+    *out = previewAvailable ? ChooseSchedule(cost) : RoundSchedule::kLevels;
+    return Status::Ok();
+  }
+  DCM_RETURN_IF_ERROR(Parse(flags.schedule, out));
+  if (*out == RoundSchedule::kPreview && !previewAvailable)
+    return Status::Error("--schedule preview: the renderer gives no preview");
+  return Status::Ok();
+}
+
 Status CheckDownsample(int width, int height, int n, const std::string& what) {
   if (n > 1 && (width % n != 0 || height % n != 0))
     return Status::Error("--downsample " + std::to_string(n) + ": " + what + " " + std::to_string(width) + "x" +

@@ -7,6 +7,7 @@
 
 #include "dcm/options.h"
 #include "dcm/reconstructor.h"
+#include "dcm/round_schedule.h"
 #include "dcm/status.h"
 
 namespace dcm::cli {
@@ -40,6 +41,21 @@ struct EngineFlags {
 /// --downsample, --progressive, -v, -q. Every numeric flag is checked at parse
 /// time (exit 2, the flag named).
 void AddEngineFlags(CLI::App* app, EngineFlags* flags);
+
+/// How a command whose renderer pays a latency per round asks for its exact
+/// samples (`dcm pipe`, `dcm povray`, `dcm blender`).
+struct RoundFlags {
+  std::string schedule = "auto";  ///< auto | levels | preview
+  int maxRounds = 3;              ///< calls to the renderer at most, with the preview schedule
+};
+
+/// Adds --schedule and --max-rounds (help group "Rounds").
+void AddRoundFlags(CLI::App* app, RoundFlags* flags);
+
+/// The schedule the flags select for a renderer whose rounds cost `cost`:
+/// the one named, or with "auto" ChooseSchedule(cost); kPreview only where
+/// `previewAvailable` (a preview asked for without one is an error naming --schedule).
+Status ScheduleFor(const RoundFlags& flags, const RoundCost& cost, bool previewAvailable, RoundSchedule* out);
 
 /// --downsample `n` on an input of `width` x `height` pixels: both must be
 /// multiples of n (a partial box at the edge would average fewer samples).

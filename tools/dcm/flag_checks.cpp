@@ -96,7 +96,7 @@ CLI::Validator Parsed(const std::string& what, std::function<Status(const std::s
 std::string HelpFormatter::make_help(const CLI::App* app, std::string name, CLI::AppFormatMode mode) const {
   if (mode == CLI::AppFormatMode::Sub) return make_expanded(app);
   std::vector<std::string> groups = {kGroupGeneral, kGroupIo,    kGroupQuality,  kGroupGuides,
-                                     kGroupTiles,   kGroupNoise, kGroupInternals};
+                                     kGroupTiles,   kGroupNoise, kGroupRounds, kGroupInternals};
   for (const std::string& g : app->get_groups())
     if (std::find(groups.begin(), groups.end(), g) == groups.end()) groups.push_back(g);
   std::ostringstream out;

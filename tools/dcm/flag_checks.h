@@ -25,6 +25,7 @@ inline constexpr const char* kGroupQuality = "Quality";
 inline constexpr const char* kGroupGuides = "Guides";
 inline constexpr const char* kGroupTiles = "Tiles and frames";
 inline constexpr const char* kGroupNoise = "Noise";
+inline constexpr const char* kGroupRounds = "Rounds";
 inline constexpr const char* kGroupInternals = "Engine internals";
 
 /// Worker threads: at most this many. TBB builds an arena of as many slots as

@@ -10,6 +10,7 @@
 #include "common/stats_json.h"
 #include "common/tiles.h"
 #include "dcm/downsample.h"
+#include "pass_downsample.h"
 
 namespace dcm::cli {
 
@@ -151,12 +152,12 @@ Status PlanOutputLayout(const aov::AovProvider& provider, const std::vector<std:
     out->notes.push_back("output: the beauty is no single channel of the inputs; written as R, G, B");
   }
   const std::string alphaName = AlphaBeside(beauty[0]);
-  const bool copyPasses = provider.dense() && downsample <= 1;
+  const bool copyPasses = provider.dense();
   if (!provider.dense())
     out->notes.push_back("output: sparse mode: the inputs' other passes are those of the guide render; not written");
-  else if (!copyPasses)
+  else if (downsample > 1)
     out->notes.push_back("output: --downsample " + std::to_string(downsample) +
-                         ": the inputs' other passes are at the input resolution; not written");
+                         ": passes box-filtered, IDs by majority, Cryptomatte by rank");
 
   // Every input channel, first file first (as the provider reads them).
   std::vector<OutputLayout::Source> all;
@@ -184,6 +185,7 @@ Status PlanOutputLayout(const aov::AovProvider& provider, const std::vector<std:
       }
     }
   }
+  out->cryptoLayers = cryptoLayers;
   const auto& ids = provider.IdChannels();
   for (auto& s : all) {
     s.raw = s.type == OIIO::TypeDesc::UINT || std::find(ids.begin(), ids.end(), s.name) != ids.end();
@@ -227,25 +229,29 @@ Status PlanOutputLayout(const aov::AovProvider& provider, const std::vector<std:
   out->notes.push_back("output: channels " + std::to_string(out->channels.size()) + " (" +
                        (out->alpha ? "alpha " + alphaName + " from the inputs"
                                    : haveAlpha ? "alpha " + alphaName + " = 1" : "no alpha") +
-                       ", " + std::to_string(out->passes.size()) + " passes copied), " +
+                       ", " + std::to_string(out->passes.size()) + " passes " +
+                       (downsample > 1 ? "downsampled" : "copied") + "), " +
                        std::to_string(out->attributes.size()) + " metadata attributes of the inputs");
   return Status::Ok();
 }
 
 Status BuildOutputImage(const OutputLayout& layout, const std::vector<std::string>& inputs,
                         const ExrReconstruction& run, int downsample, const toolkit::Metadata& provenance,
-                        toolkit::OutputImage* out) {
+                        toolkit::OutputImage* out, const Bounds2i* region) {
   const Reconstruction& r = run.result;
   // The inputs' data window: the alpha's resolution.
   const int inWidth = layout.inputSize.x, inHeight = layout.inputSize.y;
   out->display = run.display;
   out->data = run.data;
+  if (region)
+    out->data = {{run.data.min.x + region->min.x, run.data.min.y + region->min.y},
+                 {run.data.min.x + region->max.x, run.data.min.y + region->max.y}};
   out->attributes = layout.attributes;
   toolkit::AddMetadata(provenance, &out->attributes);
   const size_t n = r.image.size();
-  if (n != size_t(run.data.area()))
+  if (n != size_t(out->data.area()))
     return Status::Error("the output has " + std::to_string(n) + " pixels, its data window " +
-                         std::to_string(run.data.area()));
+                         std::to_string(out->data.area()));
 
   // The input channels the layout reads. EXR compresses all channels of a
   // block of scanlines together: each part is decoded once, as float, and
@@ -286,6 +292,7 @@ Status BuildOutputImage(const OutputLayout& layout, const std::vector<std::strin
     for (size_t i = 0; i < part.pixels; ++i) ch->values[i] = part.values[i * size_t(part.nchannels) + size_t(s.index)];
     return Status::Ok();
   };
+  std::vector<size_t> passes;  // output channels that are passes
   for (const auto& c : layout.channels) {
     toolkit::OutputChannel ch;
     ch.name = c.name;
@@ -315,10 +322,29 @@ Status BuildOutputImage(const OutputLayout& layout, const std::vector<std::strin
         ch.type = s.type;
         ch.raw = s.raw;
         DCM_RETURN_IF_ERROR(read(s, &ch));
+        passes.push_back(out->channels.size());
         break;
       }
     }
     out->channels.push_back(std::move(ch));
+  }
+  if (downsample > 1 && !passes.empty())
+    DCM_RETURN_IF_ERROR(DownsamplePasses(&out->channels, passes, layout.cryptoLayers, inWidth, inHeight, downsample));
+  if (region) {
+    // The alpha and the passes cover the whole data window: cut them to the part.
+    const size_t W = size_t(run.data.width());
+    auto cut = [&](auto& plane) {
+      if (plane.size() != W * size_t(run.data.height())) return;  // the beauty: the part's already
+      std::remove_reference_t<decltype(plane)> mine;
+      mine.reserve(size_t(region->area()));
+      for (int y = region->min.y; y < region->max.y; ++y)
+        for (int x = region->min.x; x < region->max.x; ++x) mine.push_back(plane[size_t(y) * W + size_t(x)]);
+      plane = std::move(mine);
+    };
+    for (auto& ch : out->channels) {
+      cut(ch.values);
+      cut(ch.ids);
+    }
   }
   return Status::Ok();
 }

@@ -81,7 +81,8 @@ struct OutputLayout {
   };
   std::vector<Channel> channels;  ///< in the output's order (the input's)
   std::optional<Source> alpha;    ///< the input's alpha; none: A = 1 (--alpha) or no alpha
-  std::vector<Source> passes;     ///< copied: dense mode at --downsample 1
+  std::vector<Source> passes;     ///< carried over: dense mode (downsampled by pass_downsample.h)
+  std::vector<std::string> cryptoLayers;  ///< the inputs' Cryptomatte layer names (their metadata)
   OIIO::ParamValueList attributes;  ///< the inputs' metadata (IsStructuralAttribute excluded)
   std::vector<std::string> notes;   ///< what the output keeps and what not, for -v
   Point2i inputSize;                ///< the inputs' data window's size
@@ -92,16 +93,19 @@ struct OutputLayout {
 /// Plans the output of `provider` (opened from `inputs`): the beauty under
 /// its input names (provider.BeautyChannels(), else R, G, B), the input's
 /// alpha (the channel beside the beauty's R named A), or A = 1 when `alpha`
-/// and the input has none; in dense mode at `downsample` 1 every other
-/// channel of the inputs. A file that cannot be read is an error naming it.
+/// and the input has none; in dense mode every other channel of the inputs. A file that cannot be read is an error naming it.
 Status PlanOutputLayout(const aov::AovProvider& provider, const std::vector<std::string>& inputs, bool alpha,
                         int downsample, OutputLayout* out);
 
 /// The output image of `run` laid out as `layout` says: the beauty
-/// reconstructed, the alpha and passes read from `inputs` (the alpha
-/// box-filtered by `downsample`), the inputs' metadata plus `provenance`.
+/// reconstructed, the alpha and passes read from `inputs` (with `downsample`
+/// > 1 the alpha box-filtered, the passes as DownsamplePasses filters them),
+/// the inputs' metadata plus `provenance`. With `region` (a part of the
+/// output's data window, --tile/--region), `run.result` holds that region
+/// only: the image's data window is the region, the alpha and the passes are
+/// cut to it.
 Status BuildOutputImage(const OutputLayout& layout, const std::vector<std::string>& inputs,
                         const ExrReconstruction& run, int downsample, const toolkit::Metadata& provenance,
-                        toolkit::OutputImage* out);
+                        toolkit::OutputImage* out, const Bounds2i* region = nullptr);
 
 }  // namespace dcm::cli
