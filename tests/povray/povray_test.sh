@@ -4,7 +4,7 @@
 #   povray_test.sh exact|errors DCM_BINARY SOURCE_DIR [POVRAY]
 #
 # exact: at 96x72, the exact pixels of `dcm povray` (those its sample map marks,
-#   with --rounds 10 so that no preview stand-in is left) equal the --full
+#   with --max-rounds 10 so that no preview stand-in is left) equal the --full
 #   render's within two half-float steps (tests/povray/exact_check.py says
 #   why); with the defaults, at most 5 POV-Ray processes render the lit
 #   passes (docs/POVRAY.md: 1 preview + 2 rounds x 2) and 10 in all (5 guides),
@@ -65,9 +65,9 @@ expect() {
 case $mode in
 exact)
   "$dcm" povray "$scene" -o "$tmp/full.exr" --size $size --full -q || fail "dcm povray --full failed"
-  "$dcm" povray "$scene" -o "$tmp/all.exr" --size $size --rounds 10 --stats "$tmp/all.json" \
-    --sample-map "$tmp/all.png" -q || fail "dcm povray --rounds 10 failed"
-  [[ $(json "$tmp/all.json" povray.preview_stand_ins) == 0 ]] || fail "--rounds 10 left preview stand-ins"
+  "$dcm" povray "$scene" -o "$tmp/all.exr" --size $size --max-rounds 10 --stats "$tmp/all.json" \
+    --sample-map "$tmp/all.png" -q || fail "dcm povray --max-rounds 10 failed"
+  [[ $(json "$tmp/all.json" povray.preview_stand_ins) == 0 ]] || fail "--max-rounds 10 left preview stand-ins"
   read -r _ n _ total _ maxrel _ beyond < <("$py" "$src/tests/povray/exact_check.py" "$tmp/all.exr" "$tmp/full.exr" "$tmp/all.png")
   [[ $n -gt 0 && $n -lt $((total * 2 / 5)) ]] || fail "exact pixels $n of $total: none, or more than 40 %"
   [[ $beyond == 0 ]] || fail "$beyond exact values differ from the full render by more than two half-float steps (max relative $maxrel)"

@@ -3,7 +3,7 @@
 //
 //   dcm povray SCENE.pov -o OUT.exr --size WxH [--full] [--povray PATH]
 //       [--stats S.json] [--sample-map M.png] [--reference REF.exr]
-//       [--schedule preview|levels] [--preview-scale N] [--rounds N]
+//       [--schedule auto|preview|levels] [--max-rounds N] [--preview-scale N] [--preview-passes P]
 //       [-d half|float] [--compression C] [--ch NAME,...] + engine flags
 //
 // The guide passes (IDs, tau, normal) are rendered in full, and with them the
@@ -50,10 +50,9 @@ using Clock = std::chrono::steady_clock;
 struct PovrayFlags {
   std::string scene, output, stats, sampleMap, reference, size;
   std::string povray = "povray";
-  std::string schedule = "preview";
   std::string previewPasses = "illumination";  ///< the lit passes the preview renders
   int previewScale = 8;  ///< the preview's pixels are N x N working pixels
-  int rounds = 2;        ///< exact rounds at most (preview schedule)
+  RoundFlags rounds{"auto", 2};  ///< --schedule, --max-rounds: 2 rounds keep the lit passes to 5 processes
   int processes = 2;     ///< POV-Ray processes at a time
   EngineFlags engine;
   toolkit::ExrFormat exr;
@@ -127,8 +126,6 @@ int RunPovray(const PovrayFlags& f) {
   ReconstructionOptions options;
   if (Status st = ToOptions(f.engine, &options); !st.ok()) return Fail(st.message(), kExitUsage);
   if (Status st = toolkit::CheckExrFormat(f.exr); !st.ok()) return Fail(st.message(), kExitUsage);
-  RoundSchedule schedule{};
-  if (Status st = Parse(f.schedule, &schedule); !st.ok()) return Fail("--schedule: " + st.message(), kExitUsage);
   const bool full = options.fullEvaluation;
   if (full && !f.sampleMap.empty())
     return Fail("--sample-map: with --full every pixel is rendered, there is no sample map", kExitUsage);
@@ -153,6 +150,9 @@ int RunPovray(const PovrayFlags& f) {
   po.height = H;
   po.concurrency = f.processes;
   if (Status st = povray::PovrayProvider::Open(po, &provider); !st.ok()) return Fail(st.message());
+  RoundSchedule schedule{};
+  if (Status st = ScheduleFor(f.rounds, provider->Cost(), /*previewAvailable=*/true, &schedule); !st.ok())
+    return Fail(st.message(), kExitUsage);
 
   Reconstruction rec;
   PreviewScheduleStats sched;
@@ -199,7 +199,7 @@ int RunPovray(const PovrayFlags& f) {
       PreviewSplit(L, &Li, pw, ph, W, H, g.texture, &Lc);
       povray::PovrayPreview previewProvider(*provider, pw, ph, std::move(Li), std::move(Lc));
       PreviewScheduleOptions so;
-      so.maxRounds = f.rounds;
+      so.maxRounds = f.rounds.maxRounds;
       st = ReconstructWithPreview(*provider, previewProvider, options, so, &rec, &sched);
     } else {
       st = Reconstruct(*provider, options, &rec);
@@ -225,7 +225,7 @@ int RunPovray(const PovrayFlags& f) {
   }
   j["provider"] = "povray";
   j["scene"] = f.scene;
-  j["schedule"] = full ? "full" : f.schedule;
+  j["schedule"] = full ? "full" : std::string(ToString(schedule));
   nlohmann::json p;
   p["invocations"] = runs.invocations;
   p["lit_invocations"] = runs.litInvocations;
@@ -299,12 +299,8 @@ Registration reg("povray", "Render a POV-Ray scene (the pass convention of docs/
                    app->add_option("--processes", f->processes, "POV-Ray processes at a time")
                        ->transform(Integer(1, 64))
                        ->capture_default_str();
-                   app->option_defaults()->group(kGroupQuality);
-                   app->add_option("--schedule", f->schedule,
-                                   "preview: plan on a low-resolution render, then a few rounds of exact pixels; "
-                                   "levels: one round per refinement step (many POV-Ray processes)")
-                       ->check(CLI::IsMember({"preview", "levels"}))
-                       ->capture_default_str();
+                   AddRoundFlags(app, &f->rounds);
+                   app->option_defaults()->group(kGroupRounds);
                    app->add_option("--preview-scale", f->previewScale,
                                    "the preview renders 1/N of the width and of the height")
                        ->transform(Integer(1, 64))
@@ -313,9 +309,6 @@ Registration reg("povray", "Render a POV-Ray scene (the pass convention of docs/
                                    "the lit passes the preview renders: illumination (L = L_i*tau, one process), "
                                    "beauty (L_i = L/tau), or both (two processes)")
                        ->check(CLI::IsMember({"illumination", "beauty", "both"}))
-                       ->capture_default_str();
-                   app->add_option("--rounds", f->rounds, "exact rounds at most (preview schedule)")
-                       ->transform(Integer(1, 100))
                        ->capture_default_str();
                    app->option_defaults()->group(kGroupGeneral);
                    AddExrFormatFlags(app, &f->exr);

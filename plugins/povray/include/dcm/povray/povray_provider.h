@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "dcm/round_schedule.h"
 #include "dcm/sample_provider.h"
 #include "dcm/status.h"
 
@@ -96,6 +97,12 @@ class PovrayProvider final : public SampleProvider {
   /// whose tau is below kMinDivisibleTau), from its own pixel list.
   Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what,
                   std::span<ExactSample> out) override;
+
+  /// What a round costs: a POV-Ray process spends about 0.65 s starting and
+  /// stopping however small its image (measured with POV-Ray 3.7.0.10: its
+  /// frontend and renderer exchange messages in 50 ms waits); the cost of a
+  /// pixel depends on the scene (unknown: 0).
+  RoundCost Cost() const { return RoundCost{0.65, 0}; }
 
   const PovrayRunStats& runStats() const { return stats_; }
   /// Per working pixel: 1 where Evaluate() rendered it.
