@@ -31,11 +31,17 @@ command -v povray >/dev/null 2>&1 ||
 
 tmp=$(mktemp -d /tmp/dcm-povray-test.XXXXXX) || fail "cannot create a temporary folder"
 trap 'rm -rf "$tmp"' EXIT
-# The scratch folders go here (TMPDIR), and the scene's private copy names
-# every POV-Ray process of this test on its command line (+I...).
+# The scratch folders go here (TMPDIR). POV-Ray runs through a link of its
+# own, so that its processes of this test, and only those, start with "$pov"
+# (dcm's command lines start with dcm). The scene's path has a space and a
+# quote, which POV-Ray's command line cannot take (dcm passes it in an INI file).
 export TMPDIR=$tmp/scratch
 mkdir -p "$TMPDIR"
-scene=$tmp/scene.pov
+pov=$tmp/povray-under-test
+ln -s "$(command -v povray)" "$pov"
+running() { pgrep -f "^$pov" >/dev/null; }
+mkdir -p "$tmp/my scenes"
+scene="$tmp/my scenes/it's a room.pov"
 cp "$src/examples/povray/scene.pov" "$scene"
 size=96x72
 py=/usr/bin/python3
@@ -48,7 +54,7 @@ print(d)' "$1" "$2"; }
 clean() {
   [[ ! -e $2 ]] || fail "$1: the output $2 exists"
   [[ -z $(ls -A "$TMPDIR") ]] || fail "$1: scratch left: $(ls -A "$TMPDIR")"
-  if pgrep -f "$scene" >/dev/null; then fail "$1: a POV-Ray process is left: $(pgrep -af "$scene")"; fi
+  if running; then fail "$1: a POV-Ray process is left: $(pgrep -af "^$pov")"; fi
 }
 # expect NAME CODE PATTERN OUTPUT -- COMMAND...: exit CODE, stderr matching PATTERN, then clean.
 expect() {
@@ -64,8 +70,8 @@ expect() {
 
 case $mode in
 exact)
-  "$dcm" povray "$scene" -o "$tmp/full.exr" --size $size --full -q || fail "dcm povray --full failed"
-  "$dcm" povray "$scene" -o "$tmp/all.exr" --size $size --max-rounds 10 --stats "$tmp/all.json" \
+  "$dcm" povray "$scene" -o "$tmp/full.exr" --size $size --full --povray "$pov" -q || fail "dcm povray --full failed"
+  "$dcm" povray "$scene" -o "$tmp/all.exr" --size $size --max-rounds 10 --stats "$tmp/all.json" --povray "$pov" \
     --sample-map "$tmp/all.png" -q || fail "dcm povray --max-rounds 10 failed"
   [[ $(json "$tmp/all.json" povray.preview_stand_ins) == 0 ]] || fail "--max-rounds 10 left preview stand-ins"
   read -r _ n _ total _ maxrel _ beyond < <("$py" "$src/tests/povray/exact_check.py" "$tmp/all.exr" "$tmp/full.exr" "$tmp/all.png")
@@ -74,7 +80,8 @@ exact)
   ok "$n of $total exact pixels equal the full render's (max relative difference $maxrel)"
   [[ -z $(ls -A "$TMPDIR") ]] || fail "scratch left after a run: $(ls -A "$TMPDIR")"
 
-  "$dcm" povray "$scene" -o "$tmp/dcm.exr" --size $size --reference "$tmp/full.exr" --stats "$tmp/dcm.json" -q ||
+  "$dcm" povray "$scene" -o "$tmp/dcm.exr" --size $size --reference "$tmp/full.exr" --stats "$tmp/dcm.json" \
+    --povray "$pov" -q ||
     fail "dcm povray failed"
   lit=$(json "$tmp/dcm.json" povray.lit_invocations)
   all=$(json "$tmp/dcm.json" povray.invocations)
@@ -94,27 +101,27 @@ errors)
   { echo '// Pass Sparse PixX PixY NPix'; cat "$tmp/plain.pov"; } >"$tmp/ignores.pov"
   expect "scene ignoring Pass" 1 "pass 1 \(object ID\) of ignores.pov does not hold one integer" "$out" -- \
     "$dcm" povray "$tmp/ignores.pov" -o "$out" --size $size
-  expect "povray /bin/false" 1 "rendering pass [0-9] \(.*\) of scene.pov failed: POV-Ray \(/bin/false\) exited with status 1" \
+  expect "povray /bin/false" 1 "rendering pass [0-9] \(.*\) of it's a room.pov failed: POV-Ray \(/bin/false\) exited with status 1" \
     "$out" -- "$dcm" povray "$scene" -o "$out" --size $size --povray /bin/false
   # A POV-Ray that renders the guides and the preview, then crashes in the first exact round.
   cat >"$tmp/crashing-povray" <<EOS
 #!/bin/sh
 case "\$*" in *Sparse=1*) kill -SEGV \$\$ ;; esac
-exec $(command -v povray) "\$@"
+exec "$pov" "\$@"
 EOS
   chmod +x "$tmp/crashing-povray"
-  expect "POV-Ray crashing mid-run" 1 "rendering pass [04] \(.*\) for [0-9]+ pixels of scene.pov failed: .*signal 11" "$out" -- \
+  expect "POV-Ray crashing mid-run" 1 "rendering pass [04] \(.*\) for [0-9]+ pixels of it's a room.pov failed: .*signal 11" "$out" -- \
     "$dcm" povray "$scene" -o "$out" --size $size --povray "$tmp/crashing-povray"
   expect "output folder missing" 1 "-o: cannot write '$tmp/no-dir/out.exr'" "$tmp/no-dir/out.exr" -- \
-    "$dcm" povray "$scene" -o "$tmp/no-dir/out.exr" --size $size
+    "$dcm" povray "$scene" -o "$tmp/no-dir/out.exr" --size $size --povray "$pov"
   expect "output = scene" 2 "an output never replaces an input" "$out" -- "$dcm" povray "$scene" -o "$scene" --size $size
   cmp -s "$scene" "$src/examples/povray/scene.pov" || fail "the scene was changed"
   expect "bad --size" 2 "--size: must be WIDTHxHEIGHT" "$out" -- "$dcm" povray "$scene" -o "$out" --size 96
   # SIGTERM while POV-Ray renders: dcm ends it and removes the scratch folder.
-  "$dcm" povray "$scene" -o "$out" --size 320x240 --full -q 2>"$tmp/err" &
+  "$dcm" povray "$scene" -o "$out" --size 320x240 --full --povray "$pov" -q 2>"$tmp/err" &
   pid=$!
-  for _ in $(seq 100); do pgrep -f "$scene" >/dev/null && break; sleep 0.05; done
-  pgrep -f "$scene" >/dev/null || fail "SIGTERM: POV-Ray never started"
+  for _ in $(seq 100); do running && break; sleep 0.05; done
+  running || fail "SIGTERM: POV-Ray never started"
   sleep 0.3
   kill -TERM $pid
   wait $pid
@@ -124,14 +131,14 @@ EOS
   clean "SIGTERM" "$out"
   ok "SIGTERM during a render: no output, no scratch, no POV-Ray"
   # SIGKILL: nothing of dcm runs to clean up, but its supervisor takes POV-Ray along.
-  "$dcm" povray "$scene" -o "$out" --size 320x240 --full -q 2>"$tmp/err" &
+  "$dcm" povray "$scene" -o "$out" --size 320x240 --full --povray "$pov" -q 2>"$tmp/err" &
   pid=$!
-  for _ in $(seq 100); do pgrep -f "$scene" >/dev/null && break; sleep 0.05; done
-  pgrep -f "$scene" >/dev/null || fail "SIGKILL: POV-Ray never started"
+  for _ in $(seq 100); do running && break; sleep 0.05; done
+  running || fail "SIGKILL: POV-Ray never started"
   kill -KILL $pid
   wait $pid 2>/dev/null
-  for _ in $(seq 60); do pgrep -f "$scene" >/dev/null || break; sleep 0.05; done
-  if pgrep -f "$scene" >/dev/null; then fail "SIGKILL: POV-Ray still runs 3 s after dcm died: $(pgrep -af "$scene")"; fi
+  for _ in $(seq 60); do running || break; sleep 0.05; done
+  if running; then fail "SIGKILL: POV-Ray still runs 3 s after dcm died: $(pgrep -af "^$pov")"; fi
   [[ ! -e $out ]] || fail "SIGKILL: the output $out exists"
   ok "SIGKILL of dcm during a render: POV-Ray ends with it, no output"
   ;;

@@ -34,18 +34,19 @@ std::string Dirname(const std::string& path) {
 
 /// The shell command of `job`. -D: no display (Debian's povray.ini turns it
 /// on); -A: no antialiasing (the split L = tau*L_i + L_c holds per ray); +FE:
-/// OpenEXR (half float, linear under assumed_gamma 1.0); +L: the scene's own
-/// folder for its include files, since POV-Ray runs in the scratch folder.
+/// OpenEXR (half float, linear under assumed_gamma 1.0). The scene and its
+/// folder come from ScratchIni() (WriteSceneIni): POV-Ray splits its command
+/// line at spaces, also within a quoted +I or +L option.
 std::string CommandLine(const PovrayEnv& env, const PovrayJob& job) {
   // append(), not operator+ on literals: GCC 12 warns (-Wrestrict) on those.
   std::string c = "cd ";
   for (const std::string& word :
        {ShellQuote(JobFolder(env, job)), std::string("&& exec"), ShellQuote(env.executable), std::string("-D -A +FE"),
-        "+W" + std::to_string(job.width), "+H" + std::to_string(job.height), ShellQuote("+L" + Dirname(env.scene)),
+        "+W" + std::to_string(job.width), "+H" + std::to_string(job.height),
         "Declare=Pass=" + std::to_string(job.pass)})
     c.append(word).append(" ");
   for (const auto& a : job.args) c.append(ShellQuote(a)).append(" ");
-  c.append(ShellQuote("+I" + env.scene)).append(" +O").append(ScratchRender(job.pass));
+  c.append(ScratchIni()).append(" +O").append(ScratchRender(job.pass));
   c.append(" </dev/null >").append(ScratchLog(job.pass)).append(" 2>&1");
   return c;
 }
@@ -72,6 +73,17 @@ std::string Failed(const PovrayEnv& env, const PovrayJob& job) {
 }
 
 }  // namespace
+
+Status WriteSceneIni(const std::string& folder, const std::string& scene) {
+  if (scene.find('"') != std::string::npos)
+    return Status::Error("the scene's path " + scene + " holds a '\"', which POV-Ray's INI files cannot quote");
+  const std::string path = folder + "/" + ScratchIni();
+  std::ofstream ini(path);
+  ini << "Input_File_Name=\"" << scene << "\"\nLibrary_Path=\"" << Dirname(scene) << "\"\n";
+  ini.close();
+  if (!ini) return Status::Error("cannot write " + path);
+  return Status::Ok();
+}
 
 std::string JobFolder(const PovrayEnv& env, const PovrayJob& job) {
   return job.folder.empty() ? env.scratch : env.scratch + "/" + job.folder;

@@ -43,6 +43,10 @@ Status FindExecutable(const std::string& name, std::string* path);
 /// the others killed.
 Status RunJobs(const PovrayEnv& env, std::span<const PovrayJob> jobs);
 
+/// Writes ScratchIni() into `folder`: the scene (an absolute path) and its
+/// folder for its include files, since POV-Ray runs in the scratch folder.
+Status WriteSceneIni(const std::string& folder, const std::string& scene);
+
 /// The folder `job` runs in.
 std::string JobFolder(const PovrayEnv& env, const PovrayJob& job);
 

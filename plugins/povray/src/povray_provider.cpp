@@ -116,6 +116,7 @@ Status PovrayProvider::Open(const PovrayOptions& options, std::unique_ptr<Povray
   p->options_.scene = std::filesystem::absolute(options.scene, ec).string();
   DCM_RETURN_IF_ERROR(FindExecutable(options.povray, &p->povrayPath_));
   DCM_RETURN_IF_ERROR(MakeScratch(&p->scratch_));
+  DCM_RETURN_IF_ERROR(WriteSceneIni(p->scratch_, p->options_.scene));
   *out = std::move(p);
   return Status::Ok();
 }
@@ -258,6 +259,7 @@ Status PovrayProvider::Evaluate(std::span<const Point2i> pixels, const SampleReq
     std::error_code ec;
     std::filesystem::create_directory(scratch_ + "/" + ScratchSubfolder(), ec);
     if (ec) return Status::Error("cannot make " + scratch_ + "/" + ScratchSubfolder() + ": " + ec.message());
+    DCM_RETURN_IF_ERROR(WriteSceneIni(scratch_ + "/" + ScratchSubfolder(), options_.scene));
     DCM_RETURN_IF_ERROR(WritePixelList(scratch_ + "/" + ScratchSubfolder(), liPixels));
   }
   std::vector<PovrayJob> jobs = {SparseJob(Pass::kBeauty, pixels.size())};

@@ -42,6 +42,7 @@ void UnlinkIn(const char* dir, const char* name) {
 
 std::string ScratchPixelList() { return "pixels.inc"; }
 std::string ScratchSubfolder() { return "li"; }
+std::string ScratchIni() { return "scene.ini"; }
 std::string ScratchRender(int pass) { return "pass" + std::to_string(pass) + ".exr"; }
 std::string ScratchLog(int pass) { return "pass" + std::to_string(pass) + ".log"; }
 
@@ -68,6 +69,7 @@ void RemoveScratch(const std::string& path) {
 /// Unlinks the fixed names in `dir` (async-signal-safe).
 static void RemoveFilesIn(const char* dir) {
   UnlinkIn(dir, "pixels.inc");
+  UnlinkIn(dir, "scene.ini");
   // POV-Ray's state file while it renders pass N is passN.pov-state.
   char name[] = "pass0.exr", log[] = "pass0.log", state[] = "pass0.pov-state";
   for (int p = 0; p < kPasses; ++p) {

@@ -9,10 +9,11 @@
 
 namespace dcm::povray {
 
-/// The file names a scratch folder may hold: the pixel list, and per pass
+/// The file names a scratch folder may hold: the pixel list, the INI file, and per pass
 /// (0 to 5) a render, a log and POV-Ray's state file while it renders
 /// (passN.pov-state).
 std::string ScratchPixelList();                 ///< "pixels.inc" (the name scene files include)
+std::string ScratchIni();                       ///< "scene.ini": the scene and its folder, for POV-Ray
 /// "li": the folder of the illumination pass's own pixel list, when it
 /// renders fewer pixels than the beauty pass (the same file names inside).
 std::string ScratchSubfolder();
