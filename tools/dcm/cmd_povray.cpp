@@ -6,11 +6,12 @@
 //       [--schedule auto|preview|levels] [--max-rounds N] [--preview-scale N] [--preview-passes P]
 //       [-d half|float] [--compression C] [--ch NAME,...] + engine flags
 //
-// The guide passes (IDs, tau, normal) are rendered in full, and with them the
-// beauty and illumination passes at 1/N resolution as a preview; the engine
-// plans its exact pixels on the preview and POV-Ray renders them through the
-// scene's mesh camera in a few rounds (RoundSchedule::kPreview). --full
-// renders the beauty pass in full instead: the baseline.
+// The guide passes (IDs, tau, normal, highlight mask) are rendered in full,
+// and with them the illumination pass (--preview-passes) at 1/N resolution
+// as a preview; the engine plans its exact pixels on the preview and POV-Ray
+// renders them through the scene's mesh camera in a few rounds
+// (RoundSchedule::kPreview). --full renders the beauty pass in full instead:
+// the baseline.
 //
 // Compiles to nothing unless the dcm_povray library is linked (DCM_HAVE_POVRAY).
 #ifdef DCM_HAVE_POVRAY
