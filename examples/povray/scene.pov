@@ -10,13 +10,15 @@
 //   4  illumination L_i     every pigment white, diffuse + ambient only
 //   5  normal               emission only: slope patterns along x, y, z in
 //                           R, G, B: value v = 1 - angle/180 deg, so the
-//                           normal's component is -cos(pi * v) (povtool.py)
+//                           normal's component is -cos(pi * v)
+//   6  highlight mask       emission only: 1 where the texture has specular
+//                           or reflection, else 0
 // With antialiasing off and an area light without `jitter`, L = L_i*tau + L_c
 // holds exactly: POV-Ray multiplies the pigment into the diffuse and ambient
 // terms only, so L_c = L - L_i*tau is the highlights and reflections.
 //
 // Sparse = 1 replaces the perspective camera by a mesh_camera with one
-// triangle per pixel of the list in "pixels.inc" (written by run.sh):
+// triangle per pixel of the list in "pixels.inc" (written by dcm povray):
 //   #declare NPix = N; #declare PixX = array[N] {...}; #declare PixY = array[N] {...};
 // Face i is rendered as output pixel (i mod image_width, i div image_width + 1):
 // POV-Ray 3.7 moves y to the pixel centre (y - 0.5) before truncating it to a
@@ -84,6 +86,7 @@ background { rgb 0 }
     #case (3) texture { pigment { Pig } finish { emission 1 ambient 0 diffuse 0 specular 0 } } #break
     #case (4) texture { pigment { rgb 1 } finish { ambient Amb diffuse Dif specular 0 reflection 0 } } #break
     #case (5) texture { pigment { P_Normal } finish { emission 1 ambient 0 diffuse 0 specular 0 } } #break
+    #case (6) texture { pigment { rgb (Spec > 0 | Refl > 0) } finish { emission 1 ambient 0 diffuse 0 specular 0 } } #break
     #else
       texture { pigment { Pig }
         finish { ambient Amb diffuse Dif specular Spec roughness Rough reflection Refl } }
