@@ -60,7 +60,12 @@ struct LevelEstimate {
 
 /// What ReconstructToQuality delivered and what it cost.
 struct QualityReport {
-  PsnrEstimate estimate;         ///< of the result
+  /// Of the result: with a target, from a last draw of validation pixels that
+  /// took no part in the search (`confirmed`); else from the search's.
+  PsnrEstimate estimate;
+  /// The estimate comes from the last, independent draw (a target was given
+  /// and the budget left room for it).
+  bool confirmed = false;
   double confidence = 0.90;      ///< of [low, high]
   int64_t validationPixels = 0;  ///< output pixels compared
   /// Working pixels evaluated exactly over every run, the validation's
@@ -70,7 +75,7 @@ struct QualityReport {
   int64_t totalPixels = 0;            ///< working pixels
   double threshold = 0;               ///< contrast threshold of the result (-1: full evaluation)
   int runs = 0;                       ///< reconstructions tried
-  bool targetReached = false;         ///< the lower bound reached the target (or no target)
+  bool targetReached = false;         ///< the lower bound of `estimate` reached the target (or no target)
   bool budgetBound = false;           ///< the budget stopped the refinement
   std::vector<LevelEstimate> levels;  ///< per refinement level of the final run, with options.onLevel
   double exactFraction() const { return totalPixels ? double(exactPixels) / double(totalPixels) : 0.0; }
