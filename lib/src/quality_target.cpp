@@ -41,6 +41,9 @@ constexpr double kMinStep = 0.5, kMaxStep = 0.85, kDefaultStep = 0.7;
 /// search: more where the point estimate reaches the target and its bound
 /// does not.
 constexpr int kMaxSearchDraws = 4;
+/// The descent stops where two runs raised the lower bound by less than
+/// this many dB while the pixels spent grew by more than this factor.
+constexpr double kPlateauDb = 0.5, kPlateauGrowth = 1.25;
 /// The share of the budget left that a run of the descent may spend.
 constexpr double kDescentShare = 0.6;
 /// Bisections between the last run within the budget and the one beyond.
@@ -395,6 +398,7 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   auto meets = [&](const Run& r) { return goal.targetPsnr > 0 && r.estimate.low >= goal.targetPsnr; };
 
   std::optional<Run> best, tried;
+  std::vector<double> lows, spends;  // per run of the descent: the lower bound, the pixels spent
   double t = t0 > 0 ? t0 : kMinThreshold;
   double lastT = 0, lastLow = kNaN, lastUsed = 0;
   std::optional<double> refused;  // the largest threshold the budget refused (-1: the full evaluation)
@@ -424,6 +428,16 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
     }
     const double low = best->estimate.low;
     if (meets(*best) || t < 0) break;
+    // A plateau: the bound barely moved over the last two runs while the
+    // samples grew. What the validation sees is then error that a lower
+    // threshold does not remove (a feature the lattice misses at any
+    // threshold, hit by a validation pixel); the last draw judges the result.
+    lows.push_back(low);
+    spends.push_back(double(cache.Distinct()));
+    const size_t n = lows.size();
+    if (goal.targetPsnr > 0 && n >= 3 && std::isfinite(lows[n - 3]) && lows[n - 1] - lows[n - 3] < kPlateauDb &&
+        spends[n - 1] > kPlateauGrowth * spends[n - 3])
+      break;
     if (t <= kMinThreshold) {
       // The threshold cannot go lower: the full evaluation reaches any target.
       t = -1;
