@@ -82,13 +82,15 @@ struct QualityReport {
 };
 
 /// Reconstructs with the contrast threshold that `goal` calls for: from the
-/// options' threshold (sixteen times it, at most 1, with a budget) down, until the
-/// estimate's lower bound reaches goal.targetPsnr or the next run would exceed
-/// the budget (then bisected between the two). The
+/// options' threshold (sixteen times it, at most 1, with a budget) down, until
+/// the estimate's lower bound reaches goal.targetPsnr, stops rising (a
+/// plateau), or the next run would exceed the budget (then bisected between
+/// the two); with a target, a last validation draw estimates the result. The
 /// provider is evaluated at most once per pixel across the runs. Every other
 /// option is used as given. A target that the budget (or the smallest
 /// threshold, then the full evaluation) cannot reach is no error: `report`
-/// says so (targetReached false) and the result is the best reached.
+/// says so (targetReached false) and the result is the best reached
+/// (docs/QUALITY.md).
 /// With a provider that answers Status::Pending, returns that status and
 /// leaves the requested pixels in `pending` (a `dcm plan` round: repeat with
 /// the samples rendered). The result's stats count the cost of the whole
