@@ -39,6 +39,11 @@ def render(dcm, scene, out, common, extra, reuse=False):
         return json.load(f)
 
 
+def db(v):
+    """A PSNR as the table shows it (JSON null: +infinity)."""
+    return "∞" if v is None else f"{v:.2f}"
+
+
 def at_fraction(sweep, fraction):
     """The sweep's PSNR at `fraction`, interpolated in log fraction."""
     pts = sorted((s["exact_fraction"], s["reference"]["psnr"]) for s in sweep)
@@ -82,8 +87,8 @@ def main():
         meeting = [s for s in sweep if s["reference"]["psnr"] >= a.target]
         best = min(meeting, key=lambda s: s["exact_fraction"]) if meeting else None
         q = render(a.dcm, scene, f"{base}_target", common, cmp_ + ["--target-psnr", f"{a.target:g}"])
-        line = (f"| {name} | {a.target:g} | {q['estimated_psnr']:.2f} [{q['estimated_psnr_low']:.2f}, "
-                f"{q['estimated_psnr_high']:.2f}] | {q['reference']['psnr']:.2f} | {100 * q['exact_fraction']:.2f} % | ")
+        line = (f"| {name} | {a.target:g} | {db(q['estimated_psnr'])} [{db(q['estimated_psnr_low'])}, "
+                f"{db(q['estimated_psnr_high'])}] | {db(q['reference']['psnr'])} | {100 * q['exact_fraction']:.2f} % | ")
         if best:
             budget = round(best["exact_fraction"], 4)
             b = render(a.dcm, scene, f"{base}_budget", common, cmp_ + ["--budget", f"{budget:g}"])

@@ -3,8 +3,8 @@
 #include "dcm/quality_target.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <mutex>
 #include <optional>
@@ -37,9 +37,13 @@ constexpr double kMinThreshold = 1e-3;
 /// Threshold steps: at least this ratio (a large jump overshoots the cost),
 /// at most the other (small steps cost engine runs).
 constexpr double kMinStep = 0.5, kMaxStep = 0.85, kDefaultStep = 0.7;
-/// At most this many validation draws (each of the first's size): where the
-/// point estimate reaches the target and its bound does not.
-constexpr int kMaxDraws = 4;
+/// At most this many validation draws (each of the first's size) in the
+/// search: more where the point estimate reaches the target and its bound
+/// does not.
+constexpr int kMaxSearchDraws = 4;
+/// The descent stops where two runs raised the lower bound by less than
+/// this many dB while the pixels spent grew by more than this factor.
+constexpr double kPlateauDb = 0.5, kPlateauGrowth = 1.25;
 /// The share of the budget left that a run of the descent may spend.
 constexpr double kDescentShare = 0.6;
 /// Bisections between the last run within the budget and the one beyond.
@@ -324,7 +328,7 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   int draws = 0;
   // One more stratified draw of `count` pixels, with its own seed: the union
   // of independent unbiased draws (equal total weights) is unbiased.
-  auto drawMore = [&]() -> Status {
+  auto drawMore = [&](Validation* into) -> Status {
     Validation more;
     more.pixels = DrawValidation(outW, outH, count, goal.seed + uint64_t(draws), &more.weights);
     DCM_RETURN_IF_ERROR(EvaluateValidation(cache, options, what, &more, pending));
@@ -338,13 +342,13 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
         ++report->validationPixels;
         mark = 1;
       }
-      v.pixels.push_back(p);
-      v.weights.push_back(more.weights[k]);
-      v.exact.push_back(more.exact[k]);
+      into->pixels.push_back(p);
+      into->weights.push_back(more.weights[k]);
+      into->exact.push_back(more.exact[k]);
     }
     return Status::Ok();
   };
-  if (Status st = drawMore(); !st.ok()) {
+  if (Status st = drawMore(&v); !st.ok()) {
     if (cache.BudgetHit())
       return Status::Error("--budget " + Num(goal.budget) + ": too small for the validation pixels");
     return st;
@@ -394,6 +398,7 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   auto meets = [&](const Run& r) { return goal.targetPsnr > 0 && r.estimate.low >= goal.targetPsnr; };
 
   std::optional<Run> best, tried;
+  std::vector<double> lows, spends;  // per run of the descent: the lower bound, the pixels spent
   double t = t0 > 0 ? t0 : kMinThreshold;
   double lastT = 0, lastLow = kNaN, lastUsed = 0;
   std::optional<double> refused;  // the largest threshold the budget refused (-1: the full evaluation)
@@ -413,9 +418,9 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
     // The point estimate reaches the target but its bound does not: the
     // validation is too small for how the error is spread (a few pixels
     // carry most of it). More draws before more samples of the image.
-    while (goal.targetPsnr > 0 && !meets(*best) && best->estimate.psnr >= goal.targetPsnr && draws < kMaxDraws) {
+    while (goal.targetPsnr > 0 && !meets(*best) && best->estimate.psnr >= goal.targetPsnr && draws < kMaxSearchDraws) {
       cache.ClearBudgetHit();
-      if (Status st = drawMore(); !st.ok()) {
+      if (Status st = drawMore(&v); !st.ok()) {
         if (cache.BudgetHit()) break;
         return st;
       }
@@ -423,6 +428,16 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
     }
     const double low = best->estimate.low;
     if (meets(*best) || t < 0) break;
+    // A plateau: the bound barely moved over the last two runs while the
+    // samples grew. What the validation sees is then error that a lower
+    // threshold does not remove (a feature the lattice misses at any
+    // threshold, hit by a validation pixel); the last draw judges the result.
+    lows.push_back(low);
+    spends.push_back(double(cache.Distinct()));
+    const size_t n = lows.size();
+    if (goal.targetPsnr > 0 && n >= 3 && std::isfinite(lows[n - 3]) && lows[n - 1] - lows[n - 3] < kPlateauDb &&
+        spends[n - 1] > kPlateauGrowth * spends[n - 3])
+      break;
     if (t <= kMinThreshold) {
       // The threshold cannot go lower: the full evaluation reaches any target.
       t = -1;
@@ -478,6 +493,19 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
     report->budgetBound = true;
   }
 
+  // The search stopped where its validation pixels looked good enough: on
+  // them the result errs high (the more runs, the more; 10 dB on the tracer's
+  // room). A fresh draw, which chose nothing, estimates the result.
+  if (goal.targetPsnr > 0 && best->threshold >= 0) {
+    Validation fresh;
+    cache.ClearBudgetHit();
+    if (Status st = drawMore(&fresh); st.ok()) {
+      best->estimate = EstimateAt(fresh, goal, best->rec.image, best->rec.width);
+      report->confirmed = true;
+    } else if (!cache.BudgetHit()) {
+      return st;
+    }
+  }
   report->estimate = best->estimate;
   report->levels = std::move(best->levels);
   report->threshold = best->threshold;

@@ -153,6 +153,7 @@ void AddQualityJson(const QualityReport& r, double targetPsnr, double budget, nl
   (*j)["quality"] = {{"target_psnr", orNull(targetPsnr)},
                      {"budget", orNull(budget)},
                      {"target_reached", r.targetReached},
+                     {"confirmed", r.confirmed},
                      {"budget_bound", r.budgetBound},
                      {"exact_pixels", r.exactPixels},
                      {"exact_fraction", r.exactFraction()},

@@ -38,7 +38,7 @@ nlohmann::json RunToJson(const Reconstruction& r, const std::string& method, con
 /// Adds what --target-psnr / --budget delivered to a --stats object:
 /// estimated_psnr, estimated_psnr_low, estimated_psnr_high (the interval at
 /// estimated_psnr_confidence) and quality {target_psnr, budget, target_reached,
-/// budget_bound, exact_pixels, exact_fraction, validation_pixels,
+/// confirmed, budget_bound, exact_pixels, exact_fraction, validation_pixels,
 /// validation_exact_pixels, runs, threshold, levels [{level, psnr, low, high}]};
 /// a target or budget of 0 is null (not asked).
 void AddQualityJson(const QualityReport& report, double targetPsnr, double budget, nlohmann::json* j);

@@ -60,7 +60,12 @@ struct LevelEstimate {
 
 /// What ReconstructToQuality delivered and what it cost.
 struct QualityReport {
-  PsnrEstimate estimate;         ///< of the result
+  /// Of the result: with a target, from a last draw of validation pixels that
+  /// took no part in the search (`confirmed`); else from the search's.
+  PsnrEstimate estimate;
+  /// The estimate comes from the last, independent draw (a target was given
+  /// and the budget left room for it).
+  bool confirmed = false;
   double confidence = 0.90;      ///< of [low, high]
   int64_t validationPixels = 0;  ///< output pixels compared
   /// Working pixels evaluated exactly over every run, the validation's
@@ -70,20 +75,22 @@ struct QualityReport {
   int64_t totalPixels = 0;            ///< working pixels
   double threshold = 0;               ///< contrast threshold of the result (-1: full evaluation)
   int runs = 0;                       ///< reconstructions tried
-  bool targetReached = false;         ///< the lower bound reached the target (or no target)
+  bool targetReached = false;         ///< the lower bound of `estimate` reached the target (or no target)
   bool budgetBound = false;           ///< the budget stopped the refinement
   std::vector<LevelEstimate> levels;  ///< per refinement level of the final run, with options.onLevel
   double exactFraction() const { return totalPixels ? double(exactPixels) / double(totalPixels) : 0.0; }
 };
 
 /// Reconstructs with the contrast threshold that `goal` calls for: from the
-/// options' threshold (sixteen times it, at most 1, with a budget) down, until the
-/// estimate's lower bound reaches goal.targetPsnr or the next run would exceed
-/// the budget (then bisected between the two). The
+/// options' threshold (sixteen times it, at most 1, with a budget) down, until
+/// the estimate's lower bound reaches goal.targetPsnr, stops rising (a
+/// plateau), or the next run would exceed the budget (then bisected between
+/// the two); with a target, a last validation draw estimates the result. The
 /// provider is evaluated at most once per pixel across the runs. Every other
 /// option is used as given. A target that the budget (or the smallest
 /// threshold, then the full evaluation) cannot reach is no error: `report`
-/// says so (targetReached false) and the result is the best reached.
+/// says so (targetReached false) and the result is the best reached
+/// (docs/QUALITY.md).
 /// With a provider that answers Status::Pending, returns that status and
 /// leaves the requested pixels in `pending` (a `dcm plan` round: repeat with
 /// the samples rendered). The result's stats count the cost of the whole
