@@ -10,6 +10,9 @@
 #   DCM_FUZZ_SEED=N scripts/fuzz.sh   # libFuzzer's -seed (0, the default: random;
 #                                     # the test command uses a fixed one)
 #   DCM_FUZZ_BUILD_DIR=/x scripts/fuzz.sh 300
+#   DCM_FUZZ_RUNS=N scripts/fuzz.sh   # stop after N inputs rather than after SECONDS
+#                                     # (SECONDS stays a cap): with a fixed seed the
+#                                     # same inputs on any machine, as the test command runs it
 #
 # Packages: clang-14 and libclang-rt-14-dev (libFuzzer and the sanitizer
 # runtimes), plus dcm's own build dependencies (scripts/install-deps.sh).
@@ -41,13 +44,17 @@ export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 status=0
 for target in "${targets[@]}"; do
   corpus="$build/corpus/$target"   # grows during the run; the seeds stay in the repo
+  # A counted run starts from the seeds alone, so that it is the same run every time.
+  [ -n "${DCM_FUZZ_RUNS:-}" ] && rm -rf "$corpus"
   mkdir -p "$corpus" "$build/artifacts/$target"
   seeds="$here/fuzz/corpus/${target#fuzz_}"
   dict=()
   [ -f "$here/fuzz/${target#fuzz_}.dict" ] && dict=(-dict="$here/fuzz/${target#fuzz_}.dict")
   echo "fuzz.sh: $target for ${seconds} s"
   set +e
-  "$build/$target" "$corpus" "$seeds" "${dict[@]}" \
+  runs=()
+  [ -n "${DCM_FUZZ_RUNS:-}" ] && runs=(-runs="$DCM_FUZZ_RUNS")
+  "$build/$target" "$corpus" "$seeds" "${dict[@]}" "${runs[@]}" \
     -max_total_time="$seconds" -timeout=60 -rss_limit_mb=2560 -malloc_limit_mb=2048 \
     -max_len=65536 -print_final_stats=1 -seed="${DCM_FUZZ_SEED:-0}" \
     -artifact_prefix="$build/artifacts/$target/" >"$build/$target.log" 2>&1

@@ -16,6 +16,7 @@
 
 #include "dcm/option_names.h"
 #include "dcm/reconstructor.h"
+#include "dcm/round_schedule.h"
 
 #ifndef DCM_VERSION_STRING
 #define DCM_VERSION_STRING "unknown"
@@ -48,9 +49,14 @@ struct DCMReconstructorImpl {
   void* progressUser = nullptr;
   DCMLevelFunction level = nullptr;
   void* levelUser = nullptr;
+  dcm::RoundCost roundCost;
+  int maxRounds = 3;
+  int previewWidth = 0, previewHeight = 0;
+  std::vector<dcm::RGB> previewL, previewLi, previewLc;
 
   bool hasResult = false;
   dcm::Reconstruction result;
+  dcm::PreviewScheduleStats schedule;
   std::vector<uint8_t> sampleMap;
 
   std::mutex errorMutex;
@@ -472,6 +478,43 @@ DCM_API void dcmSetProgressFunction(DCMReconstructor r, DCMProgressFunction fn, 
   r->progressUser = user;
 }
 
+DCM_API void dcmSetRoundCost(DCMReconstructor r, double latency_s, double seconds_per_sample, int max_rounds) {
+  if (!r) return SetError(nullptr, DCM_ERROR_INVALID_ARGUMENT, "dcmSetRoundCost: NULL reconstructor");
+  if (!(latency_s >= 0 && latency_s <= 1e9) || !(seconds_per_sample >= 0 && seconds_per_sample <= 1e9))
+    return SetError(r, DCM_ERROR_INVALID_ARGUMENT, "dcmSetRoundCost: costs must be finite and >= 0");
+  if (max_rounds < 1) return SetError(r, DCM_ERROR_INVALID_ARGUMENT, "dcmSetRoundCost: max_rounds must be >= 1");
+  r->roundCost = {latency_s, seconds_per_sample};
+  r->maxRounds = max_rounds;
+}
+
+DCM_API void dcmSetPreview(DCMReconstructor r, int width, int height, const float* rgb, const float* li,
+                           const float* lc) {
+  if (!r) return SetError(nullptr, DCM_ERROR_INVALID_ARGUMENT, "dcmSetPreview: NULL reconstructor");
+  Guard(r, "dcmSetPreview", [&] {
+    r->previewL.clear();
+    r->previewLi.clear();
+    r->previewLc.clear();
+    r->previewWidth = r->previewHeight = 0;
+    if (!rgb) return;
+    if (width < 1 || height < 1 || width > r->width || height > r->height)
+      return SetError(r, DCM_ERROR_INVALID_ARGUMENT,
+                      "dcmSetPreview: size " + std::to_string(width) + "x" + std::to_string(height) +
+                          " must be 1x1 up to the image size (call dcmSetImageSize() first)");
+    if (!li != !lc) return SetError(r, DCM_ERROR_INVALID_ARGUMENT, "dcmSetPreview: li and lc go together");
+    const size_t n = size_t(width) * size_t(height);
+    auto copy = [n](const float* v, std::vector<dcm::RGB>* out) {
+      if (!v) return;
+      out->resize(n);
+      for (size_t i = 0; i < n; ++i) (*out)[i] = {v[3 * i], v[3 * i + 1], v[3 * i + 2]};
+    };
+    copy(rgb, &r->previewL);
+    copy(li, &r->previewLi);
+    copy(lc, &r->previewLc);
+    r->previewWidth = width;
+    r->previewHeight = height;
+  });
+}
+
 DCM_API DCMError dcmExecute(DCMReconstructor r) {
   if (!r) {
     SetError(nullptr, DCM_ERROR_INVALID_ARGUMENT, "dcmExecute: NULL reconstructor");
@@ -517,7 +560,17 @@ DCM_API DCMError dcmExecute(DCMReconstructor r) {
         r->level(r->levelUser, level, w, h, reinterpret_cast<const float*>(image.data()));
       };
     }
-    dcm::Status st = dcm::Reconstruct(provider, options, &r->result);
+    r->schedule = {};
+    dcm::Status st;
+    if (!r->previewL.empty() && dcm::ChooseSchedule(r->roundCost) == dcm::RoundSchedule::kPreview) {
+      dcm::ImagePreviewProvider preview(r->width, r->height, r->previewWidth, r->previewHeight, r->previewL,
+                                        r->previewLi, r->previewLc);
+      dcm::PreviewScheduleOptions schedule;
+      schedule.maxRounds = r->maxRounds;
+      st = dcm::ReconstructWithPreview(provider, preview, options, schedule, &r->result, &r->schedule);
+    } else {
+      st = dcm::Reconstruct(provider, options, &r->result);
+    }
     if (!st.ok()) {
       r->result = dcm::Reconstruction{};
       fail(provider.failed() ? DCM_ERROR_CALLBACK : DCM_ERROR_RECONSTRUCTION, st.message());
@@ -593,6 +646,8 @@ DCM_API double dcmGetStat(DCMReconstructor r, const char* name) {
   if (n == "time_provider_s") return s.timeProviderS;
   if (n == "time_guides_s") return s.timeGuidesS;
   if (n == "time_engine_s") return s.timeEngineS;
+  if (n == "rounds") return double(r->schedule.rounds);
+  if (n == "preview_stand_ins") return double(r->schedule.previewStandIns);
   Guard(r, "dcmGetStat", [&] { SetError(r, DCM_ERROR_INVALID_ARGUMENT, "dcmGetStat: unknown statistic '" + std::string(n) + "'"); });
   return 0.0;
 }

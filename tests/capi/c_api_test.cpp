@@ -256,6 +256,41 @@ TEST(CApi, ReconstructsTwoSurfacesWithFewExactPixels) {
   dcmReleaseReconstructor(r);
 }
 
+TEST(CApi, RoundCostPlansOnThePreviewInFewCalls) {
+  Scene plain, planned;
+  DCMReconstructor a = Make(plain, 0);
+  DCMReconstructor b = Make(planned, 0);
+  // Not thread safe: each Evaluate is one callback call, so calls count rounds.
+  std::vector<float> preview(size_t(planned.width * planned.height) * 3);
+  for (int y = 0; y < planned.height; ++y)
+    for (int x = 0; x < planned.width; ++x) planned.Truth(x, y, &preview[3 * size_t(y * planned.width + x)]);
+  dcmSetPreview(b, planned.width, planned.height, preview.data(), nullptr, nullptr);
+  dcmSetRoundCost(b, 0.5, 0.0, 3);
+  ASSERT_EQ(dcmExecute(a), DCM_ERROR_NONE) << TakeError(a);
+  ASSERT_EQ(dcmExecute(b), DCM_ERROR_NONE) << TakeError(b);
+  // An exact preview plans exactly the pixels the engine needs: one round,
+  // no stand-in, the same image and the same pixels as level by level.
+  EXPECT_EQ(dcmGetStat(b, "rounds"), 1.0);
+  EXPECT_EQ(dcmGetStat(b, "provider_calls"), 1.0);
+  EXPECT_EQ(dcmGetStat(b, "preview_stand_ins"), 0.0);
+  EXPECT_GT(dcmGetStat(a, "provider_calls"), 1.0);
+  EXPECT_EQ(dcmGetStat(a, "rounds"), 0.0);
+  EXPECT_EQ(planned.evaluated.load(), plain.evaluated.load());
+  int w = 0, h = 0;
+  const float* ia = dcmGetImage(a, &w, &h);
+  const float* ib = dcmGetImage(b, nullptr, nullptr);
+  EXPECT_EQ(std::vector<float>(ia, ia + 3 * w * h), std::vector<float>(ib, ib + 3 * w * h));
+  // Bad costs and previews are errors on the handle.
+  dcmSetRoundCost(b, -1.0, 0.0, 3);
+  EXPECT_NE(TakeError(b).find("dcmSetRoundCost"), std::string::npos);
+  dcmSetRoundCost(b, 1.0, 0.0, 0);
+  EXPECT_NE(TakeError(b).find("max_rounds"), std::string::npos);
+  dcmSetPreview(b, planned.width + 1, planned.height, preview.data(), nullptr, nullptr);
+  EXPECT_NE(TakeError(b).find("dcmSetPreview"), std::string::npos);
+  dcmReleaseReconstructor(a);
+  dcmReleaseReconstructor(b);
+}
+
 TEST(CApi, FullEvaluationEvaluatesEveryPixel) {
   Scene scene;
   DCMReconstructor r = Make(scene);

@@ -124,6 +124,18 @@ TEST(HostileOutput, RenderOntoItsSceneOrReferenceIsRefused) {
   ExpectRefused(dir, {"render", "scene.json", "--compare", "ref.exr", "-o", "out.exr", "--reference-out", "ref.exr"},
                 "ref.exr", {"--compare", "--reference-out"}, "--reference-out onto --compare");
 }
+
+TEST(HostileOutput, RenderOntoAMeshOfItsSceneIsRefused) {
+  TempDir dir;
+  for (const char* f : {"cactus.json", "cactus_body.obj"})
+    fs::copy_file(fs::path(DCM_MESH_SCENE_DIR) / f, dir / f);
+  // The mesh is named by the scene, not on the command line.
+  for (const auto& [how, name] : Aliases(dir, "cactus_body.obj"))
+    ExpectRefused(dir, {"render", "cactus.json", "--size", "16x16", "-o", name}, "cactus_body.obj",
+                  {"the scene's objects[", "-o"}, "render onto its mesh, " + how);
+  ExpectRefused(dir, {"render", "cactus.json", "--size", "16x16", "-o", "out.exr", "--stats", "cactus_body.obj"},
+                "cactus_body.obj", {"the scene's objects[", "--stats"}, "--stats onto the mesh");
+}
 #endif
 
 TEST(HostileOutput, TwoOutputsOntoOneFileAreRefused) {

@@ -184,14 +184,13 @@ int RunRenderPart(const RenderFlags& f, const embree::Scene& scene, Reconstructi
 }
 
 int RunRender(const RenderFlags& f, CLI::App* app) {
-  if (Status st = toolkit::CheckOutputs({{"scene", f.scene}, {"--compare", f.compare}},
-                                        {{"-o", f.output},
-                                         {"--stats", f.stats},
-                                         {"--sample-map", f.sampleMap},
-                                         {"--preview", f.preview},
-                                         {"--reference-out", f.referenceOut},
-                                         toolkit::ProgressiveArg(f.engine.progressive)});
-      !st.ok()) {
+  const std::vector<toolkit::FileArg> outputFiles{{"-o", f.output},
+                                                  {"--stats", f.stats},
+                                                  {"--sample-map", f.sampleMap},
+                                                  {"--preview", f.preview},
+                                                  {"--reference-out", f.referenceOut},
+                                                  toolkit::ProgressiveArg(f.engine.progressive)};
+  if (Status st = toolkit::CheckOutputs({{"scene", f.scene}, {"--compare", f.compare}}, outputFiles); !st.ok()) {
     std::cerr << "dcm render: error: " << st.message() << "\n";
     return kExitUsage;
   }
@@ -200,6 +199,16 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
   // Scene and its overrides.
   embree::Scene scene;
   if (Status st = embree::LoadSceneFile(f.scene, &scene, f.overrides); !st.ok()) return Fail(st);
+  // The meshes and textures the scene names are inputs too.
+  std::vector<toolkit::FileArg> sceneFiles;
+  for (const embree::ObjectDesc& o : scene.objects)
+    if (!o.file.empty()) sceneFiles.push_back({"the scene's " + o.path, o.file});
+  for (const embree::MaterialDesc& m : scene.materials)
+    if (m.texture && !m.texture->file.empty()) sceneFiles.push_back({"the texture of the scene's material '" + m.name + "'", m.texture->file});
+  if (Status st = toolkit::CheckOutputs(sceneFiles, outputFiles); !st.ok()) {
+    std::cerr << "dcm render: error: " << st.message() << "\n";
+    return kExitUsage;
+  }
   if (!f.size.empty()) {
     if (Status st = ParseSize(f.size, &scene.camera.width, &scene.camera.height); !st.ok()) {
       std::cerr << "dcm render: --size: " << st.message() << "\n";

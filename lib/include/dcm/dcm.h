@@ -41,7 +41,7 @@ extern "C" {
 #endif
 
 /** Version of this C interface; raised on incompatible changes. */
-#define DCM_C_API_VERSION 2
+#define DCM_C_API_VERSION 3
 
 /** A reconstructor: options, guides, the sample callback and the last result. */
 typedef struct DCMReconstructorImpl* DCMReconstructor;
@@ -245,6 +245,25 @@ DCM_API void dcmSetProgressFunction(DCMReconstructor r, DCMProgressFunction fn, 
  *  per level). Since API version 2. */
 DCM_API void dcmSetLevelFunction(DCMReconstructor r, DCMLevelFunction fn, void* user);
 
+/** Says what a call of the sample function costs: `latency_s` seconds per
+ *  call whatever its size (a render call, a process start-up) and
+ *  `seconds_per_sample` per pixel (0: unknown). Where a call costs more than
+ *  about 1000 samples (or the per-sample cost is unknown and the latency is
+ *  not 0) and a preview is set (dcmSetPreview()), dcmExecute() chooses the
+ *  exact pixels on the preview and calls the sample function once per round,
+ *  at most `max_rounds` times (>= 1); pixels still wanted after the last round
+ *  keep their preview value (statistic "preview_stand_ins"). The default,
+ *  0 and 0, calls it as the refinement goes. Since API version 3. */
+DCM_API void dcmSetRoundCost(DCMReconstructor r, double latency_s, double seconds_per_sample, int max_rounds);
+
+/** Sets the preview that plans the rounds: a cheap render of the image at
+ *  `width` x `height` (the working size or coarser; upsampled bilinearly),
+ *  `rgb` width*height*3 floats of L, `li` and `lc` the split radiance (both or
+ *  neither; needed when the sample function has DCM_SAMPLE_SPLIT), copied.
+ *  NULL `rgb` removes it. Since API version 3. */
+DCM_API void dcmSetPreview(DCMReconstructor r, int width, int height, const float* rgb, const float* li,
+                           const float* lc);
+
 /** Runs the reconstruction: calls the sample function for the pixels it needs
  *  and keeps the result on `r`. Returns DCM_ERROR_NONE on success, otherwise
  *  the error (also recorded for dcmGetError()); the previous result is then
@@ -266,7 +285,9 @@ DCM_API const uint8_t* dcmGetSampleMap(DCMReconstructor r, int* width, int* heig
  *  "total_pixels", "exact_fraction", "provider_calls", "non_finite_samples",
  *  "clamped_samples",
  *  "smooth_blocks", "simple_edge_blocks", "complex_edge_blocks",
- *  "fallback_blocks", "time_provider_s", "time_guides_s", "time_engine_s".
+ *  "fallback_blocks", "time_provider_s", "time_guides_s", "time_engine_s",
+ *  "rounds" (calls planned on the preview; 0 without), "preview_stand_ins"
+ *  (since API version 3).
  *  0 and an error for an unknown name or before a result. */
 DCM_API double dcmGetStat(DCMReconstructor r, const char* name);
 

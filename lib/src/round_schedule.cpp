@@ -1,0 +1,255 @@
+// Preview-planned rounds (RoundSchedule::kPreview): the engine chooses its exact
+// pixels on stand-in samples, the provider evaluates them in one call per round.
+#include "dcm/round_schedule.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <new>
+#include <string>
+#include <tuple>
+#include <utility>
+
+namespace dcm {
+
+namespace {
+
+constexpr std::array<std::pair<std::string_view, RoundSchedule>, 2> kSchedules{{
+    {"levels", RoundSchedule::kLevels}, {"preview", RoundSchedule::kPreview}}};
+
+double Seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+bool SameGuideRequest(const GuideRequest& a, const GuideRequest& b) {
+  return a.objectId == b.objectId && a.shaderId == b.shaderId && a.texture == b.texture &&
+         a.normal == b.normal;
+}
+
+/// What the engine sees during planning: the exact provider's guides (asked
+/// once per region and kind), exact samples where they are known, preview
+/// samples elsewhere; it records the pixels asked for that are not known.
+class PlanningProvider : public SampleProvider {
+ public:
+  PlanningProvider(SampleProvider& exact, SampleProvider& preview)
+      : exact_(exact), preview_(preview), caps_(exact.Capabilities()) {
+    // Calls come from one thread: the records below need no locks, and the
+    // engine's work between calls is small next to a round of a slow renderer.
+    caps_.threadSafe = false;
+    const size_t n = size_t(caps_.width) * size_t(caps_.height);
+    known_.assign(n, 0);
+    wanted_.assign(n, 0);
+    samples_.resize(n);
+  }
+
+  ProviderCapabilities Capabilities() const override { return caps_; }
+
+  Status Guides(const Bounds2i& region, const GuideRequest& what, GuideImage* out) override {
+    for (const auto& [r, w, image] : guides_)
+      if (r == region && SameGuideRequest(w, what)) {
+        *out = image;
+        return Status::Ok();
+      }
+    Status s = exact_.Guides(region, what, out);
+    if (s.ok()) guides_.push_back({region, what, *out});
+    return s;
+  }
+
+  Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what,
+                  std::span<ExactSample> out) override {
+    request_.split |= what.split;
+    request_.variance |= what.variance;
+    missing_.clear();
+    for (size_t i = 0; i < pixels.size(); ++i) {
+      const size_t k = Index(pixels[i]);
+      if (known_[k]) {
+        out[i] = samples_[k];
+      } else {
+        missing_.push_back(i);
+        if (!wanted_[k]) {
+          wanted_[k] = 1;
+          wantedList_.push_back(pixels[i]);
+        }
+      }
+    }
+    if (missing_.empty()) return Status::Ok();
+    std::vector<Point2i> ask(missing_.size());
+    std::vector<ExactSample> got(missing_.size());
+    for (size_t j = 0; j < missing_.size(); ++j) ask[j] = pixels[missing_[j]];
+    Status s = preview_.Evaluate(ask, what, got);
+    if (!s.ok()) return Status::Error("preview samples: " + s.message());
+    for (size_t j = 0; j < missing_.size(); ++j) out[missing_[j]] = got[j];
+    return Status::Ok();
+  }
+
+  /// Pixels asked for in this run that are not known exactly; clears the record.
+  std::vector<Point2i> TakeWanted() {
+    for (const Point2i& p : wantedList_) wanted_[Index(p)] = 0;
+    return std::exchange(wantedList_, {});
+  }
+
+  /// Evaluates `pixels` with the exact provider in one call and keeps them.
+  Status EvaluateExactly(const std::vector<Point2i>& pixels) {
+    std::vector<ExactSample> got(pixels.size());
+    Status s = exact_.Evaluate(pixels, request_, got);
+    if (!s.ok()) return s;
+    for (size_t i = 0; i < pixels.size(); ++i) {
+      const size_t k = Index(pixels[i]);
+      samples_[k] = got[i];
+      known_[k] = 1;
+    }
+    return Status::Ok();
+  }
+
+ private:
+  size_t Index(const Point2i& p) const { return size_t(p.y) * size_t(caps_.width) + size_t(p.x); }
+
+  SampleProvider& exact_;
+  SampleProvider& preview_;
+  ProviderCapabilities caps_;
+  SampleRequest request_;
+  std::vector<std::tuple<Bounds2i, GuideRequest, GuideImage>> guides_;
+  std::vector<uint8_t> known_, wanted_;
+  std::vector<ExactSample> samples_;
+  std::vector<Point2i> wantedList_;
+  std::vector<size_t> missing_;
+};
+
+}  // namespace
+
+std::string_view ToString(RoundSchedule s) {
+  for (const auto& [name, value] : kSchedules)
+    if (value == s) return name;
+  return "?";
+}
+
+Status Parse(std::string_view s, RoundSchedule* out) {
+  for (const auto& [name, value] : kSchedules)
+    if (name == s) {
+      *out = value;
+      return Status::Ok();
+    }
+  return Status::Error("unknown round schedule '" + std::string(s) + "' (levels, preview)");
+}
+
+RoundSchedule ChooseSchedule(const RoundCost& cost, double latencySamplesThreshold) {
+  if (!(cost.latencyS > 0)) return RoundSchedule::kLevels;
+  if (!(cost.perSampleS > 0)) return RoundSchedule::kPreview;
+  return cost.latencyS > latencySamplesThreshold * cost.perSampleS ? RoundSchedule::kPreview
+                                                                   : RoundSchedule::kLevels;
+}
+
+Status ReconstructWithPreview(SampleProvider& exact, SampleProvider& preview,
+                              const ReconstructionOptions& options,
+                              const PreviewScheduleOptions& schedule, Reconstruction* out,
+                              PreviewScheduleStats* scheduleStats) {
+  if (schedule.maxRounds < 1)
+    return Status::Error("preview schedule: maxRounds must be at least 1 (is " +
+                         std::to_string(schedule.maxRounds) + ")");
+  if (!(schedule.minRoundShare >= 0 && schedule.minRoundShare <= 1))
+    return Status::Error("preview schedule: minRoundShare must be in [0, 1]");
+  const ProviderCapabilities exactCaps = exact.Capabilities();
+  const ProviderCapabilities previewCaps = preview.Capabilities();
+  if (previewCaps.width != exactCaps.width || previewCaps.height != exactCaps.height)
+    return Status::Error("preview schedule: the preview is " + std::to_string(previewCaps.width) +
+                         "x" + std::to_string(previewCaps.height) + ", the image " +
+                         std::to_string(exactCaps.width) + "x" + std::to_string(exactCaps.height));
+  if (exactCaps.splitRadiance && exactCaps.texture && options.textureSplit && !previewCaps.splitRadiance)
+    return Status::Error("preview schedule: the provider splits the radiance and the preview does not");
+
+  PreviewScheduleStats stats;
+  try {
+    PlanningProvider planning(exact, preview);
+    const double total = double(exactCaps.width) * double(exactCaps.height);
+    for (;;) {
+      const auto engineStart = std::chrono::steady_clock::now();
+      Status s = Reconstruct(planning, options, out);
+      stats.timeEngineS += Seconds(engineStart) - out->stats.timeGuidesS;
+      ++stats.engineRuns;
+      if (!s.ok()) return s;
+      std::vector<Point2i> wanted = planning.TakeWanted();
+      const bool small = double(wanted.size()) < schedule.minRoundShare * total;
+      if (wanted.empty() || stats.rounds == schedule.maxRounds || small) {
+        stats.previewStandIns = int64_t(wanted.size());
+        break;
+      }
+      const auto exactStart = std::chrono::steady_clock::now();
+      s = planning.EvaluateExactly(wanted);
+      stats.timeExactS += Seconds(exactStart);
+      if (!s.ok()) return s;
+      ++stats.rounds;
+      stats.pixelsPerRound.push_back(int64_t(wanted.size()));
+    }
+  } catch (const std::bad_alloc&) {
+    return Status::Error("out of memory while planning rounds on the preview");
+  }
+  // The final run's engine time excludes the rounds; the provider time is the rounds'.
+  out->stats.timeProviderS = stats.timeExactS;
+  out->stats.providerCalls = stats.rounds;
+  if (scheduleStats) *scheduleStats = std::move(stats);
+  return Status::Ok();
+}
+
+ImagePreviewProvider::ImagePreviewProvider(int workWidth, int workHeight, int previewWidth,
+                                           int previewHeight, std::vector<RGB> L,
+                                           std::vector<RGB> Li, std::vector<RGB> Lc)
+    : workWidth_(workWidth),
+      workHeight_(workHeight),
+      previewWidth_(previewWidth),
+      previewHeight_(previewHeight),
+      L_(std::move(L)),
+      Li_(std::move(Li)),
+      Lc_(std::move(Lc)) {}
+
+ProviderCapabilities ImagePreviewProvider::Capabilities() const {
+  ProviderCapabilities caps;
+  caps.width = workWidth_;
+  caps.height = workHeight_;
+  caps.splitRadiance = !Li_.empty() && !Lc_.empty();
+  caps.name = "preview";
+  return caps;
+}
+
+Status ImagePreviewProvider::Guides(const Bounds2i&, const GuideRequest&, GuideImage*) {
+  return Status::Error("a preview has no guides");
+}
+
+RGB ImagePreviewProvider::Lookup(const std::vector<RGB>& image, const Point2i& p) const {
+  // Pixel centres map to pixel centres: a preview at the working resolution
+  // returns its own pixels.
+  const float fx = std::clamp((float(p.x) + 0.5f) * float(previewWidth_) / float(workWidth_) - 0.5f,
+                              0.f, float(previewWidth_ - 1));
+  const float fy = std::clamp((float(p.y) + 0.5f) * float(previewHeight_) / float(workHeight_) - 0.5f,
+                              0.f, float(previewHeight_ - 1));
+  const int x0 = int(fx), y0 = int(fy);
+  const int x1 = std::min(x0 + 1, previewWidth_ - 1), y1 = std::min(y0 + 1, previewHeight_ - 1);
+  const float ax = fx - float(x0), ay = fy - float(y0);
+  auto at = [&](int x, int y) { return image[size_t(y) * size_t(previewWidth_) + size_t(x)]; };
+  return (at(x0, y0) * (1.f - ax) + at(x1, y0) * ax) * (1.f - ay) +
+         (at(x0, y1) * (1.f - ax) + at(x1, y1) * ax) * ay;
+}
+
+Status ImagePreviewProvider::Evaluate(std::span<const Point2i> pixels, const SampleRequest& what,
+                                      std::span<ExactSample> out) {
+  const size_t n = size_t(previewWidth_) * size_t(previewHeight_);
+  if (previewWidth_ < 1 || previewHeight_ < 1 || L_.size() != n ||
+      (!Li_.empty() && Li_.size() != n) || (!Lc_.empty() && Lc_.size() != n))
+    return Status::Error("preview image of " + std::to_string(previewWidth_) + "x" +
+                         std::to_string(previewHeight_) + " pixels has " +
+                         std::to_string(L_.size()) + " values");
+  if (what.split && (Li_.empty() || Lc_.empty()))
+    return Status::Error("the preview has no split radiance (L_i, L_c)");
+  for (size_t i = 0; i < pixels.size(); ++i) {
+    ExactSample& s = out[i];
+    s = ExactSample{};
+    s.L = Lookup(L_, pixels[i]);
+    if (what.split) {
+      s.Li = Lookup(Li_, pixels[i]);
+      s.Lc = Lookup(Lc_, pixels[i]);
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace dcm

@@ -1,0 +1,185 @@
+// Preview-planned rounds: a few large calls to the exact provider, and the
+// same image as the level-by-level schedule whenever no stand-in is left.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "dcm/round_schedule.h"
+#include "run_helpers.h"
+
+namespace dcm::testing {
+namespace {
+
+/// Counts Evaluate() calls of the provider it wraps.
+class CountingProvider : public SampleProvider {
+ public:
+  explicit CountingProvider(SampleProvider& inner) : inner_(inner) {}
+  ProviderCapabilities Capabilities() const override { return inner_.Capabilities(); }
+  Status Guides(const Bounds2i& r, const GuideRequest& w, GuideImage* out) override {
+    ++guideCalls;
+    return inner_.Guides(r, w, out);
+  }
+  Status Evaluate(std::span<const Point2i> p, const SampleRequest& w,
+                  std::span<ExactSample> out) override {
+    ++calls;
+    return inner_.Evaluate(p, w, out);
+  }
+  int calls = 0, guideCalls = 0;
+
+ private:
+  SampleProvider& inner_;
+};
+
+/// The provider's L, L_i and L_c box-filtered to 1/`factor` of its resolution:
+/// a preview a renderer would make at low resolution.
+ImagePreviewProvider LowResolutionPreview(const AnalyticProvider& p, int w, int h, int factor) {
+  const int pw = w / factor, ph = h / factor;
+  std::vector<RGB> L(size_t(pw) * ph), Li(L.size()), Lc(L.size());
+  const float weight = 1.f / float(factor * factor);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const PixelTruth t = p.Truth(x, y);
+      const size_t k = size_t(y / factor) * pw + size_t(x / factor);
+      L[k] += t.L() * weight;
+      Li[k] += t.Li * weight;
+      Lc[k] += t.Lc * weight;
+    }
+  return ImagePreviewProvider(w, h, pw, ph, L, Li, Lc);
+}
+
+TEST(RoundSchedule, AnExactPreviewNeedsOneRoundAndGivesTheSameImage) {
+  const int N = 128;
+  AnalyticProvider truth(N, N, FurnishedScene(N, N));
+  CountingProvider exact(truth);
+  ImagePreviewProvider preview = LowResolutionPreview(truth, N, N, 1);
+  const ReconstructionOptions o;
+  Reconstruction planned;
+  PreviewScheduleStats stats;
+  ASSERT_TRUE(ReconstructWithPreview(exact, preview, o, {}, &planned, &stats).ok());
+  const Reconstruction direct = ReconstructOrFail(truth, o);
+  // The plan on exact values asks for exactly the pixels the direct run asks for.
+  EXPECT_EQ(stats.rounds, 1);
+  EXPECT_EQ(exact.calls, 1);
+  EXPECT_EQ(exact.guideCalls, 1) << "the guides are asked once for all runs";
+  EXPECT_EQ(stats.previewStandIns, 0);
+  EXPECT_EQ(stats.engineRuns, 2);
+  EXPECT_EQ(planned.workImage, direct.workImage);
+  EXPECT_EQ(planned.sampleMap, direct.sampleMap);
+  EXPECT_EQ(stats.pixelsPerRound.at(0), direct.stats.exactPixels);
+}
+
+TEST(RoundSchedule, ALowResolutionPreviewConvergesToTheDirectImage) {
+  const int N = 128;
+  AnalyticProvider truth(N, N, FurnishedScene(N, N));
+  CountingProvider exact(truth);
+  ImagePreviewProvider preview = LowResolutionPreview(truth, N, N, 4);
+  const ReconstructionOptions o;
+  PreviewScheduleOptions schedule;
+  schedule.maxRounds = 20;
+  Reconstruction planned;
+  PreviewScheduleStats stats;
+  ASSERT_TRUE(ReconstructWithPreview(exact, preview, o, schedule, &planned, &stats).ok());
+  const Reconstruction direct = ReconstructOrFail(truth, o);
+  // Once no stand-in is left, the final run saw exact samples only, and the
+  // engine is a function of its samples: the image is the direct one.
+  std::printf("rounds %d (direct: %lld calls), pixels per round:", stats.rounds,
+              (long long)direct.stats.providerCalls);
+  for (int64_t n : stats.pixelsPerRound) std::printf(" %lld", (long long)n);
+  std::printf("\n");
+  ASSERT_EQ(stats.previewStandIns, 0);
+  EXPECT_EQ(planned.workImage, direct.workImage);
+  EXPECT_EQ(exact.calls, stats.rounds);
+  // A plan at 1/4 resolution gets most pixels right: the later rounds are the
+  // few whose choice depended on detail below the preview's resolution.
+  EXPECT_LE(stats.rounds, 6);
+  EXPECT_GT(stats.pixelsPerRound.at(0), 2 * stats.pixelsPerRound.back());
+  EXPECT_LT(stats.rounds, int(direct.stats.providerCalls)) << "fewer rounds than level by level";
+  // No pixel is evaluated twice, and none the direct run does not need.
+  EXPECT_EQ(truth.MaxEvaluationsOfOnePixel(), 2) << "once here, once in the direct run";
+}
+
+TEST(RoundSchedule, TheLastRoundLeavesStandInsAndSaysSo) {
+  const int N = 128;
+  AnalyticProvider truth(N, N, FurnishedScene(N, N));
+  CountingProvider exact(truth);
+  ImagePreviewProvider preview = LowResolutionPreview(truth, N, N, 8);
+  PreviewScheduleOptions schedule;
+  schedule.maxRounds = 1;
+  Reconstruction planned;
+  PreviewScheduleStats stats;
+  ASSERT_TRUE(ReconstructWithPreview(exact, preview, {}, schedule, &planned, &stats).ok());
+  EXPECT_EQ(exact.calls, 1);
+  EXPECT_EQ(stats.rounds, 1);
+  EXPECT_EQ(truth.MaxEvaluationsOfOnePixel(), 1);
+  // At 1/8 resolution the plan misses detail; the pixels the final run wanted
+  // beyond the one round are counted, not silently made up.
+  EXPECT_GT(stats.previewStandIns, 0);
+  EXPECT_EQ(truth.TotalEvaluations(), stats.pixelsPerRound.at(0));
+}
+
+TEST(RoundSchedule, MinRoundShareStopsBeforeASmallRound) {
+  const int N = 128;
+  AnalyticProvider truth(N, N, FurnishedScene(N, N));
+  ImagePreviewProvider preview = LowResolutionPreview(truth, N, N, 4);
+  PreviewScheduleOptions schedule;
+  schedule.maxRounds = 20;
+  schedule.minRoundShare = 1.0;  // no round is ever as large as the image
+  Reconstruction planned;
+  PreviewScheduleStats stats;
+  ASSERT_TRUE(ReconstructWithPreview(truth, preview, {}, schedule, &planned, &stats).ok());
+  EXPECT_EQ(stats.rounds, 0);
+  EXPECT_EQ(truth.TotalEvaluations(), 0);
+  EXPECT_EQ(stats.previewStandIns, planned.stats.exactPixels);
+}
+
+TEST(RoundSchedule, BadSchedulesAndPreviewsAreRefused) {
+  const int N = 64;
+  AnalyticProvider truth(N, N, FurnishedScene(N, N));
+  ImagePreviewProvider wrongSize = LowResolutionPreview(truth, N / 2, N / 2, 1);
+  Reconstruction r;
+  Status s = ReconstructWithPreview(truth, wrongSize, {}, {}, &r);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("32x32"), std::string::npos) << s.message();
+  ImagePreviewProvider preview = LowResolutionPreview(truth, N, N, 2);
+  PreviewScheduleOptions zero;
+  zero.maxRounds = 0;
+  s = ReconstructWithPreview(truth, preview, {}, zero, &r);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("maxRounds"), std::string::npos) << s.message();
+  ImagePreviewProvider noSplit(N, N, 1, 1, {RGB::Gray(1.f)});
+  s = ReconstructWithPreview(truth, noSplit, {}, {}, &r);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("split"), std::string::npos) << s.message();
+}
+
+TEST(RoundSchedule, ImagePreviewUpsamplesBilinearlyBetweenPixelCentres) {
+  // 2x1 preview of a 4x2 image: work pixel centres 0.5..3.5 map to preview
+  // coordinates -0.25, 0.25, 0.75, 1.25, clamped to [0, 1].
+  ImagePreviewProvider p(4, 2, 2, 1, {RGB::Gray(0.f), RGB::Gray(4.f)});
+  const std::vector<Point2i> pixels{{0, 0}, {1, 0}, {2, 1}, {3, 1}};
+  std::vector<ExactSample> out(pixels.size());
+  ASSERT_TRUE(p.Evaluate(pixels, {}, out).ok());
+  EXPECT_FLOAT_EQ(out[0].L.g, 0.f);
+  EXPECT_FLOAT_EQ(out[1].L.g, 1.f);
+  EXPECT_FLOAT_EQ(out[2].L.g, 3.f);
+  EXPECT_FLOAT_EQ(out[3].L.g, 4.f);
+  GuideImage g;
+  EXPECT_FALSE(p.Guides({{0, 0}, {4, 2}}, {}, &g).ok());
+}
+
+TEST(RoundSchedule, ChoiceFollowsTheCostOfARound) {
+  EXPECT_EQ(ChooseSchedule({}), RoundSchedule::kLevels);
+  EXPECT_EQ(ChooseSchedule({0.5, 0}), RoundSchedule::kPreview) << "latency, per-sample cost unknown";
+  EXPECT_EQ(ChooseSchedule({0.5, 1e-3}), RoundSchedule::kLevels) << "a round costs 500 samples";
+  EXPECT_EQ(ChooseSchedule({0.5, 1e-5}), RoundSchedule::kPreview) << "a round costs 50000 samples";
+  for (RoundSchedule s : {RoundSchedule::kLevels, RoundSchedule::kPreview}) {
+    RoundSchedule parsed;
+    ASSERT_TRUE(Parse(ToString(s), &parsed).ok());
+    EXPECT_EQ(parsed, s);
+  }
+  RoundSchedule parsed;
+  EXPECT_FALSE(Parse("fast", &parsed).ok());
+}
+
+}  // namespace
+}  // namespace dcm::testing
