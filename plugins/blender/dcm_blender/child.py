@@ -14,6 +14,7 @@ import struct
 import sys
 import tempfile
 import time
+import urllib.parse
 
 import numpy as np
 
@@ -128,8 +129,11 @@ def main(argv):
         # The guides and preview render first: its time tells what a round costs.
         session.guides()
         latency, per_sample = session.round_cost()
-        proto.send("dcm-pipe 1 width=%d height=%d caps=%s name=blender-cycles round_latency=%.4g sample_cost=%.4g"
-                   % (session.width, session.height, CAPS, latency, per_sample))
+        # view_layer (percent-encoded: names have spaces) and guides_seconds are for `dcm blender`.
+        proto.send("dcm-pipe 1 width=%d height=%d caps=%s name=blender-cycles round_latency=%.4g sample_cost=%.4g "
+                   "view_layer=%s guides_seconds=%.3f"
+                   % (session.width, session.height, CAPS, latency, per_sample,
+                      urllib.parse.quote(session.layer.name, safe=""), session.render_seconds[0][1]))
         serve(proto, session)
     except Exception as e:  # told to dcm, which stops with the message
         msg = " ".join(("%s: %s" % (type(e).__name__, e) if not isinstance(e, scene.SceneError)

@@ -200,6 +200,7 @@ Status PipeProvider::Handshake() {
     const size_t eq = t[i].find('=');
     if (eq == std::string::npos) return Fail("handshake: expected key=value, got " + Quote(t[i]));
     const std::string key = t[i].substr(0, eq), value = t[i].substr(eq + 1);
+    keys_[key] = value;
     int64_t v = 0;
     if (key == "width" || key == "height") {
       if (!ParseInt(value, &v) || v < 1 || v > kMaxSide)

@@ -2,6 +2,7 @@
 // its stdin/stdout with the dcm-pipe protocol (plugins/pipe/PROTOCOL.md).
 #pragma once
 
+#include <map>
 #include <memory>
 #include <mutex>
 #include <span>
@@ -87,6 +88,10 @@ class PipeProvider final : public SampleProvider {
   /// first outcome again.
   Status Finish();
 
+  /// Every key=value of the child's handshake, the ones dcm does not use too
+  /// (what a particular provider adds for its own command).
+  const std::map<std::string, std::string>& handshakeKeys() const { return keys_; }
+
   /// "eval" requests sent so far (rounds of exact samples).
   int64_t evalRequests() const { return evalRequests_; }
 
@@ -110,6 +115,7 @@ class PipeProvider final : public SampleProvider {
 
   ProviderCapabilities caps_;
   RoundCost cost_;
+  std::map<std::string, std::string> keys_;
   bool preview_ = false;
   int64_t evalRequests_ = 0;
   int childVersion_ = 0;
