@@ -152,12 +152,15 @@ class TimedProvider final : public SampleProvider {
   explicit TimedProvider(SampleProvider& p) : p_(p) {}
   ProviderCapabilities Capabilities() const override { return p_.Capabilities(); }
   Status Guides(const Bounds2i& region, const GuideRequest& what, GuideImage* out) override {
+    step = "reading the guides";
     const auto t = Clock::now();
     Status st = p_.Guides(region, what, out);
     guidesS += Since(t);
     return st;
   }
   Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what, std::span<ExactSample> out) override {
+    step = "rendering exact pixels (call " + std::to_string(rounds.size() + 1) + ", " +
+           std::to_string(pixels.size()) + " pixels)";
     const auto t = Clock::now();
     Status st = p_.Evaluate(pixels, what, out);
     rounds.push_back({int64_t(pixels.size()), Since(t)});
@@ -169,6 +172,7 @@ class TimedProvider final : public SampleProvider {
   };
   std::vector<Round> rounds;
   double guidesS = 0;
+  std::string step = "planning";  ///< what the last call did, for messages
 
  private:
   SampleProvider& p_;
@@ -196,6 +200,15 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       !st.ok())
     return Fail(st.message(), kExitUsage);
   if (Status st = CheckBlendFile(f.scene); !st.ok()) return Fail(st.message());
+  // Before Blender renders anything: the outputs' folders must take a file.
+  for (const std::string& out : {output, stats, sampleMap}) {
+    if (out.empty()) continue;
+    const fs::path folder = fs::absolute(fs::path(out)).parent_path();
+    std::error_code ec;
+    if (!fs::is_directory(folder, ec) || ::access(folder.c_str(), W_OK | X_OK) != 0)
+      return Fail("cannot write '" + out + "': its folder '" + folder.string() +
+                  "' does not exist or is not writable (checking the outputs before rendering)");
+  }
   std::string blender, child;
   if (Status st = FindExecutable(f.blender, &blender); !st.ok()) return Fail(st.message());
   if (Status st = FindChildScript(&child); !st.ok()) return Fail(st.message());
@@ -253,6 +266,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   if (schedule == RoundSchedule::kPreview) {
     const auto tp = Clock::now();
     std::unique_ptr<SampleProvider> preview;
+    timed.step = "reading the preview";
     st = provider->FetchPreview({options.textureSplit && caps.splitRadiance, false}, &preview);
     previewS = Since(tp);
     PreviewScheduleOptions so;
@@ -262,7 +276,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     st = Reconstruct(timed, options, &rec);
   }
   progress.Done();
-  if (!st.ok()) return Fail("'" + f.scene + "': " + st.message());
+  if (!st.ok()) return Fail("'" + f.scene + "': " + timed.step + ": " + st.message());
   // Blender must end cleanly before anything is written.
   if (Status fin = provider->Finish(); !fin.ok()) return Fail("'" + f.scene + "': " + fin.message());
   const double wallS = Since(t0);
