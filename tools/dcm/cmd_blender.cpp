@@ -224,8 +224,11 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   if (frame >= 0) command += " --frame " + std::to_string(frame);
   if (!f.viewLayer.empty()) command += " --view-layer " + ShellQuote(f.viewLayer);
   if (f.renderThreads > 0) command += " --threads " + std::to_string(f.renderThreads);
-  // Blender prints to stdout before any script runs: the protocol goes to fd 3.
-  command += " 3>&1 1>&2";
+  // Blender prints to stdout before any script runs: the protocol goes to fd 3,
+  // Blender's own output to stderr with -v, else nowhere (the child's notes and
+  // errors still reach stderr).
+  if (f.pipe.engine.verbose) command += " --verbose";
+  command += f.pipe.engine.verbose ? " 3>&1 1>&2" : " 3>&1 1>/dev/null";
   pipe::PipeOptions po;
   po.command = command;
   po.timeoutSeconds = f.pipe.timeout;

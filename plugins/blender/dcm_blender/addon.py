@@ -104,7 +104,8 @@ class DCM_OT_render(bpy.types.Operator):
             bpy.data.images.remove(img)
         img = bpy.data.images.load(self._out)
         img.name = "DCM Result"
-        img.pack()  # the temporary folder goes away
+        img.pack()
+        shutil.rmtree(self._dir, ignore_errors=True)
         for area in context.screen.areas:
             if area.type == "IMAGE_EDITOR":
                 area.spaces.active.image = img

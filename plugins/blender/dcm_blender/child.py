@@ -4,7 +4,8 @@
 
 Blender and Cycles print to stdout, Blender even before it runs any script
 (its version, "Read blend: ..."). So the protocol goes to its own descriptor:
-the shell gives the child's stdout to fd 3 and points fd 1 at stderr. Without
+the shell gives the child's stdout to fd 3 and points fd 1 at stderr (or at
+/dev/null: `dcm blender` without -v; the child's notes go to stderr). Without
 --protocol-fd the child takes a private copy of fd 1 and points fd 1 at
 stderr, which keeps everything after start-up clean."""
 import argparse
@@ -30,7 +31,13 @@ def parse_args(argv):
     ap.add_argument("--frame", type=int, default=None, help="frame to render (default: the file's current)")
     ap.add_argument("--view-layer", default="", help="view layer to render (default: the first that renders)")
     ap.add_argument("--threads", type=int, default=0, help="render threads (0: Blender's choice)")
+    ap.add_argument("--tile-size", type=int, default=32,
+                    help="a round renders the tiles of this size that hold its pixels, within render borders")
+    ap.add_argument("--max-calls", type=int, default=48, help="render calls per round at most (tiles grow)")
+    ap.add_argument("--max-border-share", type=float, default=0.5,
+                    help="above this share of the frame in borders, a round renders the whole frame in one call")
     ap.add_argument("--mask-scale", type=int, default=4, help="mask texels per pixel and side")
+    ap.add_argument("--verbose", action="store_true", help="the time of each render call on stderr")
     ap.add_argument("--protocol-fd", type=int, default=-1, help="descriptor of the protocol's output")
     ap.add_argument("--verify-restore", action="store_true",
                     help="fail when the scene after the run differs from the scene before it (tests)")
@@ -108,8 +115,11 @@ def main(argv):
     # The protocol's own copy of stdout; Blender's prints go to stderr from now on.
     args = parse_args(argv)
     sys.stdout.flush()
-    out_fd = args.protocol_fd if args.protocol_fd >= 0 else os.dup(1)
-    os.dup2(2, 1)
+    if args.protocol_fd >= 0:
+        out_fd = args.protocol_fd  # fd 1 is what the shell made of it (stderr, or /dev/null)
+    else:
+        out_fd = os.dup(1)
+        os.dup2(2, 1)
     proto = Protocol(out_fd)
     t0 = time.monotonic()
     hello = proto.line()
@@ -151,7 +161,8 @@ def main(argv):
         diff = difflib.unified_diff(before.splitlines(), session.fingerprint().splitlines(), lineterm="")
         print("dcm-blender: the scene was not restored:\n" + "\n".join(diff), file=sys.stderr)
         status = 3
-    for label, s in session.render_seconds:
-        print("dcm-blender: render %s %.2f s" % (label, s), file=sys.stderr)
-    print("dcm-blender: %.2f s in the child" % (time.monotonic() - t0), file=sys.stderr, flush=True)
+    if args.verbose:
+        for label, s in session.render_seconds:
+            print("dcm-blender: render %s %.2f s" % (label, s), file=sys.stderr)
+        print("dcm-blender: %.2f s in the child" % (time.monotonic() - t0), file=sys.stderr, flush=True)
     return status

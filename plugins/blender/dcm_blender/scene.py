@@ -40,6 +40,11 @@ class Changes:
     def on_restore(self, fn):
         self._undo.append(fn)
 
+    def restore_later(self, obj, attrs):
+        """Restores `attrs` of `obj` to their present values, in this order."""
+        saved = [(a, getattr(obj, a)) for a in attrs]
+        self._undo.append(lambda: [setattr(obj, a, v) for a, v in saved])
+
     def restore(self):
         errors = []
         while self._undo:
@@ -110,7 +115,10 @@ class Session:
             raise SceneError("empty resolution %dx%d" % (self.width, self.height))
         if r.use_border:
             self.notes.append("the render region (border) is ignored: dcm renders the whole frame")
-            c.set(r, "use_border", False)
+        # Rounds render within borders of their own (rectangles()): the user's come back.
+        c.restore_later(r, ("use_border", "use_crop_to_border", "border_min_x", "border_max_x", "border_min_y",
+                            "border_max_y"))
+        r.use_border, r.use_crop_to_border = False, False
 
         # The view layer: the named one, else the first that renders; the others are off.
         layers = [vl for vl in sc.view_layers if vl.use]
@@ -154,13 +162,17 @@ class Session:
         c.set(r, "filepath", os.path.join(self.workdir, "render.exr"))
         # The depth a format allows depends on the format: restore all three at once, format first.
         im = r.image_settings
-        saved = (im.file_format, im.color_depth, im.exr_codec)
-        c.on_restore(lambda: [setattr(im, a, v) for a, v in zip(("file_format", "color_depth", "exr_codec"), saved)])
+        c.restore_later(im, ("file_format", "color_depth", "exr_codec"))
         im.file_format, im.color_depth, im.exr_codec = "OPEN_EXR_MULTILAYER", "32", "NONE"
         # How far from its centre a pixel's camera rays leave: Box, the pixel; Gaussian, half
         # the filter width; Blackman-Harris, the width (Cycles doubles its support).
         self.filter_radius = {"BOX": 0.5, "GAUSSIAN": max(0.5, cy.filter_width / 2)}.get(
             cy.pixel_filter_type, max(0.5, cy.filter_width))
+        if self.filter_radius > 0.5:
+            self.notes.append("pixel filter %s %.2f px: the mask around each exact pixel spans %.1f px, where its "
+                              "rays leave (a Gaussian of 0.01 px renders the fewest pixels; docs/BLENDER.md)"
+                              % (cy.pixel_filter_type.replace("_", "-").title(), cy.filter_width,
+                                 2 * self.filter_radius))
         self._insert_masks()
 
     # -------------------------------------------------------- the masks --
@@ -365,23 +377,78 @@ class Session:
             self._guides = g
         return self._guides
 
+    def rectangles(self, xs, ys):
+        """Where to render pixels (xs, ys): a list of (x0, y0, x1, y1), or [None] for
+        the whole frame. A masked pixel still costs Cycles a camera ray and a
+        shader per sample (about a tenth of a rendered one), so a round renders
+        only the tiles that hold its pixels, each tile row's runs merged into one
+        render-border rectangle, unless they cover most of the frame."""
+        t = self.args.tile_size
+        while True:
+            tw, th = -(-self.width // t), -(-self.height // t)
+            occ = np.zeros((th, tw), bool)
+            occ[ys // t, xs // t] = True
+            rects = []
+            for ty in range(th):
+                tx = 0
+                while tx < tw:
+                    if not occ[ty, tx]:
+                        tx += 1
+                        continue
+                    start = tx
+                    while tx < tw and occ[ty, tx]:
+                        tx += 1
+                    rects.append((start * t, ty * t, min(tx * t, self.width), min((ty + 1) * t, self.height)))
+            if len(rects) <= self.args.max_calls or t >= max(self.width, self.height):
+                break
+            t *= 2
+        area = sum((x1 - x0) * (y1 - y0) for x0, y0, x1, y1 in rects)
+        if area > self.args.max_border_share * self.width * self.height:
+            return [None]
+        return rects
+
+    def _set_border(self, rect):
+        r = self.scene.render
+        if rect is None:
+            r.use_border = False
+            return
+        # One pixel more on each side: Blender truncates the border to whole pixels.
+        x0, y0 = max(rect[0] - 1, 0), max(rect[1] - 1, 0)
+        x1, y1 = min(rect[2] + 1, self.width), min(rect[3] + 1, self.height)
+        r.use_border = True
+        r.border_min_x, r.border_max_x = x0 / self.width, x1 / self.width
+        r.border_min_y, r.border_max_y = 1 - y1 / self.height, 1 - y0 / self.height
+
     def evaluate(self, xs, ys):
-        """L, L_i, L_c [n, 3] of pixels (xs, ys) from one render at full samples."""
+        """L, L_i, L_c [n, 3] of pixels (xs, ys) at full samples: one mask, and one
+        render call per rectangle of rectangles()."""
         g = self.guides()
         if os.environ.get("DCM_BLENDER_TEST_FAULT") == "crash-on-eval":  # tests: Blender dies mid-round
             os.kill(os.getpid(), 9)
         texels = self.mask_of(xs, ys)
         self._write_mask(texels)
-        pl = self._render(self.samples, "eval")
-        diffcol = self._rgb(pl, "DiffCol")
-        # The mask rendered must be the mask asked for: outside it no surface
-        # keeps its own shader (a stale mask would show diffuse colour there).
-        stray = (diffcol.max(axis=-1) > 0) & ~self.reached(texels)
-        if stray.any():
-            raise SceneError("%d pixels outside the mask were rendered: the mask of this round did not "
-                             "reach Cycles" % int(stray.sum()))
-        L = self._rgb(pl, "Combined")[ys, xs]
-        Li = (self._rgb(pl, "DiffDir") + self._rgb(pl, "DiffInd"))[ys, xs]
+        reached = self.reached(texels)
+        L, Li = np.zeros((len(xs), 3), np.float32), np.zeros((len(xs), 3), np.float32)
+        done = np.zeros(len(xs), bool)
+        self._evals = getattr(self, "_evals", 0) + 1
+        for rect in self.rectangles(xs, ys):
+            self._set_border(rect)
+            pl = self._render(self.samples, "eval%d" % self._evals)
+            diffcol = self._rgb(pl, "DiffCol")
+            # The mask rendered must be the mask asked for: outside it no surface
+            # keeps its own shader (a stale mask would show diffuse colour there).
+            stray = (diffcol.max(axis=-1) > 0) & ~reached
+            if stray.any():
+                raise SceneError("%d pixels outside the mask were rendered: the mask of this round did not "
+                                 "reach Cycles" % int(stray.sum()))
+            inside = np.ones(len(xs), bool) if rect is None else (
+                (xs >= rect[0]) & (xs < rect[2]) & (ys >= rect[1]) & (ys < rect[3]))
+            L[inside] = self._rgb(pl, "Combined")[ys[inside], xs[inside]]
+            Li[inside] = (self._rgb(pl, "DiffDir") + self._rgb(pl, "DiffInd"))[ys[inside], xs[inside]]
+            done |= inside
+        self._set_border(None)
+        if not done.all():
+            raise SceneError("%d pixels fell outside every render border" % int((~done).sum()))
         Lc = L - Li * g["texture"][ys, xs]
         return L, Li, Lc
 
@@ -412,7 +479,8 @@ class Session:
             lines.append("layer %s %s" % (vl.name, [getattr(vl, a) for a in dir(vl) if a.startswith("use_pass")]
                                           + [vl.use, vl.pass_cryptomatte_depth]))
         r, cy = sc.render, sc.cycles
-        lines.append("render %s" % ([getattr(r, a) for a in ("use_border", "use_persistent_data", "use_compositing",
+        lines.append("render %s" % ([getattr(r, a) for a in ("use_border", "use_crop_to_border", "border_min_x",
+                                                             "border_max_y", "use_persistent_data", "use_compositing",
                                                              "use_sequencer", "use_file_extension", "filepath",
                                                              "threads_mode", "threads")]
                                     + [r.image_settings.file_format, r.image_settings.color_depth,

@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# End to end, as a user runs it: `dcm blender ROOM.blend` against the full
+# Cycles render of the same file at the same samples, in the same run, both
+# from the command to the EXR (Blender start-up included); PSNR of both
+# against a converged render (REF_SPP samples).
+#
+#   examples/blender/dcm_vs_cycles.sh OUT_DIR [RES=256] [SPP=512] [REF_SPP=2048] [VIEW=a]
+#
+# Prints one line per render and leaves in OUT_DIR: room.blend, full.exr,
+# dcm.exr, dcm.json, ref.exr, times.txt.
+set -euo pipefail
+here=$(cd "$(dirname "$0")/../.." && pwd)
+out=${1:?usage: dcm_vs_cycles.sh OUT_DIR [RES] [SPP] [REF_SPP] [VIEW]}
+res=${2:-256} spp=${3:-512} ref_spp=${4:-2048} view=${5:-a}
+dcm=${DCM:-$here/build/tools/dcm/dcm}
+mkdir -p "$out"
+cd "$out"
+# The scene (examples/blender/make_and_render.py), saved after a 1-spp render.
+[ -f room.blend ] || blender -b --factory-startup --python "$here/examples/blender/make_and_render.py" -- \
+    --out room_1spp.exr --view "$view" --res "$res" --samples 1 --save-blend room.blend >/dev/null
+render() {  # render SAMPLES OUT: the file as it is at SAMPLES, Combined in a multilayer EXR
+  blender -b room.blend --python-expr "
+import bpy
+sc = bpy.context.scene
+sc.cycles.samples = $1
+im = sc.render.image_settings
+im.file_format = 'OPEN_EXR_MULTILAYER'; im.color_depth = '32'
+sc.render.use_file_extension = False
+sc.render.filepath = '$PWD/$2'
+bpy.ops.render.render(write_still=True)" >/dev/null
+}
+now() { /usr/bin/python3 -c 'import time; print(time.monotonic())'; }  # the clock dcm's --stats use
+t0=$(now); render "$spp" full.exr; t1=$(now)
+"$dcm" blender room.blend -o dcm.exr --stats dcm.json --samples "$spp" -q ${DCM_ARGS:-} >/dev/null; t2=$(now)
+full_s=$(echo "$t1 - $t0" | bc -l); dcm_s=$(echo "$t2 - $t1" | bc -l)
+printf "full %.2f s\ndcm %.2f s\n" "$full_s" "$dcm_s" > times.txt
+[ -f ref.exr ] || render "$ref_spp" ref.exr
+/usr/bin/python3 - "$full_s" "$dcm_s" <<'PY'
+import json, sys
+import numpy as np
+import OpenImageIO as oiio
+
+def load(path):
+    inp = oiio.ImageInput.open(path)
+    spec, px = inp.spec(), inp.read_image("float")
+    names = list(spec.channelnames)
+    return px[:, :, [next(i for i, n in enumerate(names) if n.endswith("Combined." + c)) for c in "RGB"]]
+
+def psnr(a, b):  # on sRGB-encoded values clipped to [0, 1], as docs/AOV.md
+    enc = lambda x: np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(np.maximum(x, 0), 1 / 2.4) - 0.055)
+    mse = np.mean((np.clip(enc(a), 0, 1) - np.clip(enc(b), 0, 1)) ** 2)
+    return 10 * np.log10(1 / mse)
+
+ref, full, dcm = load("ref.exr"), load("full.exr"), load("dcm.exr")
+j = json.load(open("dcm.json"))
+b = j["blender"]
+full_s, dcm_s = float(sys.argv[1]), float(sys.argv[2])
+print("full Cycles   %7.2f s                PSNR %.2f dB vs the converged render" % (full_s, psnr(full, ref)))
+print("dcm blender   %7.2f s  (%.2fx)  PSNR %.2f dB; %.2f %% exact, %d render calls %s; start %.2f s, "
+      "guides+preview %.2f s, rounds %.2f s, engine %.2f s"
+      % (dcm_s, full_s / dcm_s, psnr(dcm, ref), 100 * j["exact_fraction"], len(b["rounds"]),
+         [r["pixels"] for r in b["rounds"]], b["startup_s"], b["guides_s"] + b["preview_s"], b["rounds_s"],
+         b["engine_s"]))
+print("dcm vs full   PSNR %.2f dB" % psnr(dcm, full))
+PY
