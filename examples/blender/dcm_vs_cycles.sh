@@ -6,8 +6,9 @@
 #
 #   examples/blender/dcm_vs_cycles.sh OUT_DIR [RES=256] [SPP=512] [REF_SPP=2048] [VIEW=a]
 #
-# Prints one line per render and leaves in OUT_DIR: room.blend, full.exr,
-# dcm.exr, dcm.json, ref.exr, times.txt.
+# DCM_VARIANTS="FLAGS|FLAGS|..." runs dcm blender once per set of flags after
+# the one full render. Prints one line per render and leaves in OUT_DIR:
+# room.blend, full.exr, dcmN.exr, dcmN.json, ref.exr, times.txt.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/../.." && pwd)
 out=${1:?usage: dcm_vs_cycles.sh OUT_DIR [RES] [SPP] [REF_SPP] [VIEW]}
@@ -30,12 +31,21 @@ sc.render.filepath = '$PWD/$2'
 bpy.ops.render.render(write_still=True)" >/dev/null
 }
 now() { /usr/bin/python3 -c 'import time; print(time.monotonic())'; }  # the clock dcm's --stats use
+# DCM_VARIANTS: extra dcm flags per run, separated by '|' (default: one run, no flags).
+IFS='|' read -r -a variants <<< "${DCM_VARIANTS:- }"
 t0=$(now); render "$spp" full.exr; t1=$(now)
-"$dcm" blender room.blend -o dcm.exr --stats dcm.json --samples "$spp" -q ${DCM_ARGS:-} >/dev/null; t2=$(now)
-full_s=$(echo "$t1 - $t0" | bc -l); dcm_s=$(echo "$t2 - $t1" | bc -l)
-printf "full %.2f s\ndcm %.2f s\n" "$full_s" "$dcm_s" > times.txt
+full_s=$(echo "$t1 - $t0" | bc -l)
+printf "full %.2f s\n" "$full_s" > times.txt
+dcm_s=()
+for i in "${!variants[@]}"; do
+  t1=$(now)
+  "$dcm" blender room.blend -o "dcm$i.exr" --stats "dcm$i.json" --samples "$spp" -q ${variants[$i]} >/dev/null
+  t2=$(now)
+  dcm_s+=("$(echo "$t2 - $t1" | bc -l)")
+  printf "dcm %s: %.2f s\n" "${variants[$i]}" "${dcm_s[$i]}" >> times.txt
+done
 [ -f ref.exr ] || render "$ref_spp" ref.exr
-/usr/bin/python3 - "$full_s" "$dcm_s" <<'PY'
+/usr/bin/python3 - "$full_s" "${DCM_VARIANTS:- }" "${dcm_s[@]}" <<'PY'
 import json, sys
 import numpy as np
 import OpenImageIO as oiio
@@ -51,15 +61,15 @@ def psnr(a, b):  # on sRGB-encoded values clipped to [0, 1], as docs/AOV.md
     mse = np.mean((np.clip(enc(a), 0, 1) - np.clip(enc(b), 0, 1)) ** 2)
     return 10 * np.log10(1 / mse)
 
-ref, full, dcm = load("ref.exr"), load("full.exr"), load("dcm.exr")
-j = json.load(open("dcm.json"))
-b = j["blender"]
-full_s, dcm_s = float(sys.argv[1]), float(sys.argv[2])
-print("full Cycles   %7.2f s                PSNR %.2f dB vs the converged render" % (full_s, psnr(full, ref)))
-print("dcm blender   %7.2f s  (%.2fx)  PSNR %.2f dB; %.2f %% exact, %d render calls %s; start %.2f s, "
-      "guides+preview %.2f s, rounds %.2f s, engine %.2f s"
-      % (dcm_s, full_s / dcm_s, psnr(dcm, ref), 100 * j["exact_fraction"], len(b["rounds"]),
-         [r["pixels"] for r in b["rounds"]], b["startup_s"], b["guides_s"] + b["preview_s"], b["rounds_s"],
-         b["engine_s"]))
-print("dcm vs full   PSNR %.2f dB" % psnr(dcm, full))
+ref, full = load("ref.exr"), load("full.exr")
+full_s = float(sys.argv[1])
+print("full Cycles          %7.2f s           PSNR %.2f dB vs the converged render" % (full_s, psnr(full, ref)))
+for i, (flags, s) in enumerate(zip(sys.argv[2].split("|"), sys.argv[3:])):
+    dcm, j = load("dcm%d.exr" % i), json.load(open("dcm%d.json" % i))
+    b, s = j["blender"], float(s)
+    print("dcm blender %-20s %7.2f s (%.2fx)  PSNR %.2f dB (%.2f dB vs full); %.2f %% exact, %d calls %s; "
+          "start %.2f s, guides+preview %.2f s, rounds %.2f s, engine %.2f s"
+          % (flags.strip() or "(defaults)", s, full_s / s, psnr(dcm, ref), psnr(dcm, full), 100 * j["exact_fraction"],
+             len(b["rounds"]), [r["pixels"] for r in b["rounds"]], b["startup_s"], b["guides_s"] + b["preview_s"],
+             b["rounds_s"], b["engine_s"]))
 PY

@@ -32,8 +32,7 @@ def main():
         keep = os.path.join(tmp, "renders")
         # Tiles of 8 px, always within render borders: rounds 1 and 2 render six
         # rows of tiles each, round 3 one tile.
-        child = bs.Child(blender, src, blend, ["--verify-restore", "--keep-renders", keep, "--tile-size", "8",
-                                               "--max-border-share", "1"])
+        child = bs.Child(blender, src, blend, ["--verify-restore", "--keep-renders", keep, "--border-tile", "8"])
         assert (child.width, child.height) == (w, h), (child.width, child.height)
         assert "preview" in child.caps and "split" in child.caps, child.caps
         assert child.round_latency > 0 and child.sample_cost > 0, child.hello

@@ -53,7 +53,7 @@ struct BlenderFlags {
   std::string viewLayer;   ///< empty: the first that renders
   std::string schedule = "auto";  ///< auto | preview | levels
   int samples = 0;         ///< 0: the file's
-  int previewSamples = 0;  ///< 0: samples / 16, at least 1
+  int previewSamples = 0;  ///< 0: samples / 16, at least 4
   int maxRounds = 3;
   int renderThreads = 0;
   PipeFlags pipe;  ///< --provider-timeout, --provider-startup-timeout; engine; EXR format
@@ -399,7 +399,7 @@ Registration reg("blender", "Render a .blend with Cycles at the pixels DCM asks 
                    app->add_option("--samples", f->samples, "Cycles samples of the exact pixels (0: the file's)")
                        ->transform(Integer(0, 1 << 24));
                    app->add_option("--preview-samples", f->previewSamples,
-                                   "samples of the guides and preview render (0: the child's default, 4)")
+                                   "samples of the guides and preview render (0: a sixteenth of --samples, at least 4)")
                        ->transform(Integer(0, 1 << 24));
                    app->add_option("--schedule", f->schedule,
                                    "rounds: preview (plan on the preview, few render calls), levels (one call per "

@@ -27,15 +27,16 @@ CAPS = "object_id,shader_id,texture,normal,split,preview"
 def parse_args(argv):
     ap = argparse.ArgumentParser(prog="dcm_blender child")
     ap.add_argument("--samples", type=int, default=0, help="Cycles samples of the exact pixels (0: the file's)")
-    ap.add_argument("--preview-samples", type=int, default=4, help="samples of the guides and preview render")
+    ap.add_argument("--preview-samples", type=int, default=0,
+                    help="samples of the guides and preview render (0: a sixteenth of --samples, at least 4)")
     ap.add_argument("--frame", type=int, default=None, help="frame to render (default: the file's current)")
     ap.add_argument("--view-layer", default="", help="view layer to render (default: the first that renders)")
     ap.add_argument("--threads", type=int, default=0, help="render threads (0: Blender's choice)")
-    ap.add_argument("--tile-size", type=int, default=32,
-                    help="a round renders the tiles of this size that hold its pixels, within render borders")
-    ap.add_argument("--max-calls", type=int, default=48, help="render calls per round at most (tiles grow)")
-    ap.add_argument("--max-border-share", type=float, default=0.5,
-                    help="above this share of the frame in borders, a round renders the whole frame in one call")
+    ap.add_argument("--call-seconds", type=float, default=0.3,
+                    help="fixed time of a render call in the running Blender (sets how many borders pay off)")
+    ap.add_argument("--max-calls", type=int, default=64, help="render calls per round at most")
+    ap.add_argument("--border-tile", type=int, default=0,
+                    help="tests: render every round within borders over tiles of this size")
     ap.add_argument("--mask-scale", type=int, default=4, help="mask texels per pixel and side")
     ap.add_argument("--verbose", action="store_true", help="the time of each render call on stderr")
     ap.add_argument("--protocol-fd", type=int, default=-1, help="descriptor of the protocol's output")

@@ -144,7 +144,7 @@ class Session:
 
         cy = sc.cycles
         self.samples = a.samples if a.samples > 0 else cy.samples
-        self.preview_samples = max(1, min(self.samples, a.preview_samples))
+        self.preview_samples = min(self.samples, a.preview_samples or max(4, self.samples // 16))
         if cy.use_adaptive_sampling:
             self.notes.append("adaptive sampling off: every pixel gets %d samples" % self.samples)
             c.set(cy, "use_adaptive_sampling", False)
@@ -377,35 +377,41 @@ class Session:
             self._guides = g
         return self._guides
 
+    def _runs(self, xs, ys, t):
+        """Rectangles over the tiles of side t that hold a pixel: each tile row's runs."""
+        tw, th = -(-self.width // t), -(-self.height // t)
+        occ = np.zeros((th, tw), bool)
+        occ[ys // t, xs // t] = True
+        rects = []
+        for ty in range(th):
+            tx = 0
+            while tx < tw:
+                if not occ[ty, tx]:
+                    tx += 1
+                    continue
+                start = tx
+                while tx < tw and occ[ty, tx]:
+                    tx += 1
+                rects.append((start * t, ty * t, min(tx * t, self.width), min((ty + 1) * t, self.height)))
+        return rects
+
     def rectangles(self, xs, ys):
         """Where to render pixels (xs, ys): a list of (x0, y0, x1, y1), or [None] for
         the whole frame. A masked pixel still costs Cycles a camera ray and a
-        shader per sample (about a tenth of a rendered one), so a round renders
-        only the tiles that hold its pixels, each tile row's runs merged into one
-        render-border rectangle, unless they cover most of the frame."""
-        t = self.args.tile_size
-        while True:
-            tw, th = -(-self.width // t), -(-self.height // t)
-            occ = np.zeros((th, tw), bool)
-            occ[ys // t, xs // t] = True
-            rects = []
-            for ty in range(th):
-                tx = 0
-                while tx < tw:
-                    if not occ[ty, tx]:
-                        tx += 1
-                        continue
-                    start = tx
-                    while tx < tw and occ[ty, tx]:
-                        tx += 1
-                    rects.append((start * t, ty * t, min(tx * t, self.width), min((ty + 1) * t, self.height)))
-            if len(rects) <= self.args.max_calls or t >= max(self.width, self.height):
-                break
-            t *= 2
-        area = sum((x1 - x0) * (y1 - y0) for x0, y0, x1, y1 in rects)
-        if area > self.args.max_border_share * self.width * self.height:
-            return [None]
-        return rects
+        shader per sample (about a seventh of a rendered one), a render call a
+        fixed time: of tiles of 16, 32 or 64 px that hold the pixels (each tile
+        row's runs one render border) and the whole frame, the cheapest."""
+        if self.args.border_tile > 0:
+            return self._runs(xs, ys, self.args.border_tile)
+        masked = 0.14 * self.pixel_seconds()
+        best, best_cost = [None], self.args.call_seconds + self.width * self.height * masked
+        for t in (16, 32, 64):
+            rects = self._runs(xs, ys, t)
+            area = sum((x1 - x0) * (y1 - y0) for x0, y0, x1, y1 in rects)
+            cost = len(rects) * self.args.call_seconds + area * masked
+            if len(rects) <= self.args.max_calls and cost < best_cost:
+                best, best_cost = rects, cost
+        return best
 
     def _set_border(self, rect):
         r = self.scene.render
@@ -451,6 +457,11 @@ class Session:
             raise SceneError("%d pixels fell outside every render border" % int((~done).sum()))
         Lc = L - Li * g["texture"][ys, xs]
         return L, Li, Lc
+
+    def pixel_seconds(self):
+        """What one pixel at full samples costs, from the guides render (its samples
+        are preview_samples; its time includes the scene's first sync: an upper bound)."""
+        return self.render_seconds[0][1] * self.samples / self.preview_samples / (self.width * self.height)
 
     def round_cost(self):
         """(seconds per render call, seconds per exact pixel), from the guides render: a
