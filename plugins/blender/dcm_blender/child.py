@@ -11,7 +11,6 @@ stderr, which keeps everything after start-up clean."""
 import argparse
 import os
 import shutil
-import struct
 import sys
 import tempfile
 import time

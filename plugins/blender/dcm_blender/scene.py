@@ -232,8 +232,8 @@ class Session:
     def _give_material(self, ob, mat):
         if ob.material_slots:
             slot = ob.material_slots[0]
-            old_link, old_mat = slot.link, slot.material
-            self.changes.on_restore(lambda: (setattr(slot, "material", old_mat)))
+            old_mat = slot.material
+            self.changes.on_restore(lambda: setattr(slot, "material", old_mat))
             slot.material = mat
         else:
             data = ob.data
@@ -345,7 +345,6 @@ class Session:
         os.remove(path)
         self.render_seconds.append((label, time.monotonic() - t0))
         if self.args.keep_renders:
-            import shutil
             os.makedirs(self.args.keep_renders, exist_ok=True)
             dst = os.path.join(self.args.keep_renders, "%02d_%s.npz" % (self._round, label))
             np.savez(dst, **{k.split(".", 1)[-1]: v for k, v in planes.items()})
