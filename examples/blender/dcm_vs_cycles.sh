@@ -7,7 +7,8 @@
 #   examples/blender/dcm_vs_cycles.sh OUT_DIR [RES=256] [SPP=512] [REF_SPP=2048] [VIEW=a]
 #
 # DCM_VARIANTS="FLAGS|FLAGS|..." runs dcm blender once per set of flags after
-# the one full render. Prints one line per render and leaves in OUT_DIR:
+# the one full render; ADAPTIVE="0.01 0.03" renders with Cycles' adaptive
+# sampling at those noise thresholds (same samples at most) for comparison. Prints one line per render and leaves in OUT_DIR:
 # room.blend, full.exr, dcmN.exr, dcmN.json, ref.exr, times.txt.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/../.." && pwd)
@@ -19,11 +20,13 @@ cd "$out"
 # The scene (examples/blender/make_and_render.py), saved after a 1-spp render.
 [ -f room.blend ] || blender -b --factory-startup --python "$here/examples/blender/make_and_render.py" -- \
     --out room_1spp.exr --view "$view" --res "$res" --samples 1 --save-blend room.blend >/dev/null
-render() {  # render SAMPLES OUT: the file as it is at SAMPLES, Combined in a multilayer EXR
+render() {  # render SAMPLES OUT [NOISE_THRESHOLD]: the file at SAMPLES (adaptive sampling at the threshold)
   blender -b room.blend --python-expr "
 import bpy
 sc = bpy.context.scene
 sc.cycles.samples = $1
+sc.cycles.use_adaptive_sampling = $([ -n "${3:-}" ] && echo True || echo False)
+sc.cycles.adaptive_threshold = ${3:-0.01}
 im = sc.render.image_settings
 im.file_format = 'OPEN_EXR_MULTILAYER'; im.color_depth = '32'
 sc.render.use_file_extension = False
@@ -44,8 +47,14 @@ for i in "${!variants[@]}"; do
   dcm_s+=("$(echo "$t2 - $t1" | bc -l)")
   printf "dcm %s: %.2f s\n" "${variants[$i]}" "${dcm_s[$i]}" >> times.txt
 done
+# ADAPTIVE="T1 T2 ...": Cycles' adaptive sampling at these noise thresholds, the rival at equal time.
+adaptive_s=()
+for t in ${ADAPTIVE:-}; do
+  t1=$(now); render "$spp" "adaptive_$t.exr" "$t"; t2=$(now)
+  adaptive_s+=("$t:$(echo "$t2 - $t1" | bc -l)")
+done
 [ -f ref.exr ] || render "$ref_spp" ref.exr
-/usr/bin/python3 - "$full_s" "${DCM_VARIANTS:- }" "${dcm_s[@]}" <<'PY'
+/usr/bin/python3 - "$full_s" "${DCM_VARIANTS:- }" "${adaptive_s[*]:-}" "${dcm_s[@]}" <<'PY'
 import json, sys
 import numpy as np
 import OpenImageIO as oiio
@@ -64,7 +73,11 @@ def psnr(a, b):  # on sRGB-encoded values clipped to [0, 1], as docs/AOV.md
 ref, full = load("ref.exr"), load("full.exr")
 full_s = float(sys.argv[1])
 print("full Cycles          %7.2f s           PSNR %.2f dB vs the converged render" % (full_s, psnr(full, ref)))
-for i, (flags, s) in enumerate(zip(sys.argv[2].split("|"), sys.argv[3:])):
+for item in sys.argv[3].split():
+    t, s = item.split(":")
+    print("adaptive %-6s       %7.2f s (%.2fx)  PSNR %.2f dB vs the converged render"
+          % (t, float(s), full_s / float(s), psnr(load("adaptive_%s.exr" % t), ref)))
+for i, (flags, s) in enumerate(zip(sys.argv[2].split("|"), sys.argv[4:])):
     dcm, j = load("dcm%d.exr" % i), json.load(open("dcm%d.json" % i))
     b, s = j["blender"], float(s)
     print("dcm blender %-20s %7.2f s (%.2fx)  PSNR %.2f dB (%.2f dB vs full); %.2f %% exact, %d calls %s; "
