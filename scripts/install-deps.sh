@@ -22,6 +22,8 @@ packages=(
   slurm-wlm munge
   # tests/povray: POV-Ray 3.7 driven for real (examples/povray)
   povray
+  # tests/blender: pgrep checks that no Blender outlives `dcm blender`
+  procps
   # helper scripts (plots, checks): Debian's python, not the one first on PATH
   # (tools/bench/error_strip.py imports PIL itself)
   python3-numpy python3-matplotlib python3-openimageio python3-pil
@@ -32,7 +34,7 @@ packages=(
 )
 for arg in "$@"; do
   case "$arg" in
-    --with-renderers) packages+=(blender) ;;                   # examples/blender
+    --with-renderers) packages+=(blender) ;;                   # examples/blender, tests/blender
     --with-fuzz) packages+=(clang-14 libclang-rt-14-dev) ;;    # scripts/fuzz.sh (libFuzzer)
     *) echo "install-deps: unknown option $arg" >&2; exit 2 ;;
   esac

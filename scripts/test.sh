@@ -6,7 +6,8 @@
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 build=${DCM_BUILD_DIR:-$here/build}
-"$here/scripts/install-deps.sh"
+# --with-renderers: Blender for tests/blender (POV-Ray is in the base list).
+"$here/scripts/install-deps.sh" --with-renderers
 cmake -S "$here" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$build" -j2
 (cd "$build" && ctest --output-on-failure -j2 --timeout 600)

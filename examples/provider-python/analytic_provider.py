@@ -82,8 +82,9 @@ class AnalyticScene:
 class Provider:
     """Serves a scene over the dcm-pipe protocol."""
 
-    def __init__(self, scene, name="analytic-python", noise=0.0, normals=False):
+    def __init__(self, scene, name="analytic-python", noise=0.0, normals=False, round_latency=0.0):
         self.scene = scene
+        self.round_latency = round_latency
         self.name = name
         self.noise = noise
         self.normals = normals
@@ -108,8 +109,12 @@ class Provider:
     def handshake_line(self):
         caps = ("object_id,shader_id,texture,split" + (",normal" if self.normals else "") +
                 (",variance" if self.noise > 0 else ""))
-        return "dcm-pipe %d width=%d height=%d caps=%s name=%s\n" % (
-            PROTOCOL_VERSION, self.scene.width, self.scene.height, caps, self.name)
+        cost = ""
+        if self.round_latency > 0:
+            caps += ",preview"
+            cost = " round_latency=%g sample_cost=1e-6" % self.round_latency
+        return "dcm-pipe %d width=%d height=%d caps=%s name=%s%s\n" % (
+            PROTOCOL_VERSION, self.scene.width, self.scene.height, caps, self.name, cost)
 
     def answer_guides(self, tokens, out):
         x0, y0, x1, y1 = (int(t) for t in tokens[1:5])
@@ -159,6 +164,17 @@ class Provider:
         self.evaluated += n
         self.batches += 1
 
+    def answer_preview(self, tokens, out):
+        """A half-resolution preview: each pixel gets its 2x2 block's top-left value."""
+        x0, y0, x1, y1 = (int(t) for t in tokens[1:5])
+        if not (0 <= x0 < x1 <= self.scene.width and 0 <= y0 < y1 <= self.scene.height):
+            raise ProtocolError("preview region outside the image")
+        split = len(tokens) > 5 and "split" in tokens[5].split(",")
+        ys, xs = np.mgrid[y0:y1, x0:x1]
+        L, li, lc = self.scene.radiance(xs.ravel() & ~1, ys.ravel() & ~1)
+        out.write(b"samples %d\n" % xs.size)
+        out.write(np.hstack([L] + ([li, lc] if split else [])).astype("<f4").tobytes())
+
     def serve(self, inp, out):
         """Answers requests until 'quit' or end of input; returns the exit status."""
         hello = self.read_line(inp)
@@ -177,6 +193,8 @@ class Provider:
                     self.answer_guides(tokens, out)
                 elif tokens[0] == "eval" and len(tokens) >= 2:
                     self.answer_eval(tokens, inp, out)
+                elif tokens[0] == "preview" and len(tokens) >= 5 and self.round_latency > 0:
+                    self.answer_preview(tokens, out)
                 else:
                     raise ProtocolError("unknown request %r" % line[:60])
             except (ProtocolError, ValueError) as e:
@@ -195,6 +213,8 @@ def main(argv=None):
                     help="Gaussian noise of this sd on L_i, announced with its variance (a Monte Carlo renderer); "
                          "--truth stays noise-free")
     ap.add_argument("--normals", action="store_true", help="announce and serve normal guides")
+    ap.add_argument("--round-latency", type=float, default=0.0,
+                    help="announce this latency per round (seconds) and serve a half-resolution preview")
     ap.add_argument("--count-file", help="at the end, write the number of evaluated pixels to this file")
     args = ap.parse_args(argv)
     scene = AnalyticScene(args.width, args.height)
@@ -203,7 +223,7 @@ def main(argv=None):
         L, _, _ = scene.radiance(xs.ravel(), ys.ravel())
         L.astype("<f4").tofile(args.truth)
         return 0
-    provider = Provider(scene, noise=args.noise, normals=args.normals)
+    provider = Provider(scene, noise=args.noise, normals=args.normals, round_latency=args.round_latency)
     status = provider.serve(sys.stdin.buffer, sys.stdout.buffer)
     sys.stderr.write("analytic_provider: evaluated %d pixels in %d batches\n" % (provider.evaluated, provider.batches))
     if args.count_file:

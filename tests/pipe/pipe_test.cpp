@@ -18,6 +18,7 @@
 #include "common/image_io.h"
 #include "dcm/pipe/pipe_provider.h"
 #include "dcm/reconstructor.h"
+#include "dcm/round_schedule.h"
 
 namespace fs = std::filesystem;
 
@@ -157,6 +158,62 @@ TEST(PipeProvider, UnknownHandshakeKeysAndCapabilitiesAreIgnored) {
   EXPECT_TRUE(p->Capabilities().objectId);
   EXPECT_FALSE(p->Capabilities().texture);
   EXPECT_EQ(p->Capabilities().name, "pipe");
+  EXPECT_TRUE(p->Finish().ok());
+}
+
+TEST(PipeProvider, HandshakeCarriesTheRoundCostAndThePreview) {
+  std::unique_ptr<dcm::pipe::PipeProvider> p;
+  ASSERT_TRUE(Start("printf 'dcm-pipe 1 width=4 height=3 caps=preview round_latency=0.25 sample_cost=2e-4\\n'; "
+                    "cat >/dev/null",
+                    &p)
+                  .ok());
+  EXPECT_TRUE(p->hasPreview());
+  EXPECT_DOUBLE_EQ(p->roundCost().latencyS, 0.25);
+  EXPECT_DOUBLE_EQ(p->roundCost().perSampleS, 2e-4);
+  EXPECT_EQ(dcm::ChooseSchedule(p->roundCost()), dcm::RoundSchedule::kPreview);
+  EXPECT_TRUE(p->Finish().ok());
+  // A provider that says nothing costs nothing and has no preview: the levels schedule.
+  ASSERT_TRUE(Start("printf 'dcm-pipe 1 width=4 height=3\\n'; cat >/dev/null", &p).ok());
+  EXPECT_FALSE(p->hasPreview());
+  EXPECT_EQ(p->roundCost().latencyS, 0);
+  EXPECT_EQ(dcm::ChooseSchedule(p->roundCost()), dcm::RoundSchedule::kLevels);
+  std::vector<dcm::ExactSample> s;
+  EXPECT_FALSE(p->Preview({{0, 0}, {4, 3}}, {}, &s).ok());
+  EXPECT_TRUE(p->Finish().ok());
+  for (const char* bad : {"round_latency=-1", "round_latency=abc", "sample_cost=nan", "round_latency=1e9"}) {
+    const dcm::Status st =
+        Start(std::string("printf 'dcm-pipe 1 width=4 height=3 ") + bad + "\\n'; cat >/dev/null", &p);
+    ASSERT_FALSE(st.ok()) << bad;
+    EXPECT_TRUE(Contains(st.message(), "must be seconds")) << st.message();
+  }
+}
+
+TEST(PipeProvider, PreviewPlannedRoundsAreOneEvalEach) {
+  // A provider whose rounds cost a latency: the engine plans on its
+  // half-resolution preview and asks for each round's pixels in one request.
+  std::unique_ptr<dcm::pipe::PipeProvider> p;
+  ASSERT_TRUE(Start(Analytic("--width 96 --height 72 --round-latency 0.5"), &p).ok());
+  ASSERT_TRUE(p->hasPreview());
+  ASSERT_EQ(dcm::ChooseSchedule(p->roundCost()), dcm::RoundSchedule::kPreview);
+  std::unique_ptr<dcm::SampleProvider> preview;
+  ASSERT_TRUE(p->FetchPreview({true, false}, &preview).ok());
+  std::vector<dcm::ExactSample> one(1);
+  const dcm::Point2i odd{5, 7};
+  ASSERT_TRUE(preview->Evaluate({&odd, 1}, {false, false}, one).ok());
+  std::vector<dcm::ExactSample> s;
+  ASSERT_TRUE(p->Preview({{4, 6}, {5, 7}}, {}, &s).ok());  // (5, 7) shows its block's corner (4, 6)
+  EXPECT_EQ(one[0].L.r, s[0].L.r);
+  dcm::ReconstructionOptions o;
+  dcm::PreviewScheduleOptions sched;
+  sched.maxRounds = 3;
+  dcm::Reconstruction r;
+  dcm::PreviewScheduleStats ss;
+  ASSERT_TRUE(dcm::ReconstructWithPreview(*p, *preview, o, sched, &r, &ss).ok());
+  EXPECT_GE(ss.rounds, 1);
+  EXPECT_LE(ss.rounds, 3);
+  EXPECT_EQ(p->evalRequests(), ss.rounds);  // one request per round, whatever its size
+  EXPECT_GT(ss.pixelsPerRound[0], 4096 / 8);
+  EXPECT_LT(r.stats.exactFraction(), 0.6);
   EXPECT_TRUE(p->Finish().ok());
 }
 

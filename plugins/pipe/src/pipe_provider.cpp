@@ -47,6 +47,13 @@ bool ParseInt(const std::string& s, int64_t* v) {
   return ec == std::errc() && p == end;
 }
 
+/// A duration in seconds: finite, from 0 to a day (a round costs less).
+bool ParseSeconds(const std::string& s, double* v) {
+  const char* end = s.data() + s.size();
+  auto [p, ec] = std::from_chars(s.data(), end, *v);
+  return ec == std::errc() && p == end && std::isfinite(*v) && *v >= 0 && *v <= 86400;
+}
+
 /// A line of the child quoted for a message: printable ASCII, at most 60 characters.
 std::string Quote(const std::string& line) {
   std::string q;
@@ -193,6 +200,7 @@ Status PipeProvider::Handshake() {
     const size_t eq = t[i].find('=');
     if (eq == std::string::npos) return Fail("handshake: expected key=value, got " + Quote(t[i]));
     const std::string key = t[i].substr(0, eq), value = t[i].substr(eq + 1);
+    keys_[key] = value;
     int64_t v = 0;
     if (key == "width" || key == "height") {
       if (!ParseInt(value, &v) || v < 1 || v > kMaxSide)
@@ -208,10 +216,16 @@ Status PipeProvider::Handshake() {
         else if (c == "split") caps_.splitRadiance = true;
         else if (c == "variance") caps_.variance = true;
         else if (c == "hard_shadows_guided") caps_.hardShadowsGuided = true;
+        else if (c == "preview") preview_ = true;
         // Unknown capabilities are ignored (newer providers).
       }
     } else if (key == "name") {
       caps_.name = value;
+    } else if (key == "round_latency" || key == "sample_cost") {
+      double seconds = 0;
+      if (!ParseSeconds(value, &seconds))
+        return Fail("handshake: " + key + " must be seconds from 0 to 86400, got " + Quote(value));
+      (key == "round_latency" ? cost_.latencyS : cost_.perSampleS) = seconds;
     }
     // Unknown keys are ignored (newer providers).
   }
@@ -316,6 +330,12 @@ Status PipeProvider::Evaluate(std::span<const Point2i> pixels, const SampleReque
     xy[2 * i + 1] = pixels[i].y;
   }
   std::memcpy(message.data() + request.size() + 1, xy.data(), n * 8);
+  ++evalRequests_;
+  return ReadSamples(request, message, n, split, variance, out.data());
+}
+
+Status PipeProvider::ReadSamples(const std::string& request, const std::vector<char>& message, size_t n, bool split,
+                                 bool variance, ExactSample* out) {
   const auto deadline =
       Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.timeoutSeconds));
   Status written = child_->Write(message.data(), message.size(), deadline);
@@ -347,6 +367,24 @@ Status PipeProvider::Evaluate(std::span<const Point2i> pixels, const SampleReque
     }
   }
   return Status::Ok();
+}
+
+Status PipeProvider::Preview(const Bounds2i& region, const SampleRequest& what, std::vector<ExactSample>* out) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!broken_.ok()) return broken_;
+  if (finished_) return Status::Error(Prefix() + ": preview requested after Finish()");
+  if (!preview_) return Status::Error(Prefix() + ": the provider serves no preview (capability 'preview')");
+  const Bounds2i all{{0, 0}, {caps_.width, caps_.height}};
+  if (region.empty() || Intersect(region, all) != region)
+    return Status::Error(Prefix() + ": preview region outside the image");
+  const bool split = what.split && caps_.splitRadiance;
+  const std::string request = "preview " + std::to_string(region.min.x) + " " + std::to_string(region.min.y) + " " +
+                              std::to_string(region.max.x) + " " + std::to_string(region.max.y) + " L" +
+                              (split ? ",split" : "");
+  const std::string line = request + "\n";
+  const size_t n = size_t(region.area());
+  out->assign(n, ExactSample{});
+  return ReadSamples(request, std::vector<char>(line.begin(), line.end()), n, split, false, out->data());
 }
 
 Status PipeProvider::Finish() {

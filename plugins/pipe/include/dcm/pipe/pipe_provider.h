@@ -2,11 +2,13 @@
 // its stdin/stdout with the dcm-pipe protocol (plugins/pipe/PROTOCOL.md).
 #pragma once
 
+#include <map>
 #include <memory>
 #include <mutex>
 #include <span>
 #include <string>
 
+#include "dcm/round_schedule.h"
 #include "dcm/sample_provider.h"
 #include "dcm/status.h"
 
@@ -61,14 +63,37 @@ class PipeProvider final : public SampleProvider {
   /// Asks the child for the guides of `region` ("guides" request).
   Status Guides(const Bounds2i& region, const GuideRequest& what, GuideImage* out) override;
 
-  /// Asks the child to evaluate `pixels` ("eval" request).
+  /// Asks the child to evaluate `pixels` ("eval" request): one request
+  /// whatever their number (a round of RoundSchedule::kPreview is one call).
   Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what,
                   std::span<ExactSample> out) override;
+
+  /// What a round costs, as the child announced it (round_latency=,
+  /// sample_cost=; zero when it did not).
+  const RoundCost& roundCost() const { return cost_; }
+
+  /// Whether the child serves cheap preview samples (capability `preview`).
+  bool hasPreview() const { return preview_; }
+
+  /// Asks the child for the preview samples of every pixel of `region`
+  /// ("preview" request), row-major. Only when hasPreview().
+  Status Preview(const Bounds2i& region, const SampleRequest& what, std::vector<ExactSample>* out);
+
+  /// The child's preview of the whole image, fetched in one request, as a
+  /// provider of stand-in samples for ReconstructWithPreview().
+  Status FetchPreview(const SampleRequest& what, std::unique_ptr<SampleProvider>* out);
 
   /// Sends "quit", closes the child's stdin and waits for it to exit. An exit
   /// status other than 0 (or a signal) is an error. Idempotent: returns the
   /// first outcome again.
   Status Finish();
+
+  /// Every key=value of the child's handshake, the ones dcm does not use too
+  /// (what a particular provider adds for its own command).
+  const std::map<std::string, std::string>& handshakeKeys() const { return keys_; }
+
+  /// "eval" requests sent so far (rounds of exact samples).
+  int64_t evalRequests() const { return evalRequests_; }
 
   /// The protocol version the child announced.
   int childProtocolVersion() const { return childVersion_; }
@@ -83,7 +108,16 @@ class PipeProvider final : public SampleProvider {
 
   PipeOptions options_;
   std::unique_ptr<ChildProcess> child_;
+  /// Sends `request` with `payload`, reads the answer 'samples N' and its
+  /// records of the parts of `split`/`variance` into `out` (n of them).
+  Status ReadSamples(const std::string& request, const std::vector<char>& message, size_t n, bool split,
+                     bool variance, ExactSample* out);
+
   ProviderCapabilities caps_;
+  RoundCost cost_;
+  std::map<std::string, std::string> keys_;
+  bool preview_ = false;
+  int64_t evalRequests_ = 0;
   int childVersion_ = 0;
   std::mutex mutex_;
   Status broken_;  ///< the first failure; OK while healthy

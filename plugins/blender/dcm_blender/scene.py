@@ -1,0 +1,503 @@
+"""The loaded scene as dcm's sample provider: renders the guides and preview
+once, and any set of pixels at full quality in one Cycles render call.
+
+How Cycles renders only some pixels: before every Material Output the surface
+is mixed with a zero-strength Emission, Fac = 1 - IsCameraRay * (1 - mask),
+where mask is an Image Texture in Window coordinates (Closest, Extend) that is
+1 on the pixels asked for. Only camera rays see the mask, so indirect light is
+the full render's. The mask has `mask_scale` texels per pixel and side and
+covers, around each pixel asked for, the footprint of the pixel filter (where
+the pixel's camera rays leave). With persistent data a mask changed in memory,
+or saved and reloaded under the same name, does not reach the next render; a
+new file per render does.
+
+Every change to the scene (settings, nodes, materials) is recorded and undone
+by restore(), also after an error; the .blend on disk is never written."""
+import os
+
+import bpy
+import numpy as np
+
+from . import exr
+
+
+class SceneError(Exception):
+    """A scene dcm cannot render, with the reason for the user."""
+
+
+class Changes:
+    """Attribute changes and created data, undone in reverse order."""
+
+    def __init__(self):
+        self._undo = []
+
+    def set(self, obj, attr, value):
+        old = getattr(obj, attr)
+        if old != value:
+            self._undo.append(lambda: setattr(obj, attr, old))
+            setattr(obj, attr, value)
+
+    def on_restore(self, fn):
+        self._undo.append(fn)
+
+    def restore_later(self, obj, attrs):
+        """Restores `attrs` of `obj` to their present values, in this order."""
+        saved = [(a, getattr(obj, a)) for a in attrs]
+        self._undo.append(lambda: [setattr(obj, a, v) for a, v in saved])
+
+    def restore(self):
+        errors = []
+        while self._undo:
+            fn = self._undo.pop()
+            try:
+                fn()
+            except Exception as e:  # keep undoing the rest
+                errors.append(str(e))
+        return errors
+
+
+def _write_png(path, grey):
+    """An 8-bit greyscale PNG of `grey` [rows top-down, columns]."""
+    import struct
+    import zlib
+
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+    h, w = grey.shape
+    rows = np.zeros((h, w + 1), np.uint8)  # filter byte 0 per row
+    rows[:, 1:] = grey
+    with open(path, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 0, 0, 0, 0))
+                + chunk(b"IDAT", zlib.compress(rows.tobytes(), 1)) + chunk(b"IEND", b""))
+
+
+def _log(msg):
+    print("dcm-blender: " + msg, file=os.sys.stderr, flush=True)
+
+
+class Session:
+    def __init__(self, args, workdir):
+        self.args = args
+        self.workdir = workdir
+        self.changes = Changes()
+        self.scene = bpy.context.scene
+        self.notes = []
+        self._guides = None   # planes of the guides/preview render
+        self._mask_image = None
+        self._round = 0
+        self.render_seconds = []
+
+    # ------------------------------------------------------------- setup --
+    def setup(self):
+        sc, c, a = self.scene, self.changes, self.args
+        if a.frame is not None:
+            old = sc.frame_current
+            self.changes.on_restore(lambda: sc.frame_set(old))
+            sc.frame_set(a.frame)
+        if sc.render.engine != "CYCLES":
+            raise SceneError("the scene renders with %s; dcm blender renders with Cycles only "
+                             "(Render Properties > Render Engine)" % sc.render.engine)
+        if sc.camera is None:
+            raise SceneError("the scene has no camera")
+        cam = sc.camera.data
+        if getattr(cam, "type", "PERSP") == "PANO":
+            raise SceneError("panoramic cameras are not supported (the pixel mask follows a flat image)")
+        if cam.dof.use_dof:
+            raise SceneError("depth of field is on (Camera > Depth of Field): a pixel's rays then "
+                             "leave from the whole lens and the pixel mask cannot follow them")
+        if sc.render.use_motion_blur:
+            raise SceneError("motion blur is on (Render Properties > Motion Blur): a pixel's rays "
+                             "then see moving surfaces the pixel mask cannot follow")
+        r = sc.render
+        self.width = r.resolution_x * r.resolution_percentage // 100
+        self.height = r.resolution_y * r.resolution_percentage // 100
+        if self.width < 1 or self.height < 1:
+            raise SceneError("empty resolution %dx%d" % (self.width, self.height))
+        if r.use_border:
+            self.notes.append("the render region (border) is ignored: dcm renders the whole frame")
+        # Rounds render within borders of their own (rectangles()): the user's come back.
+        c.restore_later(r, ("use_border", "use_crop_to_border", "border_min_x", "border_max_x", "border_min_y",
+                            "border_max_y"))
+        r.use_border, r.use_crop_to_border = False, False
+
+        # The view layer: the named one, else the first that renders; the others are off.
+        layers = [vl for vl in sc.view_layers if vl.use]
+        if a.view_layer:
+            layers = [vl for vl in sc.view_layers if vl.name == a.view_layer]
+            if not layers:
+                raise SceneError("no view layer '%s' (the scene has: %s)"
+                                 % (a.view_layer, ", ".join(vl.name for vl in sc.view_layers)))
+        if not layers:
+            raise SceneError("no view layer renders (View Layer > Use for Rendering)")
+        self.layer = layers[0]
+        if len([vl for vl in sc.view_layers if vl.use]) > 1 and not a.view_layer:
+            self.notes.append("several view layers render; dcm renders '%s' (--view-layer NAME)"
+                              % self.layer.name)
+        for vl in sc.view_layers:
+            c.set(vl, "use", vl == self.layer)
+        vl = self.layer
+        for attr in ("use_pass_combined", "use_pass_diffuse_color", "use_pass_diffuse_direct",
+                     "use_pass_diffuse_indirect", "use_pass_normal", "use_pass_cryptomatte_object",
+                     "use_pass_cryptomatte_material"):
+            c.set(vl, attr, True)
+        c.set(vl, "pass_cryptomatte_depth", 2)
+
+        cy = sc.cycles
+        self.samples = a.samples if a.samples > 0 else cy.samples
+        self.preview_samples = min(self.samples, a.preview_samples or max(4, self.samples // 16))
+        if cy.use_adaptive_sampling:
+            self.notes.append("adaptive sampling off: every pixel gets %d samples" % self.samples)
+            c.set(cy, "use_adaptive_sampling", False)
+        if cy.use_denoising:
+            self.notes.append("denoising off (it would see a frame of black, unrendered pixels)")
+            c.set(cy, "use_denoising", False)
+        c.set(cy, "samples", self.samples)
+        if a.threads > 0:
+            c.set(r, "threads_mode", "FIXED")
+            c.set(r, "threads", a.threads)
+        c.set(r, "use_persistent_data", True)  # the BVH and shaders are built once
+        c.set(r, "use_compositing", False)     # the passes as Cycles renders them
+        c.set(r, "use_sequencer", False)
+        c.set(r, "use_file_extension", False)
+        c.set(r, "filepath", os.path.join(self.workdir, "render.exr"))
+        # The depth a format allows depends on the format: restore all three at once, format first.
+        im = r.image_settings
+        c.restore_later(im, ("file_format", "color_depth", "exr_codec"))
+        im.file_format, im.color_depth, im.exr_codec = "OPEN_EXR_MULTILAYER", "32", "NONE"
+        # How far from its centre a pixel's camera rays leave: Box, the pixel; Gaussian, half
+        # the filter width; Blackman-Harris, the width (Cycles doubles its support).
+        self.filter_radius = {"BOX": 0.5, "GAUSSIAN": max(0.5, cy.filter_width / 2)}.get(
+            cy.pixel_filter_type, max(0.5, cy.filter_width))
+        if self.filter_radius > 0.5:
+            self.notes.append("pixel filter %s %.2f px: the mask around each exact pixel spans %.1f px, where its "
+                              "rays leave (a Gaussian of 0.01 px renders the fewest pixels; docs/BLENDER.md)"
+                              % (cy.pixel_filter_type.replace("_", "-").title(), cy.filter_width,
+                                 2 * self.filter_radius))
+        self._insert_masks()
+
+    # -------------------------------------------------------- the masks --
+    def _insert_masks(self):
+        k = self.args.mask_scale
+        self._write_mask(np.ones((self.height * k, self.width * k), np.float32))
+        img = bpy.data.images.load(self.mask_path)
+        self.changes.on_restore(lambda: bpy.data.images.remove(img))
+        img.colorspace_settings.name = "Non-Color"
+        self._mask_image = img
+
+        # Objects that render without a material of nodes get a stand-in that
+        # renders the same: Cycles' default surface, or the material's colour.
+        default = None
+        for m in list(bpy.data.materials):
+            if m.use_nodes or m.users == 0:
+                continue
+            self._nodes_for_plain(m)
+        for ob in self.scene.objects:
+            if ob.type not in {"MESH", "CURVE", "SURFACE", "META", "FONT"} or ob.hide_render:
+                continue
+            if any(s.material for s in ob.material_slots):
+                continue
+            if default is None:
+                default = bpy.data.materials.new("dcm_default_surface")
+                self.changes.on_restore(lambda m=default: bpy.data.materials.remove(m))
+                self._nodes_for_plain(default, colour=(0.8, 0.8, 0.8, 1.0), created=True)
+            self._give_material(ob, default)
+        for m in bpy.data.materials:
+            if m.use_nodes and m.node_tree and m.users:
+                self._mask_tree(m.node_tree)
+
+    def _nodes_for_plain(self, m, colour=None, created=False):
+        """Cycles renders a material without nodes as a Diffuse BSDF of its colour."""
+        colour = tuple(m.diffuse_color) if colour is None else colour
+        had_tree = m.node_tree is not None
+        if not created:
+            self.changes.set(m, "use_nodes", True)
+        else:
+            m.use_nodes = True
+        nt = m.node_tree
+        if not had_tree and not created:
+            # use_nodes made a default tree; Blender keeps it, so empty it again on restore.
+            self.changes.on_restore(lambda: [nt.nodes.remove(n) for n in list(nt.nodes)])
+        saved = [n for n in nt.nodes]
+        for n in saved:  # outputs of the user's (unused) tree must not win
+            if n.bl_idname == "ShaderNodeOutputMaterial":
+                self.changes.set(n, "is_active_output", False)
+        diffuse = nt.nodes.new("ShaderNodeBsdfDiffuse")
+        diffuse.inputs["Color"].default_value = colour
+        out = nt.nodes.new("ShaderNodeOutputMaterial")
+        out.target = "ALL"
+        nt.links.new(diffuse.outputs["BSDF"], out.inputs["Surface"])
+        out.is_active_output = True
+        self.changes.on_restore(lambda: (nt.nodes.remove(out), nt.nodes.remove(diffuse)))
+
+    def _give_material(self, ob, mat):
+        if ob.material_slots:
+            slot = ob.material_slots[0]
+            old_mat = slot.material
+            self.changes.on_restore(lambda: setattr(slot, "material", old_mat))
+            slot.material = mat
+        else:
+            data = ob.data
+            data.materials.append(mat)
+            self.changes.on_restore(lambda: data.materials.clear())  # it had none
+
+    def _mask_tree(self, nt):
+        for out in [n for n in nt.nodes if n.bl_idname == "ShaderNodeOutputMaterial"]:
+            if out.target not in {"ALL", "CYCLES"}:
+                continue
+            surf = out.inputs["Surface"]
+            if not surf.is_linked:
+                continue  # renders black in any case
+            src = surf.links[0].from_socket
+            made = []
+
+            def new(kind):
+                n = nt.nodes.new(kind)
+                made.append(n)
+                return n
+            coord = new("ShaderNodeTexCoord")
+            tex = new("ShaderNodeTexImage")
+            tex.image = self._mask_image
+            tex.interpolation = "Closest"
+            tex.extension = "EXTEND"  # rays of border pixels leave the frame: the edge texel
+            nt.links.new(coord.outputs["Window"], tex.inputs["Vector"])
+            path = new("ShaderNodeLightPath")
+            inv = new("ShaderNodeMath")
+            inv.operation = "SUBTRACT"
+            inv.inputs[0].default_value = 1.0
+            nt.links.new(tex.outputs["Color"], inv.inputs[1])
+            mul = new("ShaderNodeMath")
+            mul.operation = "MULTIPLY"
+            nt.links.new(path.outputs["Is Camera Ray"], mul.inputs[0])
+            nt.links.new(inv.outputs[0], mul.inputs[1])
+            fac = new("ShaderNodeMath")
+            fac.operation = "SUBTRACT"
+            fac.inputs[0].default_value = 1.0
+            nt.links.new(mul.outputs[0], fac.inputs[1])
+            emit = new("ShaderNodeEmission")
+            emit.inputs["Strength"].default_value = 0.0
+            mix = new("ShaderNodeMixShader")
+            nt.links.new(fac.outputs[0], mix.inputs["Fac"])
+            nt.links.new(emit.outputs["Emission"], mix.inputs[1])
+            nt.links.new(src, mix.inputs[2])
+            nt.links.new(mix.outputs["Shader"], surf)
+
+            def undo(nt=nt, made=made, src=src, surf=surf):
+                for n in made:
+                    nt.nodes.remove(n)
+                nt.links.new(src, surf)
+            self.changes.on_restore(undo)
+
+    def _write_mask(self, texels):
+        """texels: [rows top-down, columns] of 0/1. Written to its file and reloaded:
+        with persistent data Cycles sees a mask changed in memory only that way."""
+        self._mask_count = getattr(self, "_mask_count", 0) + 1
+        self.mask_path = os.path.join(self.workdir, "mask%d.png" % self._mask_count)
+        _write_png(self.mask_path, (texels > 0).astype(np.uint8) * 255)
+        if self._mask_image is not None:
+            self._mask_image.filepath = self.mask_path
+            self._mask_image.reload()
+
+    def _footprint(self):
+        """Texel offsets (lo, hi) from a pixel's first texel that its camera rays may reach."""
+        k = self.args.mask_scale
+        r = self.filter_radius + 1e-3
+        return int(np.floor((0.5 - r) * k)), int(np.ceil((0.5 + r) * k))
+
+    def mask_of(self, xs, ys):
+        """The mask texels for pixels (xs, ys): the filter footprint of each."""
+        k = self.args.mask_scale
+        lo, hi = self._footprint()
+        texels = np.zeros((self.height * k, self.width * k), np.float32)
+        for dy in range(lo, hi):
+            ty = np.clip(ys * k + dy, 0, self.height * k - 1)
+            for dx in range(lo, hi):
+                tx = np.clip(xs * k + dx, 0, self.width * k - 1)
+                texels[ty, tx] = 1.0
+        return texels
+
+    def reached(self, texels):
+        """[height, width]: whether any camera ray of the pixel can meet a mask texel of 1."""
+        k = self.args.mask_scale
+        lo, hi = self._footprint()
+        ys, xs = np.mgrid[0:self.height, 0:self.width]
+        out = np.zeros((self.height, self.width), bool)
+        for dy in range(lo, hi):
+            ty = np.clip(ys * k + dy, 0, self.height * k - 1)
+            for dx in range(lo, hi):
+                out |= texels[ty, np.clip(xs * k + dx, 0, self.width * k - 1)] > 0
+        return out
+
+    # ----------------------------------------------------------- renders --
+    def _render(self, samples, label):
+        import time
+        sc = self.scene
+        self._round += 1
+        path = sc.render.filepath
+        sc.cycles.samples = samples
+        # A changed sample count alone does not reach a persistent Cycles session;
+        # a change to the render settings (the same path) makes it look again.
+        sc.render.filepath = path
+        t0 = time.monotonic()
+        result = bpy.ops.render.render(write_still=True, scene=sc.name, layer=self.layer.name)
+        if "FINISHED" not in result or not os.path.exists(path):
+            raise SceneError("Cycles did not render (%s)" % label)
+        w, h, planes, meta = exr.read(path)
+        os.remove(path)
+        self.render_seconds.append((label, time.monotonic() - t0))
+        if self.args.keep_renders:
+            os.makedirs(self.args.keep_renders, exist_ok=True)
+            dst = os.path.join(self.args.keep_renders, "%02d_%s.npz" % (self._round, label))
+            np.savez(dst, **{k.split(".", 1)[-1]: v for k, v in planes.items()})
+        if (w, h) != (self.width, self.height):
+            raise SceneError("Cycles rendered %dx%d, expected %dx%d" % (w, h, self.width, self.height))
+        done = meta.get("cycles.%s.samples" % self.layer.name)
+        if done is not None and done != str(samples):
+            raise SceneError("Cycles rendered %s samples per pixel, asked for %d (%s)" % (done, samples, label))
+        p = self.layer.name + "."
+        return {k[len(p):]: v for k, v in planes.items() if k.startswith(p)}
+
+    def _rgb(self, planes, name, comps="RGB"):
+        return np.stack([planes[name + "." + c] for c in comps], axis=-1)
+
+    def guides(self):
+        """The guides and the preview: one unmasked render at the preview's samples."""
+        if self._guides is None:
+            self._write_mask(np.ones((self.height * self.args.mask_scale,
+                                      self.width * self.args.mask_scale), np.float32))
+            pl = self._render(self.preview_samples, "guides")
+            g = {}
+            g["object_id"] = pl["CryptoObject00.r"].view(np.uint32).copy()
+            g["shader_id"] = pl["CryptoMaterial00.r"].view(np.uint32).copy()
+            g["texture"] = self._rgb(pl, "DiffCol")
+            g["normal"] = self._rgb(pl, "Normal", "XYZ")
+            g["L"] = self._rgb(pl, "Combined")
+            g["Li"] = self._rgb(pl, "DiffDir") + self._rgb(pl, "DiffInd")
+            g["Lc"] = g["L"] - g["Li"] * g["texture"]
+            self._guides = g
+        return self._guides
+
+    def _runs(self, xs, ys, t):
+        """Rectangles over the tiles of side t that hold a pixel: each tile row's runs."""
+        tw, th = -(-self.width // t), -(-self.height // t)
+        occ = np.zeros((th, tw), bool)
+        occ[ys // t, xs // t] = True
+        rects = []
+        for ty in range(th):
+            tx = 0
+            while tx < tw:
+                if not occ[ty, tx]:
+                    tx += 1
+                    continue
+                start = tx
+                while tx < tw and occ[ty, tx]:
+                    tx += 1
+                rects.append((start * t, ty * t, min(tx * t, self.width), min((ty + 1) * t, self.height)))
+        return rects
+
+    def rectangles(self, xs, ys):
+        """Where to render pixels (xs, ys): a list of (x0, y0, x1, y1), or [None] for
+        the whole frame. A masked pixel still costs Cycles a camera ray and a
+        shader per sample (about a seventh of a rendered one), a render call a
+        fixed time: of tiles of 16, 32 or 64 px that hold the pixels (each tile
+        row's runs one render border) and the whole frame, the cheapest."""
+        if self.args.border_tile > 0:
+            return self._runs(xs, ys, self.args.border_tile)
+        masked = 0.14 * self.pixel_seconds()
+        best, best_cost = [None], self.args.call_seconds + self.width * self.height * masked
+        for t in (16, 32, 64):
+            rects = self._runs(xs, ys, t)
+            area = sum((x1 - x0) * (y1 - y0) for x0, y0, x1, y1 in rects)
+            cost = len(rects) * self.args.call_seconds + area * masked
+            if len(rects) <= self.args.max_calls and cost < best_cost:
+                best, best_cost = rects, cost
+        return best
+
+    def _set_border(self, rect):
+        r = self.scene.render
+        if rect is None:
+            r.use_border = False
+            return
+        # One pixel more on each side: Blender truncates the border to whole pixels.
+        x0, y0 = max(rect[0] - 1, 0), max(rect[1] - 1, 0)
+        x1, y1 = min(rect[2] + 1, self.width), min(rect[3] + 1, self.height)
+        r.use_border = True
+        r.border_min_x, r.border_max_x = x0 / self.width, x1 / self.width
+        r.border_min_y, r.border_max_y = 1 - y1 / self.height, 1 - y0 / self.height
+
+    def evaluate(self, xs, ys):
+        """L, L_i, L_c [n, 3] of pixels (xs, ys) at full samples: one mask, and one
+        render call per rectangle of rectangles()."""
+        g = self.guides()
+        if os.environ.get("DCM_BLENDER_TEST_FAULT") == "crash-on-eval":  # tests: Blender dies mid-round
+            os.kill(os.getpid(), 9)
+        texels = self.mask_of(xs, ys)
+        self._write_mask(texels)
+        reached = self.reached(texels)
+        L, Li = np.zeros((len(xs), 3), np.float32), np.zeros((len(xs), 3), np.float32)
+        done = np.zeros(len(xs), bool)
+        self._evals = getattr(self, "_evals", 0) + 1
+        for rect in self.rectangles(xs, ys):
+            self._set_border(rect)
+            pl = self._render(self.samples, "eval%d" % self._evals)
+            diffcol = self._rgb(pl, "DiffCol")
+            # The mask rendered must be the mask asked for: outside it no surface
+            # keeps its own shader (a stale mask would show diffuse colour there).
+            stray = (diffcol.max(axis=-1) > 0) & ~reached
+            if stray.any():
+                raise SceneError("%d pixels outside the mask were rendered: the mask of this round did not "
+                                 "reach Cycles" % int(stray.sum()))
+            inside = np.ones(len(xs), bool) if rect is None else (
+                (xs >= rect[0]) & (xs < rect[2]) & (ys >= rect[1]) & (ys < rect[3]))
+            L[inside] = self._rgb(pl, "Combined")[ys[inside], xs[inside]]
+            Li[inside] = (self._rgb(pl, "DiffDir") + self._rgb(pl, "DiffInd"))[ys[inside], xs[inside]]
+            done |= inside
+        self._set_border(None)
+        if not done.all():
+            raise SceneError("%d pixels fell outside every render border" % int((~done).sum()))
+        Lc = L - Li * g["texture"][ys, xs]
+        return L, Li, Lc
+
+    def pixel_seconds(self):
+        """What one pixel at full samples costs, from the guides render (its samples
+        are preview_samples; its time includes the scene's first sync: an upper bound)."""
+        return self.render_seconds[0][1] * self.samples / self.preview_samples / (self.width * self.height)
+
+    def round_cost(self):
+        """(seconds per render call, seconds per exact pixel), from the guides render: a
+        pixel at full samples costs samples / preview_samples times a preview pixel; a
+        masked pixel still costs about 14 % of one (camera ray, shader, film), and a render
+        call in a running Blender about 0.1 s (docs/BLENDER.md)."""
+        seconds = self.render_seconds[0][1]
+        full = seconds * self.samples / self.preview_samples
+        pixels = self.width * self.height
+        return 0.1 + 0.14 * full, full / pixels
+
+    def fingerprint(self):
+        """What setup() may change, as text: restore() must bring it back."""
+        sc = self.scene
+        lines = []
+        for m in bpy.data.materials:
+            lines.append("material %s nodes=%s" % (m.name, m.use_nodes))
+            if m.node_tree:
+                lines += sorted("  node %s %s" % (n.name, getattr(n, "is_active_output", "")) for n in m.node_tree.nodes)
+                lines += sorted("  link %s.%s>%s.%s" % (l.from_node.name, l.from_socket.identifier, l.to_node.name,
+                                                         l.to_socket.identifier) for l in m.node_tree.links)
+        lines += ["image " + i.name for i in bpy.data.images if i.type != "RENDER_RESULT"]
+        for ob in sc.objects:
+            lines.append("object %s %s" % (ob.name, [s.material and s.material.name for s in ob.material_slots]))
+        for vl in sc.view_layers:
+            lines.append("layer %s %s" % (vl.name, [getattr(vl, a) for a in dir(vl) if a.startswith("use_pass")]
+                                          + [vl.use, vl.pass_cryptomatte_depth]))
+        r, cy = sc.render, sc.cycles
+        lines.append("render %s" % ([getattr(r, a) for a in ("use_border", "use_crop_to_border", "border_min_x",
+                                                             "border_max_y", "use_persistent_data", "use_compositing",
+                                                             "use_sequencer", "use_file_extension", "filepath",
+                                                             "threads_mode", "threads")]
+                                    + [r.image_settings.file_format, r.image_settings.color_depth,
+                                       r.image_settings.exr_codec]))
+        lines.append("cycles %s" % [cy.samples, cy.use_adaptive_sampling, cy.use_denoising, sc.frame_current])
+        return "\n".join(lines)
+
+    def restore(self):
+        for e in self.changes.restore():
+            _log("while restoring the scene: " + e)

@@ -1,0 +1,34 @@
+// PipeProvider::FetchPreview: the child's preview as a provider of stand-in
+// samples. Apart from pipe_provider.cpp, which reads the protocol alone (and is
+// what fuzz/fuzz_pipe builds), because it needs the engine's round schedule.
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "dcm/pipe/pipe_provider.h"
+#include "dcm/round_schedule.h"
+
+namespace dcm::pipe {
+
+Status PipeProvider::FetchPreview(const SampleRequest& what, std::unique_ptr<SampleProvider>* out) {
+  std::vector<ExactSample> s;
+  DCM_RETURN_IF_ERROR(Preview(Bounds2i{{0, 0}, {caps_.width, caps_.height}}, what, &s));
+  const bool split = what.split && caps_.splitRadiance;
+  std::vector<RGB> L(s.size()), Li, Lc;
+  if (split) {
+    Li.resize(s.size());
+    Lc.resize(s.size());
+  }
+  for (size_t i = 0; i < s.size(); ++i) {
+    L[i] = s[i].L;
+    if (split) {
+      Li[i] = s[i].Li;
+      Lc[i] = s[i].Lc;
+    }
+  }
+  *out = std::make_unique<ImagePreviewProvider>(caps_.width, caps_.height, caps_.width, caps_.height, std::move(L),
+                                                std::move(Li), std::move(Lc));
+  return Status::Ok();
+}
+
+}  // namespace dcm::pipe

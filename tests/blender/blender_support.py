@@ -1,0 +1,85 @@
+"""Shared by the Blender tests: the test scene, a full reference render, and
+a driver of the dcm-pipe child."""
+import os
+import subprocess
+
+import numpy as np
+
+
+def make_scene(blender, src, tmp, res="64x48", samples=16):
+    out = os.path.join(tmp, "scene.blend")
+    subprocess.run([blender, "-b", "--factory-startup", "--python",
+                    os.path.join(src, "tests/blender/make_scene.py"), "--", "--out", out,
+                    "--res", res, "--samples", str(samples)],
+                   check=True, stdout=subprocess.DEVNULL)
+    return out
+
+
+def read_exr(path, layer="ViewLayer.Combined."):
+    import OpenImageIO as oiio
+    inp = oiio.ImageInput.open(path)
+    if inp is None:
+        raise RuntimeError("cannot open " + path)
+    spec = inp.spec()
+    px = inp.read_image("float")
+    inp.close()
+    names = list(spec.channelnames)
+    return px[:, :, [names.index(layer + c) for c in "RGB"]], spec
+
+
+def render_full(blender, src, blend, tmp):
+    out = os.path.join(tmp, "full.exr")
+    subprocess.run([blender, "-b", blend, "--python", os.path.join(src, "tests/blender/render_full.py"), "--", out],
+                   check=True, stdout=subprocess.DEVNULL)
+    return read_exr(out)[0]
+
+
+class Child:
+    """The child started as `dcm blender` starts it; speaks the protocol."""
+
+    def __init__(self, blender, src, blend, args=()):
+        cmd = "'%s' -b '%s' --python '%s' -- --protocol-fd 3 %s 3>&1 1>&2" % (
+            blender, blend, os.path.join(src, "plugins/blender/child_main.py"), " ".join(args))
+        self.p = subprocess.Popen(["/bin/sh", "-c", cmd], stdin=subprocess.PIPE, stdout=subprocess.PIPE)
+        self.hello = self._ask(b"dcm-pipe 1\n")
+        t = self.hello.split()
+        assert t[:2] == ["dcm-pipe", "1"], self.hello
+        kv = dict(x.split("=", 1) for x in t[2:])
+        self.width, self.height = int(kv["width"]), int(kv["height"])
+        self.caps = kv["caps"].split(",")
+        self.round_latency, self.sample_cost = float(kv["round_latency"]), float(kv["sample_cost"])
+
+    def _ask(self, request):
+        self.p.stdin.write(request)
+        self.p.stdin.flush()
+        return self.p.stdout.readline().decode()
+
+    def _read(self, dtype, count):
+        return np.frombuffer(self.p.stdout.read(np.dtype(dtype).itemsize * count), dtype)
+
+    def guides(self):
+        w, h = self.width, self.height
+        line = self._ask(b"guides 0 0 %d %d object_id,shader_id,texture,normal\n" % (w, h))
+        assert line.split() == ["guides", str(w * h)], line
+        n = w * h
+        ids, shaders = self._read("<u4", n), self._read("<u4", n)
+        tau, normal = self._read("<f4", 3 * n).reshape(h, w, 3), self._read("<f4", 3 * n).reshape(h, w, 3)
+        return ids, shaders, tau, normal
+
+    def eval(self, xs, ys):
+        xy = np.stack([xs, ys], 1).astype("<i4")
+        line = self._ask(b"eval %d L,split\n" % len(xs) + xy.tobytes())
+        assert line.split() == ["samples", str(len(xs))], line
+        rec = self._read("<f4", 9 * len(xs)).reshape(-1, 9)
+        return rec[:, 0:3], rec[:, 3:6], rec[:, 6:9]
+
+    def preview(self, x0, y0, x1, y1):
+        line = self._ask(b"preview %d %d %d %d L\n" % (x0, y0, x1, y1))
+        n = (x1 - x0) * (y1 - y0)
+        assert line.split() == ["samples", str(n)], line
+        return self._read("<f4", 3 * n).reshape(n, 3)
+
+    def quit(self):
+        self.p.stdin.write(b"quit\n")
+        self.p.stdin.close()
+        return self.p.wait(timeout=60)

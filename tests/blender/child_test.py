@@ -1,0 +1,89 @@
+"""The dcm-pipe child inside Blender (plugins/blender), driven over the
+protocol: the pixels of two rounds equal a full Cycles render of the same
+file, each round renders its own mask (not the last one), the scene is
+restored and the .blend is unchanged.
+
+    /usr/bin/python3 child_test.py BLENDER SOURCE_DIR
+Exit 77 (skipped) when Blender is missing."""
+import hashlib
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import blender_support as bs  # noqa: E402
+
+
+def main():
+    blender, src = sys.argv[1], sys.argv[2]
+    if not shutil.which(blender):
+        print("blender not found: skipped")
+        return 77
+    tmp = tempfile.mkdtemp(prefix="dcm-blender-child-test-")
+    try:
+        blend = bs.make_scene(blender, src, tmp)
+        digest = hashlib.sha256(open(blend, "rb").read()).hexdigest()
+        ref = bs.render_full(blender, src, blend, tmp)
+        h, w = ref.shape[:2]
+        keep = os.path.join(tmp, "renders")
+        # Tiles of 8 px, always within render borders: rounds 1 and 2 render six
+        # rows of tiles each, round 3 one tile.
+        child = bs.Child(blender, src, blend, ["--verify-restore", "--keep-renders", keep, "--border-tile", "8"])
+        assert (child.width, child.height) == (w, h), (child.width, child.height)
+        assert "preview" in child.caps and "split" in child.caps, child.caps
+        assert child.round_latency > 0 and child.sample_cost > 0, child.hello
+
+        ids, shaders, tau, normal = child.guides()
+        # Floor, cube, the two spheres, the shade and the sky: six objects and materials.
+        assert len(set(ids.tolist())) == 6 and len(set(shaders.tolist())) == 6, (set(ids), set(shaders))
+
+        rng = np.random.default_rng(7)
+        order = rng.permutation(w * h)
+        block = np.array([y * w + x for y in range(10, 14) for x in range(19, 25)])  # tiles 2 and 3 of row 1: one border
+        rounds = [order[: w * h // 10], order[w * h // 10: w * h // 5], block]
+        for r, sel in enumerate(rounds):
+            xs, ys = sel % w, sel // w
+            L, Li, Lc = child.eval(xs, ys)
+            want = ref[ys, xs]
+            # The same samples of the same pixels: equal but for the order of
+            # float additions in Cycles' film (relative 1e-5 is far below the
+            # 16-spp noise, about 10 %, and far above float rounding).
+            err = np.abs(L - want)
+            assert (err <= 1e-5 * np.maximum(np.abs(want), 1) + 1e-7).all(), \
+                "round %d: max |L - full render| = %g" % (r, err.max())
+            # L = L_i * tau + L_c with the guides' tau, as the engine composes it.
+            assert np.allclose(Li * tau[ys, xs] + Lc, L, rtol=1e-5, atol=1e-6)
+            print("round %d: %d pixels, %.1f %% bit-identical to the full render"
+                  % (r, len(sel), 100 * (err == 0).all(axis=1).mean()))
+        # The mask rendered was the mask asked for: the second round shows
+        # surfaces (diffuse colour) only around its own pixels, not around the first's.
+        import glob
+        second = np.zeros((h, w), bool)
+        for f in sorted(glob.glob(os.path.join(keep, "*_eval2.npz"))):
+            second |= np.load(f)["DiffCol.R"] > 0
+        assert len(glob.glob(os.path.join(keep, "*_eval3.npz"))) == 1, os.listdir(keep)
+        first_only = np.zeros((h, w), bool)
+        first_only.flat[rounds[0]] = True
+        near_second = np.zeros((h, w), bool)
+        for dy in range(-2, 3):
+            for dx in range(-2, 3):
+                near_second[np.clip(rounds[1] // w + dy, 0, h - 1), np.clip(rounds[1] % w + dx, 0, w - 1)] = True
+        assert not (second & first_only & ~near_second).any(), "round 2 rendered pixels of round 1"
+        assert second.flat[rounds[1]][tau.reshape(-1, 3)[rounds[1]].max(1) > 0].all()
+
+        prev = child.preview(0, 0, w, h)
+        assert prev.shape == (w * h, 3) and np.isfinite(prev).all()
+        assert child.quit() == 0, "the child did not exit cleanly (or the scene was not restored)"
+        assert hashlib.sha256(open(blend, "rb").read()).hexdigest() == digest, "the .blend changed"
+        print("ok")
+        return 0
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

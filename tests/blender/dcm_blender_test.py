@@ -1,0 +1,116 @@
+"""`dcm blender` on the tiny test scene: the exact pixels equal a full Cycles
+render of the same file, the .blend is unchanged, and bad input ends with a
+message naming the file and the step, exit 1, no output and no Blender left.
+
+    /usr/bin/python3 dcm_blender_test.py DCM BLENDER SOURCE_DIR exact|errors
+Exit 77 (skipped) when Blender is missing."""
+import hashlib
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import blender_support as bs  # noqa: E402
+
+
+def run(dcm, args, env=None):
+    p = subprocess.run([dcm, "blender", "-q"] + args, capture_output=True, text=True, env=env, timeout=120)
+    return p.returncode, p.stdout, p.stderr
+
+
+def no_blender_left(marker):
+    """No process of this test's scene is running (pgrep over command lines)."""
+    out = subprocess.run(["pgrep", "-f", marker], capture_output=True, text=True).stdout.split()
+    return not [pid for pid in out if int(pid) != os.getpid()]
+
+
+def exact(dcm, blender, src, tmp):
+    blend = bs.make_scene(blender, src, tmp)
+    digest = hashlib.sha256(open(blend, "rb").read()).hexdigest()
+    ref = bs.render_full(blender, src, blend, tmp)
+    h, w = ref.shape[:2]
+    for schedule in ("preview", "levels"):
+        out, stats, smap = (os.path.join(tmp, schedule + e) for e in (".exr", ".json", ".png"))
+        code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--sample-map", smap, "--schedule", schedule,
+                                 "--blender", blender, "--max-rounds", "8"])
+        assert code == 0, se
+        img, spec = bs.read_exr(out)
+        assert spec.channelnames == ("ViewLayer.Combined.R", "ViewLayer.Combined.G", "ViewLayer.Combined.B",
+                                     "ViewLayer.Combined.A") or sorted(spec.channelnames) == sorted(
+            ["ViewLayer.Combined." + c for c in "RGBA"]), spec.channelnames
+        j = json.load(open(stats))
+        b = j["blender"]
+        assert b["preview_stand_ins"] == 0, b
+        # The sample map's image part: dark grey (40, 40, 40) where interpolated.
+        import OpenImageIO as oiio
+        m = oiio.ImageInput.open(smap)
+        sm = m.read_image("uint8")[:h, :w, :3]
+        m.close()
+        is_exact = (sm != 40).any(axis=2)
+        assert is_exact.sum() == j["exact_pixels"], (is_exact.sum(), j["exact_pixels"])
+        assert 0 < j["exact_fraction"] < 0.6, j["exact_fraction"]
+        # Exact pixels: the same Cycles samples as the full render, equal but
+        # for the order of float additions in the film (relative 1e-5, far
+        # below the 16-spp noise of about 10 %).
+        err = np.abs(img - ref)[is_exact]
+        assert (err <= 1e-5 * np.maximum(np.abs(ref[is_exact]), 1) + 1e-7).all(), err.max()
+        rounds = len(b["rounds"])
+        if schedule == "preview":
+            assert 1 <= rounds <= 8, b
+        print("%s: %.1f %% exact in %d render calls, %.1f %% bit-identical to the full render; %.2f s" % (
+            schedule, 100 * j["exact_fraction"], rounds, 100 * (err == 0).all(axis=1).mean(), b["wall_s"]))
+    assert hashlib.sha256(open(blend, "rb").read()).hexdigest() == digest, "the .blend changed"
+    assert no_blender_left(blend)
+
+
+def errors(dcm, blender, src, tmp):
+    blend = bs.make_scene(blender, src, tmp)
+    out = os.path.join(tmp, "out.exr")
+
+    def refused(args, *parts, env=None, code=1):
+        c, so, se = run(dcm, args, env)
+        assert c == code, (args, c, se)
+        for part in parts:
+            assert part in se, (args, part, se)
+        assert not os.path.exists(out), args
+        assert not [f for f in os.listdir(tmp) if f.startswith("out")], os.listdir(tmp)
+        assert no_blender_left(blend), "a Blender is still running"
+
+    missing = os.path.join(tmp, "missing.blend")
+    refused([missing, "-o", out, "--blender", blender], missing, "no such file", "reading the scene")
+    text = os.path.join(tmp, "notes.blend")
+    open(text, "w").write("not a blend file\n")
+    refused([text, "-o", out, "--blender", blender], text, "not a .blend file")
+    refused([blend, "-o", out, "--blender", os.path.join(tmp, "no-blender")], "no-blender", "not found")
+    env = dict(os.environ, DCM_BLENDER_TEST_FAULT="crash-on-eval")
+    refused([blend, "-o", out, "--blender", blender], blend, "signal", env=env)
+    refused([blend, "-o", os.path.join(tmp, "no-such-dir", "out.exr"), "--blender", blender], "no-such-dir")
+    # A scene set to Eevee: the child says why it cannot render it.
+    eevee = os.path.join(tmp, "eevee.blend")
+    subprocess.run([blender, "-b", blend, "--python-expr",
+                    "import bpy; bpy.context.scene.render.engine = 'BLENDER_EEVEE'; "
+                    "bpy.ops.wm.save_as_mainfile(filepath=%r)" % eevee], check=True, capture_output=True)
+    refused([eevee, "-o", out, "--blender", blender], eevee, "Cycles only")
+
+
+def main():
+    dcm, blender, src, what = sys.argv[1:5]
+    if not shutil.which(blender):
+        print("blender not found: skipped")
+        return 77
+    tmp = tempfile.mkdtemp(prefix="dcm-blender-test-")
+    try:
+        {"exact": exact, "errors": errors}[what](dcm, blender, src, tmp)
+        print("ok")
+        return 0
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,424 @@
+// dcm blender: a user's .blend rendered by Cycles only at the pixels DCM asks
+// for. Blender starts once as a dcm-pipe child (plugins/blender/child_main.py)
+// that renders the guides and a few-samples preview in one render call, then
+// each round of exact pixels in one masked render call at full samples; dcm
+// plans the rounds on the preview (RoundSchedule::kPreview) and writes a
+// multilayer EXR with Blender's names. Nothing is written on failure, and no
+// Blender is left running.
+//
+//   dcm blender SCENE.blend -o OUT.exr [--stats S.json] [--samples N] [--frames A-B]
+//       [--blender PATH] + the engine and EXR flags of `dcm reconstruct`
+//
+// Compiles to nothing unless the dcm_pipe library is linked (DCM_HAVE_PIPE).
+#ifdef DCM_HAVE_PIPE
+
+#include <unistd.h>
+
+#include <cctype>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "commands.h"
+#include "common/output_exr.h"
+#include "common/output_guard.h"
+#include "common/output_transaction.h"
+#include "common/progress.h"
+#include "common/sample_map.h"
+#include "common/stats_json.h"
+#include "dcm/pipe/pipe_provider.h"
+#include "dcm/reconstructor.h"
+#include "dcm/round_schedule.h"
+#include "engine_flags.h"
+#include "flag_checks.h"
+#include "output_flags.h"
+#include "pipe_run.h"
+
+namespace dcm::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+struct BlenderFlags {
+  std::string scene, output, stats, sampleMap;
+  std::string blender = "blender";
+  std::string frames;      ///< A-B: one output per frame, '#' in -o replaced by the frame number
+  std::string viewLayer;   ///< empty: the first that renders
+  std::string schedule = "auto";  ///< auto | preview | levels
+  int samples = 0;         ///< 0: the file's
+  int previewSamples = 0;  ///< 0: samples / 16, at least 4
+  int maxRounds = 3;
+  int renderThreads = 0;
+  PipeFlags pipe;  ///< --provider-timeout, --provider-startup-timeout; engine; EXR format
+};
+
+/// Undoes the child's percent-encoding of a handshake value.
+std::string PercentDecoded(const std::string& s) {
+  std::string out;
+  for (size_t i = 0; i < s.size(); ++i) {
+    if (s[i] == '%' && i + 2 < s.size() && std::isxdigit(uint8_t(s[i + 1])) && std::isxdigit(uint8_t(s[i + 2]))) {
+      out += char(std::stoi(s.substr(i + 1, 2), nullptr, 16));
+      i += 2;
+    } else {
+      out += s[i];
+    }
+  }
+  return out;
+}
+
+double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+/// A word quoted for /bin/sh.
+std::string ShellQuote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+/// The child script: $DCM_BLENDER_CHILD, else installed beside the binary
+/// (../share/dcm/blender), else the source tree's.
+Status FindChildScript(std::string* path) {
+  std::vector<fs::path> candidates;
+  if (const char* env = std::getenv("DCM_BLENDER_CHILD"); env && *env) candidates.push_back(env);
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) candidates.push_back(exe.parent_path().parent_path() / "share/dcm/blender/child_main.py");
+  candidates.push_back(fs::path(DCM_SOURCE_DIR) / "plugins/blender/child_main.py");
+  for (const auto& c : candidates) {
+    if (fs::is_regular_file(c, ec)) {
+      *path = c.string();
+      return Status::Ok();
+    }
+  }
+  return Status::Error("the Blender child script child_main.py is not installed (looked in " +
+                       candidates.back().parent_path().string() + "; set DCM_BLENDER_CHILD)");
+}
+
+/// `name` as an executable: a path, or a name looked up in $PATH.
+Status FindExecutable(const std::string& name, std::string* path) {
+  auto ok = [](const fs::path& p) {
+    std::error_code ec;
+    return fs::is_regular_file(p, ec) && ::access(p.c_str(), X_OK) == 0;
+  };
+  if (name.find('/') != std::string::npos) {
+    if (ok(name)) {
+      *path = name;
+      return Status::Ok();
+    }
+  } else if (const char* env = std::getenv("PATH")) {
+    std::string dirs = env;
+    size_t start = 0;
+    while (start <= dirs.size()) {
+      const size_t end = std::min(dirs.find(':', start), dirs.size());
+      const fs::path p = fs::path(dirs.substr(start, end - start).empty() ? "." : dirs.substr(start, end - start)) / name;
+      if (ok(p)) {
+        *path = p.string();
+        return Status::Ok();
+      }
+      start = end + 1;
+    }
+  }
+  return Status::Error("blender '" + name + "' not found or not executable (--blender PATH; Debian: apt-get install "
+                       "blender)");
+}
+
+/// The scene must be a readable .blend: plain ("BLENDER"), gzip or zstd compressed.
+Status CheckBlendFile(const std::string& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return Status::Error("'" + path + "': no such file (reading the scene)");
+  if (!fs::is_regular_file(path, ec)) return Status::Error("'" + path + "': not a file (reading the scene)");
+  std::ifstream in(path, std::ios::binary);
+  char head[7] = {};
+  if (!in.read(head, sizeof head))
+    return Status::Error("'" + path + "': cannot read it, or shorter than a .blend header (reading the scene)");
+  const std::string h(head, sizeof head);
+  const bool plain = h == "BLENDER";
+  const bool gzip = uint8_t(h[0]) == 0x1f && uint8_t(h[1]) == 0x8b;
+  const bool zstd = uint8_t(h[0]) == 0x28 && uint8_t(h[1]) == 0xb5 && uint8_t(h[2]) == 0x2f && uint8_t(h[3]) == 0xfd;
+  if (!plain && !gzip && !zstd) return Status::Error("'" + path + "': not a .blend file (reading the scene)");
+  return Status::Ok();
+}
+
+/// Times every call of the exact provider: a round each with the preview schedule.
+class TimedProvider final : public SampleProvider {
+ public:
+  explicit TimedProvider(SampleProvider& p) : p_(p) {}
+  ProviderCapabilities Capabilities() const override { return p_.Capabilities(); }
+  Status Guides(const Bounds2i& region, const GuideRequest& what, GuideImage* out) override {
+    step = "reading the guides";
+    const auto t = Clock::now();
+    Status st = p_.Guides(region, what, out);
+    guidesS += Since(t);
+    return st;
+  }
+  Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what, std::span<ExactSample> out) override {
+    step = "rendering exact pixels (call " + std::to_string(rounds.size() + 1) + ", " +
+           std::to_string(pixels.size()) + " pixels)";
+    const auto t = Clock::now();
+    Status st = p_.Evaluate(pixels, what, out);
+    rounds.push_back({int64_t(pixels.size()), Since(t)});
+    return st;
+  }
+  struct Round {
+    int64_t pixels;
+    double seconds;
+  };
+  std::vector<Round> rounds;
+  double guidesS = 0;
+  std::string step = "planning";  ///< what the last call did, for messages
+
+ private:
+  SampleProvider& p_;
+};
+
+/// Renders one frame (`frame` < 0: the file's current frame) to `output`.
+int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const std::string& stats,
+             const std::string& sampleMap) {
+  const std::string cmd = "blender";
+  auto Fail = [&](const std::string& message, int code = kExitFailure) {
+    std::cerr << "dcm " << cmd << ": error: " << message << "\n";
+    return code;
+  };
+  ReconstructionOptions options;
+  if (Status st = ToOptions(f.pipe.engine, &options); !st.ok()) return Fail(st.message(), kExitUsage);
+  RoundSchedule schedule = RoundSchedule::kPreview;
+  if (f.schedule != "auto") {
+    if (Status st = Parse(f.schedule, &schedule); !st.ok()) return Fail("--schedule: " + st.message(), kExitUsage);
+  }
+  if (Status st = toolkit::CheckExrFormat(f.pipe.exr); !st.ok()) return Fail(st.message(), kExitUsage);
+  if (Status st = toolkit::CheckOutputs({{"scene", f.scene}}, {{"-o", output},
+                                                               {"--stats", stats},
+                                                               {"--sample-map", sampleMap},
+                                                               toolkit::ProgressiveArg(f.pipe.engine.progressive)});
+      !st.ok())
+    return Fail(st.message(), kExitUsage);
+  if (Status st = CheckBlendFile(f.scene); !st.ok()) return Fail(st.message());
+  // Before Blender renders anything: the outputs' folders must take a file.
+  for (const std::string& out : {output, stats, sampleMap}) {
+    if (out.empty()) continue;
+    const fs::path folder = fs::absolute(fs::path(out)).parent_path();
+    std::error_code ec;
+    if (!fs::is_directory(folder, ec) || ::access(folder.c_str(), W_OK | X_OK) != 0)
+      return Fail("cannot write '" + out + "': its folder '" + folder.string() +
+                  "' does not exist or is not writable (checking the outputs before rendering)");
+  }
+  std::string blender, child;
+  if (Status st = FindExecutable(f.blender, &blender); !st.ok()) return Fail(st.message());
+  if (Status st = FindChildScript(&child); !st.ok()) return Fail(st.message());
+
+  // Every output of the run appears at its Commit(), or none; a signal ends Blender too.
+  toolkit::OutputTransaction outputs;
+  toolkit::SetSignalHook(pipe::KillAllChildren);
+  const auto t0 = Clock::now();
+  std::string command = ShellQuote(blender) + " -b " + ShellQuote(f.scene) + " --python " + ShellQuote(child) +
+                        " -- --protocol-fd 3";
+  if (f.samples > 0) command += " --samples " + std::to_string(f.samples);
+  if (f.previewSamples > 0) command += " --preview-samples " + std::to_string(f.previewSamples);
+  if (frame >= 0) command += " --frame " + std::to_string(frame);
+  if (!f.viewLayer.empty()) command += " --view-layer " + ShellQuote(f.viewLayer);
+  if (f.renderThreads > 0) command += " --threads " + std::to_string(f.renderThreads);
+  // Blender prints to stdout before any script runs: the protocol goes to fd 3,
+  // Blender's own output to stderr with -v, else nowhere (the child's notes and
+  // errors still reach stderr).
+  if (f.pipe.engine.verbose) command += " --verbose";
+  command += f.pipe.engine.verbose ? " 3>&1 1>&2" : " 3>&1 1>/dev/null";
+  pipe::PipeOptions po;
+  po.command = command;
+  po.timeoutSeconds = f.pipe.timeout;
+  po.startupTimeoutSeconds = f.pipe.startupTimeout;
+  std::unique_ptr<pipe::PipeProvider> provider;
+  if (Status st = pipe::PipeProvider::Start(po, &provider); !st.ok())
+    return Fail("'" + f.scene + "': starting Blender: " + st.message());
+  // The child renders its guides and preview before it answers the handshake.
+  const double handshakeS = Since(t0);
+  const auto& keys = provider->handshakeKeys();
+  const double guidesRenderS = keys.count("guides_seconds") ? std::atof(keys.at("guides_seconds").c_str()) : 0.0;
+  const std::string layer = keys.count("view_layer") ? PercentDecoded(keys.at("view_layer")) : "ViewLayer";
+  const ProviderCapabilities caps = provider->Capabilities();
+  if (f.schedule == "auto") schedule = ChooseSchedule(provider->roundCost());
+  if (schedule == RoundSchedule::kPreview && !provider->hasPreview())
+    return Fail("'" + f.scene + "': the Blender child serves no preview (capability 'preview')");
+  if (options.fullEvaluation) {
+    // The baseline: every pixel in one render call.
+    schedule = RoundSchedule::kLevels;
+    options.batchSize = caps.width * caps.height;
+  }
+  if (f.pipe.engine.verbose) {
+    std::cerr << "blender: " << caps.width << "x" << caps.height << ", view layer '" << layer << "', round latency "
+              << provider->roundCost().latencyS << " s, " << provider->roundCost().perSampleS
+              << " s per pixel: schedule " << ToString(schedule) << "\n"
+              << "engine settings: " << SettingsSummary(options, caps) << "\n";
+  }
+  if (Status st = CheckDownsample(caps.width, caps.height, options.downsample, "the Blender image"); !st.ok())
+    return Fail(st.message(), kExitUsage);
+
+  toolkit::Progress progress(!f.pipe.engine.quiet);
+  options.progress = [&](float v, std::string_view stage) { progress.Update(v, stage); };
+  TimedProvider timed(*provider);
+  Reconstruction rec;
+  PreviewScheduleStats sched;
+  double previewS = 0;
+  Status st;
+  if (schedule == RoundSchedule::kPreview) {
+    const auto tp = Clock::now();
+    std::unique_ptr<SampleProvider> preview;
+    timed.step = "reading the preview";
+    st = provider->FetchPreview({options.textureSplit && caps.splitRadiance, false}, &preview);
+    previewS = Since(tp);
+    PreviewScheduleOptions so;
+    so.maxRounds = f.maxRounds;
+    if (st.ok()) st = ReconstructWithPreview(timed, *preview, options, so, &rec, &sched);
+  } else {
+    st = Reconstruct(timed, options, &rec);
+  }
+  progress.Done();
+  if (!st.ok()) return Fail("'" + f.scene + "': " + timed.step + ": " + st.message());
+  // Blender must end cleanly before anything is written.
+  if (Status fin = provider->Finish(); !fin.ok()) return Fail("'" + f.scene + "': " + fin.message());
+  const double wallS = Since(t0);
+  const ReconstructionStats& stats_ = rec.stats;
+  double roundsS = 0;
+  for (const auto& r : timed.rounds) roundsS += r.seconds;
+  const double engineS = schedule == RoundSchedule::kPreview ? sched.timeEngineS : stats_.timeEngineS;
+  const std::string method = options.fullEvaluation ? "full" : f.pipe.engine.method;
+
+  // Blender's own layout: <view layer>.Combined.R/G/B/A.
+  toolkit::OutputImage image;
+  image.display = image.data = Bounds2i{{0, 0}, {rec.width, rec.height}};
+  const size_t n = rec.image.size();
+  for (int c = 0; c < 4; ++c) {
+    toolkit::OutputChannel ch;
+    ch.name = layer + ".Combined." + "RGBA"[c];
+    ch.values.resize(n);
+    for (size_t i = 0; i < n; ++i) ch.values[i] = c == 3 ? 1.f : (&rec.image[i].r)[c];
+    image.channels.push_back(std::move(ch));
+  }
+  toolkit::Metadata meta;
+  meta.strings.push_back({"Software", std::string("dcm ") + DCM_VERSION});
+  meta.strings.push_back({"File", f.scene});
+  meta.strings.push_back({"dcm:version", DCM_VERSION});
+  meta.strings.push_back({"dcm:command_line", toolkit::CommandLine()});
+  meta.strings.push_back({"dcm:provider", "blender"});
+  meta.strings.push_back({"dcm:method", method});
+  meta.strings.push_back({"dcm:schedule", std::string(ToString(schedule))});
+  meta.strings.push_back({"dcm:options", toolkit::OptionsToJson(options).dump()});
+  meta.floats.push_back({"dcm:exact_fraction", float(stats_.exactFraction())});
+  if (frame >= 0) meta.strings.push_back({"Frame", std::to_string(frame)});
+  toolkit::AddMetadata(meta, &image.attributes);
+  if (Status w = toolkit::WriteOutputExr(output, image, f.pipe.exr); !w.ok()) return Fail(w.message());
+  if (!sampleMap.empty()) {
+    if (Status w = toolkit::WriteSampleMap(sampleMap, rec); !w.ok()) return Fail(w.message());
+  }
+  if (!stats.empty()) {
+    nlohmann::json j = toolkit::RunToJson(rec, method, options, wallS);
+    j["provider"] = "blender";
+    j["scene"] = f.scene;
+    j["schedule"] = ToString(schedule);
+    nlohmann::json b;
+    b["startup_s"] = handshakeS - guidesRenderS;
+    b["guides_s"] = guidesRenderS + timed.guidesS;
+    b["preview_s"] = previewS;
+    b["engine_s"] = engineS;
+    b["rounds_s"] = roundsS;
+    b["wall_s"] = wallS;
+    nlohmann::json rounds = nlohmann::json::array();
+    for (const auto& r : timed.rounds) rounds.push_back({{"pixels", r.pixels}, {"seconds", r.seconds}});
+    b["rounds"] = rounds;
+    b["preview_stand_ins"] = sched.previewStandIns;
+    b["round_latency_s"] = provider->roundCost().latencyS;
+    b["sample_cost_s"] = provider->roundCost().perSampleS;
+    j["blender"] = b;
+    if (Status w = toolkit::WriteJson(stats, j); !w.ok()) return Fail(w.message());
+  }
+  if (Status w = outputs.Commit(); !w.ok()) return Fail(w.message());
+
+  std::printf("%s: %dx%d, %s, schedule %s, %zu render calls for exact pixels\n", output.c_str(), rec.width,
+              rec.height, method.c_str(), std::string(ToString(schedule)).c_str(), timed.rounds.size());
+  std::printf("  exact pixels   %.2f %% (%lld of %lld)%s\n", 100.0 * stats_.exactFraction(),
+              static_cast<long long>(stats_.exactPixels), static_cast<long long>(stats_.totalPixels),
+              sched.previewStandIns ? (", " + std::to_string(sched.previewStandIns) + " preview stand-ins").c_str()
+                                    : "");
+  std::printf("  time           Blender start %.2f s, guides %.2f s, preview %.2f s, rounds %.2f s, DCM %.2f s, "
+              "total %.2f s\n",
+              handshakeS - guidesRenderS, guidesRenderS + timed.guidesS, previewS, roundsS, engineS, wallS);
+  for (const auto& w : toolkit::SampleWarnings(stats_)) std::cerr << "dcm " << cmd << ": warning: " << w << "\n";
+  return kExitOk;
+}
+
+/// --frames A-B: the frame numbers; '#' in a path becomes the frame number.
+int Run(const BlenderFlags& f) {
+  if (f.frames.empty()) return RunFrame(f, -1, f.output, f.stats, f.sampleMap);
+  int a = 0, b = 0;
+  char dash = 0, extra = 0;
+  if (std::sscanf(f.frames.c_str(), "%d%c%d%c", &a, &dash, &b, &extra) != 3 || dash != '-' || b < a) {
+    if (std::sscanf(f.frames.c_str(), "%d%c", &a, &extra) != 1) {
+      std::cerr << "dcm blender: error: --frames: expected A-B or A, got '" << f.frames << "'\n";
+      return kExitUsage;
+    }
+    b = a;
+  }
+  auto named = [](const std::string& p, int frame) {
+    if (p.empty()) return p;
+    const size_t h = p.find('#');
+    char num[16];
+    std::snprintf(num, sizeof num, "%04d", frame);
+    return h == std::string::npos ? p : p.substr(0, h) + num + p.substr(h + 1);
+  };
+  if (a != b && f.output.find('#') == std::string::npos) {
+    std::cerr << "dcm blender: error: --frames " << f.frames << " writes one image per frame: put '#' in -o "
+              << "(it becomes the frame number, e.g. out_#.exr)\n";
+    return kExitUsage;
+  }
+  for (int frame = a; frame <= b; ++frame) {
+    if (int code = RunFrame(f, frame, named(f.output, frame), named(f.stats, frame), named(f.sampleMap, frame)))
+      return code;
+  }
+  return kExitOk;
+}
+
+Registration reg("blender", "Render a .blend with Cycles at the pixels DCM asks for, reconstruct the rest",
+                 [](CLI::App* app) -> std::function<int()> {
+                   auto f = std::make_shared<BlenderFlags>();
+                   app->option_defaults()->group(kGroupIo);
+                   app->add_option("scene", f->scene, "the scene (.blend); never modified")->required();
+                   app->add_option("-o,--output", f->output, "output image (multilayer EXR, Blender's names)")
+                       ->required();
+                   app->add_option("--stats", f->stats, "write statistics (JSON): exact_fraction, times per phase");
+                   app->add_option("--sample-map", f->sampleMap, "write the sample map (PNG)");
+                   app->add_option("--blender", f->blender, "the Blender executable")->capture_default_str();
+                   app->add_option("--frames", f->frames, "frames A-B (or A): one image each, '#' in -o the number");
+                   app->add_option("--view-layer", f->viewLayer, "view layer to render (default: the first that renders)");
+                   app->option_defaults()->group(kGroupQuality);
+                   app->add_option("--samples", f->samples, "Cycles samples of the exact pixels (0: the file's)")
+                       ->transform(Integer(0, 1 << 24));
+                   app->add_option("--preview-samples", f->previewSamples,
+                                   "samples of the guides and preview render (0: a sixteenth of --samples, at least 4)")
+                       ->transform(Integer(0, 1 << 24));
+                   app->add_option("--schedule", f->schedule,
+                                   "rounds: preview (plan on the preview, few render calls), levels (one call per "
+                                   "refinement step), auto (from the round cost Blender reports)")
+                       ->check(CLI::IsMember({"auto", "preview", "levels"}))
+                       ->capture_default_str();
+                   app->add_option("--max-rounds", f->maxRounds, "render calls for exact pixels at most (preview)")
+                       ->transform(Integer(1, 1000))
+                       ->capture_default_str();
+                   app->add_option("--render-threads", f->renderThreads, "Cycles threads (0: Blender's choice)")
+                       ->transform(Integer(0, kMaxThreads));
+                   app->option_defaults()->group(kGroupGeneral);
+                   AddProviderTimeoutFlags(app, &f->pipe);
+                   AddExrFormatFlags(app, &f->pipe.exr);
+                   AddEngineFlags(app, &f->pipe.engine);
+                   return [f] { return Run(*f); };
+                 });
+
+}  // namespace
+}  // namespace dcm::cli
+
+#endif  // DCM_HAVE_PIPE
