@@ -90,6 +90,8 @@ def errors(dcm, blender, src, tmp):
     env = dict(os.environ, DCM_BLENDER_TEST_FAULT="crash-on-eval")
     refused([blend, "-o", out, "--blender", blender], blend, "signal", env=env)
     refused([blend, "-o", os.path.join(tmp, "no-such-dir", "out.exr"), "--blender", blender], "no-such-dir")
+    refused([blend, "-o", out, "--blender", blender, "--target-psnr", "40"], "--target-psnr: not with dcm blender",
+            code=2)
     # A scene set to Eevee: the child says why it cannot render it.
     eevee = os.path.join(tmp, "eevee.blend")
     subprocess.run([blender, "-b", blend, "--python-expr",

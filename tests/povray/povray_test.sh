@@ -117,6 +117,8 @@ EOS
   expect "output = scene" 2 "an output never replaces an input" "$out" -- "$dcm" povray "$scene" -o "$scene" --size $size
   cmp -s "$scene" "$src/examples/povray/scene.pov" || fail "the scene was changed"
   expect "bad --size" 2 "--size: must be WIDTHxHEIGHT" "$out" -- "$dcm" povray "$scene" -o "$out" --size 96
+  expect "quality goal" 2 "--target-psnr: not with dcm povray yet" "$out" -- \
+    "$dcm" povray "$scene" -o "$out" --size $size --target-psnr 40
   # SIGTERM while POV-Ray renders: dcm ends it and removes the scratch folder.
   "$dcm" povray "$scene" -o "$out" --size 320x240 --full --povray "$pov" -q 2>"$tmp/err" &
   pid=$!

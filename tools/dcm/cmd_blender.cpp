@@ -51,10 +51,9 @@ struct BlenderFlags {
   std::string blender = "blender";
   std::string frames;      ///< A-B: one output per frame, '#' in -o replaced by the frame number
   std::string viewLayer;   ///< empty: the first that renders
-  std::string schedule = "auto";  ///< auto | preview | levels
   int samples = 0;         ///< 0: the file's
   int previewSamples = 0;  ///< 0: samples / 16, at least 4
-  int maxRounds = 3;
+  RoundFlags rounds;       ///< --schedule, --max-rounds
   int renderThreads = 0;
   PipeFlags pipe;  ///< --provider-timeout, --provider-startup-timeout; engine; EXR format
 };
@@ -188,10 +187,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   };
   ReconstructionOptions options;
   if (Status st = ToOptions(f.pipe.engine, &options); !st.ok()) return Fail(st.message(), kExitUsage);
-  RoundSchedule schedule = RoundSchedule::kPreview;
-  if (f.schedule != "auto") {
-    if (Status st = Parse(f.schedule, &schedule); !st.ok()) return Fail("--schedule: " + st.message(), kExitUsage);
-  }
+  if (Status st = RefuseQualityGoal(f.pipe.engine, cmd); !st.ok()) return Fail(st.message(), kExitUsage);
   if (Status st = toolkit::CheckExrFormat(f.pipe.exr); !st.ok()) return Fail(st.message(), kExitUsage);
   if (Status st = toolkit::CheckOutputs({{"scene", f.scene}}, {{"-o", output},
                                                                {"--stats", stats},
@@ -242,9 +238,9 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   const double guidesRenderS = keys.count("guides_seconds") ? std::atof(keys.at("guides_seconds").c_str()) : 0.0;
   const std::string layer = keys.count("view_layer") ? PercentDecoded(keys.at("view_layer")) : "ViewLayer";
   const ProviderCapabilities caps = provider->Capabilities();
-  if (f.schedule == "auto") schedule = ChooseSchedule(provider->roundCost());
-  if (schedule == RoundSchedule::kPreview && !provider->hasPreview())
-    return Fail("'" + f.scene + "': the Blender child serves no preview (capability 'preview')");
+  RoundSchedule schedule = RoundSchedule::kLevels;
+  if (Status st = ScheduleFor(f.rounds, provider->roundCost(), provider->hasPreview(), &schedule); !st.ok())
+    return Fail("'" + f.scene + "': " + st.message());
   if (options.fullEvaluation) {
     // The baseline: every pixel in one render call.
     schedule = RoundSchedule::kLevels;
@@ -273,7 +269,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     st = provider->FetchPreview({options.textureSplit && caps.splitRadiance, false}, &preview);
     previewS = Since(tp);
     PreviewScheduleOptions so;
-    so.maxRounds = f.maxRounds;
+    so.maxRounds = f.rounds.maxRounds;
     if (st.ok()) st = ReconstructWithPreview(timed, *preview, options, so, &rec, &sched);
   } else {
     st = Reconstruct(timed, options, &rec);
@@ -401,20 +397,13 @@ Registration reg("blender", "Render a .blend with Cycles at the pixels DCM asks 
                    app->add_option("--preview-samples", f->previewSamples,
                                    "samples of the guides and preview render (0: a sixteenth of --samples, at least 4)")
                        ->transform(Integer(0, 1 << 24));
-                   app->add_option("--schedule", f->schedule,
-                                   "rounds: preview (plan on the preview, few render calls), levels (one call per "
-                                   "refinement step), auto (from the round cost Blender reports)")
-                       ->check(CLI::IsMember({"auto", "preview", "levels"}))
-                       ->capture_default_str();
-                   app->add_option("--max-rounds", f->maxRounds, "render calls for exact pixels at most (preview)")
-                       ->transform(Integer(1, 1000))
-                       ->capture_default_str();
                    app->add_option("--render-threads", f->renderThreads, "Cycles threads (0: Blender's choice)")
                        ->transform(Integer(0, kMaxThreads));
                    app->option_defaults()->group(kGroupGeneral);
                    AddProviderTimeoutFlags(app, &f->pipe);
                    AddExrFormatFlags(app, &f->pipe.exr);
                    AddEngineFlags(app, &f->pipe.engine);
+                   AddRoundFlags(app, &f->rounds);
                    return [f] { return Run(*f); };
                  });
 

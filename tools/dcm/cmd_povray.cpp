@@ -126,6 +126,7 @@ int RunPovray(const PovrayFlags& f) {
   if (Status st = ParseSize(f.size, &outW, &outH); !st.ok()) return Fail(st.message(), kExitUsage);
   ReconstructionOptions options;
   if (Status st = ToOptions(f.engine, &options); !st.ok()) return Fail(st.message(), kExitUsage);
+  if (Status st = RefuseQualityGoal(f.engine, "povray"); !st.ok()) return Fail(st.message(), kExitUsage);
   if (Status st = toolkit::CheckExrFormat(f.exr); !st.ok()) return Fail(st.message(), kExitUsage);
   const bool full = options.fullEvaluation;
   if (full && !f.sampleMap.empty())

@@ -204,6 +204,15 @@ Status ScheduleFor(const RoundFlags& flags, const RoundCost& cost, bool previewA
   return Status::Ok();
 }
 
+Status RefuseQualityGoal(const EngineFlags& f, const std::string& command) {
+  if (!f.targetPsnr && !f.budget) return Status::Ok();
+  // The quality search reruns the engine level by level on a sample cache;
+  // with a renderer whose rounds cost a latency it would pay one per step.
+  return Status::Error(std::string(f.targetPsnr ? "--target-psnr" : "--budget") + ": not with dcm " + command +
+                       " yet (its rounds are planned on a preview; set --threshold, or reconstruct its passes with "
+                       "dcm reconstruct --target-psnr)");
+}
+
 Status CheckDownsample(int width, int height, int n, const std::string& what) {
   if (n > 1 && (width % n != 0 || height % n != 0))
     return Status::Error("--downsample " + std::to_string(n) + ": " + what + " " + std::to_string(width) + "x" +

@@ -1,124 +1,224 @@
-"""The add-on's operator, panel and preferences. The render itself is
-`dcm blender` on a saved copy of the open file, run in the background while
-Blender stays responsive; its result is loaded as the image "DCM Result"."""
+"""The add-on's operator, panel and preferences. "Render with DCM" runs
+`dcm blender` (the headless command) on a copy of the open file as it is in
+memory, in its own session so that Esc stops it and its Blender; the result
+is loaded as the image "DCM Result". The open file is never modified."""
+
+import json
 import os
-import shlex
 import shutil
-import subprocess
 import tempfile
 
 import bpy
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
+
+from . import runner
+
+RESULT_IMAGE = "DCM Result"
 
 
-def command(prefs, settings, blend, out, stats):
-    """The `dcm blender` command line for the settings (the headless command)."""
-    cmd = [prefs.dcm_path or "dcm", "blender", blend, "-o", out, "--stats", stats, "-q",
-           "--blender", bpy.app.binary_path,
-           "--method", settings.method, "--max-rounds", str(settings.max_rounds)]
-    if settings.samples:
-        cmd += ["--samples", str(settings.samples)]
-    if settings.preview_samples:
-        cmd += ["--preview-samples", str(settings.preview_samples)]
-    if settings.threshold > 0:
-        cmd += ["--threshold", "%g" % settings.threshold]
-    if settings.full:
-        cmd += ["--full"]
-    return cmd
+def find_dcm(context):
+    """The dcm executable: the add-on preference, else `dcm` on PATH."""
+    prefs = context.preferences.addons[__package__].preferences if __package__ in context.preferences.addons else None
+    path = bpy.path.abspath(prefs.dcm_path) if prefs and prefs.dcm_path else ""
+    return path or shutil.which("dcm") or ""
 
 
 class DCMPreferences(bpy.types.AddonPreferences):
     bl_idname = __package__
 
-    dcm_path: bpy.props.StringProperty(
-        name="dcm executable", subtype="FILE_PATH", default="",
-        description="The dcm command (empty: 'dcm' on PATH)")
+    dcm_path: StringProperty(
+        name="dcm executable",
+        description="Path of the dcm command (empty: dcm on PATH)",
+        subtype="FILE_PATH",
+        default="",
+    )
 
     def draw(self, context):
         self.layout.prop(self, "dcm_path")
+        found = find_dcm(context)
+        self.layout.label(text="Using: " + (found or "dcm not found"), icon="CHECKMARK" if found else "ERROR")
 
 
 class DCMSettings(bpy.types.PropertyGroup):
-    samples: bpy.props.IntProperty(name="Samples", default=0, min=0,
-                                   description="Cycles samples of the exact pixels (0: the scene's)")
-    preview_samples: bpy.props.IntProperty(name="Preview Samples", default=0, min=0,
-                                           description="Samples of the guides and preview render (0: default)")
-    method: bpy.props.EnumProperty(name="Method", default="dcm", items=[
+    method: EnumProperty(name="Method", default="dcm", items=[
         ("dcm", "DCM", "dcm's refinements (the default)"),
-        ("paper", "Paper", "the paper's algorithm"),
+        ("paper", "Paper", "Scheel et al. 2001 as written"),
         ("guo", "Guo", "Guo 1998")])
-    threshold: bpy.props.FloatProperty(name="Threshold", default=0.0, min=0.0, max=1.0,
-                                       description="Contrast threshold (0: the method's default); lower: more "
-                                                   "exact pixels, closer to the full render")
-    max_rounds: bpy.props.IntProperty(name="Max Render Calls", default=3, min=1, max=100,
-                                      description="Render calls for exact pixels at most")
-    full: bpy.props.BoolProperty(name="Full Render", default=False,
-                                 description="Render every pixel exactly (the baseline)")
+    threshold: FloatProperty(name="Threshold", default=0.0, min=0.0, max=1.0, precision=3,
+                             description="Contrast threshold (0: the method's default); lower: more exact pixels, "
+                                         "closer to the full render")
+    samples: IntProperty(name="Samples", description="Cycles samples of the exact pixels (0: the scene's)",
+                         default=0, min=0, max=1 << 20)
+    preview_samples: IntProperty(name="Preview Samples", default=0, min=0, max=1 << 20,
+                                 description="Samples of the guides and preview render (0: dcm's default)")
+    full: BoolProperty(name="Full Render", default=False,
+                       description="Render every pixel exactly through dcm (the baseline)")
+    schedule: EnumProperty(
+        name="Rounds",
+        description="How Cycles is asked for the exact pixels",
+        items=[
+            ("auto", "Auto", "Plan on a preview where a render call costs much (Cycles: always)"),
+            ("preview", "Preview", "Choose the pixels on a cheap preview, then a few render calls"),
+            ("levels", "Levels", "A render call per refinement step (many calls)"),
+        ],
+        default="auto",
+    )
+    max_rounds: IntProperty(name="Max rounds", description="Render calls for exact pixels at most",
+                            default=3, min=1, max=50)
+    output: StringProperty(name="Output", description="Keep the EXR here (empty: a temporary file)",
+                           subtype="FILE_PATH", default="")
+    sample_map: BoolProperty(name="Sample map", description="Also load the sample map as 'DCM Sample Map'",
+                             default=False)
+    extra: StringProperty(name="Extra flags", description="More dcm blender flags, as on the command line",
+                          default="")
 
 
-class DCM_OT_render(bpy.types.Operator):
-    """Render the scene with Cycles at the pixels DCM asks for (dcm blender)"""
-    bl_idname = "render.dcm_render"
-    bl_label = "Render with DCM"
+def _render_source(context, workdir):
+    """The .blend dcm renders: a copy of the open file as it is in memory
+    (is_dirty misses changes made by scripts, so the saved file may be stale)."""
+    copy = os.path.join(workdir, "scene.blend")
+    # copy=True writes the file without making it the open one; relative
+    # paths are remapped to the copy's folder.
+    bpy.ops.wm.save_as_mainfile(filepath=copy, copy=True, check_existing=False, relative_remap=True)
+    return copy
 
-    _timer = None
-    _proc = None
 
-    def execute(self, context):
-        prefs = context.preferences.addons[__package__].preferences
-        exe = prefs.dcm_path or shutil.which("dcm")
-        if not exe or not os.path.exists(exe):
-            self.report({"ERROR"}, "dcm not found: set its path in the add-on's preferences")
-            return {"CANCELLED"}
-        self._dir = tempfile.mkdtemp(prefix="dcm-render-")
-        blend = os.path.join(self._dir, "scene.blend")
-        # A copy: the open file, its path and its unsaved state stay as they are.
-        bpy.ops.wm.save_as_mainfile(filepath=blend, copy=True)
-        self._out = os.path.join(self._dir, "dcm.exr")
-        cmd = command(prefs, context.scene.dcm, blend, self._out, os.path.join(self._dir, "dcm.json"))
-        cmd[0] = exe
-        print("DCM:", " ".join(shlex.quote(c) for c in cmd))
-        self._log = open(os.path.join(self._dir, "dcm.log"), "w+")
-        self._proc = subprocess.Popen(cmd, stdout=self._log, stderr=subprocess.STDOUT)
-        self._timer = context.window_manager.event_timer_add(0.5, window=context.window)
-        context.window_manager.modal_handler_add(self)
-        self.report({"INFO"}, "DCM render started")
-        return {"RUNNING_MODAL"}
+def _build(context, workdir):
+    s = context.scene.dcm
+    dcm = find_dcm(context)
+    if not dcm:
+        raise RuntimeError("dcm not found: set its path in the add-on's preferences or put it on PATH")
+    if not (os.path.isfile(dcm) and os.access(dcm, os.X_OK)):
+        raise RuntimeError("dcm not found at '%s' (the add-on's preferences)" % dcm)
+    # Without an output named, the EXR goes to Blender's session folder, which
+    # Blender removes at exit: the image reads from it until then.
+    out = bpy.path.abspath(s.output) if s.output else os.path.join(
+        bpy.app.tempdir or tempfile.gettempdir(), "dcm_result_%s.exr" % os.path.basename(workdir))
+    if os.path.isdir(out):
+        raise RuntimeError("Output '%s' is a folder; name a file" % out)
+    cmd = runner.command_line(
+        dcm, _render_source(context, workdir), out,
+        blender=bpy.app.binary_path or None,
+        stats=os.path.join(workdir, "stats.json"),
+        sample_map=os.path.join(workdir, "sample_map.png") if s.sample_map else None,
+        samples=s.samples, preview_samples=s.preview_samples, method=s.method, full=s.full,
+        threshold=s.threshold if s.threshold > 0 and not s.full else None,
+        schedule=s.schedule, max_rounds=s.max_rounds,
+        view_layer=context.view_layer.name, frame=context.scene.frame_current, extra=s.extra)
+    return cmd, out
 
-    def modal(self, context, event):
-        if event.type == "ESC":
-            self._proc.terminate()  # dcm ends its Blender child and writes nothing
-            self._proc.wait()
-            self._finish(context)
-            self.report({"WARNING"}, "DCM render cancelled")
-            return {"CANCELLED"}
-        if event.type != "TIMER" or self._proc.poll() is None:
-            return {"PASS_THROUGH"}
-        self._finish(context)
-        if self._proc.returncode != 0:
-            self._log.seek(0)
-            lines = [l for l in self._log.read().splitlines() if "error" in l] or ["dcm failed"]
-            self.report({"ERROR"}, lines[-1][:500])
-            return {"CANCELLED"}
-        img = bpy.data.images.get("DCM Result")
-        if img is not None:
-            bpy.data.images.remove(img)
-        img = bpy.data.images.load(self._out)
-        img.name = "DCM Result"
+
+def _show(path, name, pack):
+    """Loads `path` as the image `name`, replacing an older one; `pack`: into
+    the .blend's memory, for a file about to be removed."""
+    old = bpy.data.images.get(name)
+    if old:
+        bpy.data.images.remove(old)
+    img = bpy.data.images.load(path, check_existing=False)
+    img.name = name
+    if pack:
         img.pack()
-        shutil.rmtree(self._dir, ignore_errors=True)
-        for area in context.screen.areas:
+    return img
+
+
+def _finish(operator, context, run, out, workdir):
+    code = run.wait()
+    if code != 0:
+        operator.report({"ERROR"}, "dcm blender failed (exit %d): %s" % (code, run.error_text() or "no message"))
+        return {"CANCELLED"}
+    img = _show(out, RESULT_IMAGE, False)
+    if context.scene.dcm.sample_map and os.path.exists(os.path.join(workdir, "sample_map.png")):
+        _show(os.path.join(workdir, "sample_map.png"), "DCM Sample Map", True)
+    summary = "DCM: done"
+    try:
+        with open(os.path.join(workdir, "stats.json")) as f:
+            st = json.load(f)
+        wall = st.get("blender", {}).get("wall_s")
+        summary = "DCM: %.1f %% of the pixels rendered%s" % (
+            100.0 * st["exact_fraction"], " in %.1f s" % wall if wall is not None else "")
+    except (OSError, ValueError, KeyError):
+        pass
+    operator.report({"INFO"}, summary)
+    for window in context.window_manager.windows if context.window_manager else []:
+        for area in window.screen.areas:
             if area.type == "IMAGE_EDITOR":
                 area.spaces.active.image = img
                 break
-        self.report({"INFO"}, "DCM render done: image 'DCM Result'")
-        return {"FINISHED"}
+    return {"FINISHED"}
 
-    def _finish(self, context):
-        context.window_manager.event_timer_remove(self._timer)
-        self._log.close()
-        keep = self._proc.returncode == 0
-        if not keep:
-            shutil.rmtree(self._dir, ignore_errors=True)
+
+class RENDER_OT_dcm_render(bpy.types.Operator):
+    """Render the current frame with DCM: Cycles renders only the pixels DCM needs"""
+
+    bl_idname = "render.dcm_render"
+    bl_label = "Render with DCM"
+    bl_options = {"REGISTER"}
+
+    _timer = None
+    _run = None
+
+    @classmethod
+    def poll(cls, context):
+        return context.scene is not None
+
+    def _start(self, context):
+        self._workdir = tempfile.mkdtemp(prefix="dcm-blender-")
+        try:
+            cmd, self._out = _build(context, self._workdir)
+        except (RuntimeError, OSError) as e:
+            shutil.rmtree(self._workdir, ignore_errors=True)
+            self.report({"ERROR"}, str(e))
+            return False
+        self._run = runner.Run(cmd)
+        return True
+
+    def _cleanup(self):
+        shutil.rmtree(self._workdir, ignore_errors=True)
+
+    def execute(self, context):
+        # Without an event loop (blender -b, scripts): run to the end.
+        if not self._start(context):
+            return {"CANCELLED"}
+        try:
+            return _finish(self, context, self._run, self._out, self._workdir)
+        finally:
+            self._cleanup()
+
+    def invoke(self, context, event):
+        if bpy.app.background:
+            return self.execute(context)
+        if not self._start(context):
+            return {"CANCELLED"}
+        wm = context.window_manager
+        self._timer = wm.event_timer_add(0.25, window=context.window)
+        wm.progress_begin(0, 100)
+        wm.modal_handler_add(self)
+        return {"RUNNING_MODAL"}
+
+    def modal(self, context, event):
+        wm = context.window_manager
+        if event.type == "ESC":
+            self._run.cancel()
+            self._end(context)
+            self.report({"WARNING"}, "DCM render cancelled")
+            return {"CANCELLED"}
+        if event.type != "TIMER":
+            return {"PASS_THROUGH"}
+        wm.progress_update(int(100 * self._run.fraction))
+        context.workspace.status_text_set("DCM: %s %d%% (Esc cancels)" % (self._run.stage, 100 * self._run.fraction))
+        if self._run.poll() is None:
+            return {"PASS_THROUGH"}
+        result = _finish(self, context, self._run, self._out, self._workdir)
+        self._end(context)
+        return result
+
+    def _end(self, context):
+        wm = context.window_manager
+        if self._timer:
+            wm.event_timer_remove(self._timer)
+        wm.progress_end()
+        context.workspace.status_text_set(None)
+        self._cleanup()
 
 
 class RENDER_PT_dcm(bpy.types.Panel):
@@ -133,28 +233,39 @@ class RENDER_PT_dcm(bpy.types.Panel):
 
     def draw(self, context):
         s = context.scene.dcm
-        col = self.layout.column()
-        for name in ("samples", "preview_samples", "method", "threshold", "max_rounds", "full"):
-            col.prop(s, name)
-        col.operator(DCM_OT_render.bl_idname, icon="RENDER_STILL")
+        layout = self.layout
+        layout.use_property_split = True
+        layout.prop(s, "method")
+        layout.prop(s, "threshold")
+        layout.prop(s, "samples")
+        layout.prop(s, "preview_samples")
+        layout.prop(s, "full")
+        col = layout.column(heading="Rounds")
+        col.prop(s, "schedule", text="Schedule")
+        col.prop(s, "max_rounds")
+        layout.prop(s, "output")
+        layout.prop(s, "sample_map")
+        layout.prop(s, "extra")
+        layout.operator(RENDER_OT_dcm_render.bl_idname, icon="RENDER_STILL")
 
 
-def menu(self, context):
-    self.layout.operator(DCM_OT_render.bl_idname, icon="RENDER_STILL")
+def menu_func(self, context):
+    self.layout.separator()
+    self.layout.operator(RENDER_OT_dcm_render.bl_idname, icon="RENDER_STILL")
 
 
-classes = (DCMPreferences, DCMSettings, DCM_OT_render, RENDER_PT_dcm)
+_classes = (DCMPreferences, DCMSettings, RENDER_OT_dcm_render, RENDER_PT_dcm)
 
 
 def register():
-    for c in classes:
+    for c in _classes:
         bpy.utils.register_class(c)
-    bpy.types.Scene.dcm = bpy.props.PointerProperty(type=DCMSettings)
-    bpy.types.TOPBAR_MT_render.append(menu)
+    bpy.types.Scene.dcm = PointerProperty(type=DCMSettings)
+    bpy.types.TOPBAR_MT_render.append(menu_func)
 
 
 def unregister():
-    bpy.types.TOPBAR_MT_render.remove(menu)
+    bpy.types.TOPBAR_MT_render.remove(menu_func)
     del bpy.types.Scene.dcm
-    for c in reversed(classes):
+    for c in reversed(_classes):
         bpy.utils.unregister_class(c)
