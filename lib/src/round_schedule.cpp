@@ -215,17 +215,16 @@ Status ImagePreviewProvider::Guides(const Bounds2i&, const GuideRequest&, GuideI
   return Status::Error("a preview has no guides");
 }
 
-RGB ImagePreviewProvider::Lookup(const std::vector<RGB>& image, const Point2i& p) const {
-  // Pixel centres map to pixel centres: a preview at the working resolution
-  // returns its own pixels.
-  const float fx = std::clamp((float(p.x) + 0.5f) * float(previewWidth_) / float(workWidth_) - 0.5f,
-                              0.f, float(previewWidth_ - 1));
-  const float fy = std::clamp((float(p.y) + 0.5f) * float(previewHeight_) / float(workHeight_) - 0.5f,
-                              0.f, float(previewHeight_ - 1));
+RGB UpsampleBilinear(const std::vector<RGB>& image, int previewWidth, int previewHeight, int workWidth,
+                     int workHeight, const Point2i& p) {
+  const float fx = std::clamp((float(p.x) + 0.5f) * float(previewWidth) / float(workWidth) - 0.5f, 0.f,
+                              float(previewWidth - 1));
+  const float fy = std::clamp((float(p.y) + 0.5f) * float(previewHeight) / float(workHeight) - 0.5f, 0.f,
+                              float(previewHeight - 1));
   const int x0 = int(fx), y0 = int(fy);
-  const int x1 = std::min(x0 + 1, previewWidth_ - 1), y1 = std::min(y0 + 1, previewHeight_ - 1);
+  const int x1 = std::min(x0 + 1, previewWidth - 1), y1 = std::min(y0 + 1, previewHeight - 1);
   const float ax = fx - float(x0), ay = fy - float(y0);
-  auto at = [&](int x, int y) { return image[size_t(y) * size_t(previewWidth_) + size_t(x)]; };
+  auto at = [&](int x, int y) { return image[size_t(y) * size_t(previewWidth) + size_t(x)]; };
   return (at(x0, y0) * (1.f - ax) + at(x1, y0) * ax) * (1.f - ay) +
          (at(x0, y1) * (1.f - ax) + at(x1, y1) * ax) * ay;
 }
@@ -243,10 +242,13 @@ Status ImagePreviewProvider::Evaluate(std::span<const Point2i> pixels, const Sam
   for (size_t i = 0; i < pixels.size(); ++i) {
     ExactSample& s = out[i];
     s = ExactSample{};
-    s.L = Lookup(L_, pixels[i]);
+    auto at = [&](const std::vector<RGB>& image) {
+      return UpsampleBilinear(image, previewWidth_, previewHeight_, workWidth_, workHeight_, pixels[i]);
+    };
+    s.L = at(L_);
     if (what.split) {
-      s.Li = Lookup(Li_, pixels[i]);
-      s.Lc = Lookup(Lc_, pixels[i]);
+      s.Li = at(Li_);
+      s.Lc = at(Lc_);
     }
   }
   return Status::Ok();

@@ -72,6 +72,12 @@ Status ReconstructWithPreview(SampleProvider& exact, SampleProvider& preview,
                               const PreviewScheduleOptions& schedule, Reconstruction* out,
                               PreviewScheduleStats* scheduleStats = nullptr);
 
+/// The value of `image` (previewWidth x previewHeight, row-major) at work
+/// pixel `p` of a workWidth x workHeight image: bilinear between pixel
+/// centres, clamped at the edges (the same resolution returns its pixels).
+RGB UpsampleBilinear(const std::vector<RGB>& image, int previewWidth, int previewHeight, int workWidth,
+                     int workHeight, const Point2i& p);
+
 /// A provider of stand-in samples from a dense image at `scale` times coarser
 /// resolution than the working image (1: the same), upsampled bilinearly:
 /// L, and L_i/L_c when given (empty vectors: not given). For previews that a
@@ -86,7 +92,6 @@ class ImagePreviewProvider : public SampleProvider {
                   std::span<ExactSample> out) override;
 
  private:
-  RGB Lookup(const std::vector<RGB>& image, const Point2i& p) const;
   int workWidth_, workHeight_, previewWidth_, previewHeight_;
   std::vector<RGB> L_, Li_, Lc_;
 };

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 
+#include "dcm/round_schedule.h"
+
 namespace dcm::povray {
 
 PovrayPreview::PovrayPreview(const PovrayProvider& exact, int previewWidth, int previewHeight, std::vector<RGB> Li,
@@ -28,19 +30,6 @@ ProviderCapabilities PovrayPreview::Capabilities() const {
 
 Status PovrayPreview::Guides(const Bounds2i&, const GuideRequest&, GuideImage*) {
   return Status::Error("a preview has no guides");
-}
-
-RGB PovrayPreview::Bilinear(const std::vector<RGB>& image, const Point2i& p) const {
-  // Pixel centres map to pixel centres.
-  const float fx = std::clamp((float(p.x) + 0.5f) * float(previewWidth_) / float(width_) - 0.5f, 0.f,
-                              float(previewWidth_ - 1));
-  const float fy = std::clamp((float(p.y) + 0.5f) * float(previewHeight_) / float(height_) - 0.5f, 0.f,
-                              float(previewHeight_ - 1));
-  const int x0 = int(fx), y0 = int(fy);
-  const int x1 = std::min(x0 + 1, previewWidth_ - 1), y1 = std::min(y0 + 1, previewHeight_ - 1);
-  const float ax = fx - float(x0), ay = fy - float(y0);
-  auto at = [&](int x, int y) { return image[size_t(y) * size_t(previewWidth_) + size_t(x)]; };
-  return (at(x0, y0) * (1.f - ax) + at(x1, y0) * ax) * (1.f - ay) + (at(x0, y1) * (1.f - ax) + at(x1, y1) * ax) * ay;
 }
 
 Status PovrayPreview::Evaluate(std::span<const Point2i> pixels, const SampleRequest& what,
@@ -71,8 +60,8 @@ Status PovrayPreview::Evaluate(std::span<const Point2i> pixels, const SampleRequ
       s.Li = samples[size_t(best)].Li;
       s.Lc = samples[size_t(best)].Lc;
     } else {
-      s.Li = Bilinear(Li_, p);
-      s.Lc = Bilinear(Lc_, p);
+      s.Li = UpsampleBilinear(Li_, previewWidth_, previewHeight_, width_, height_, p);
+      s.Lc = UpsampleBilinear(Lc_, previewWidth_, previewHeight_, width_, height_, p);
     }
     s.L = s.Li * tau[i] + s.Lc;
     if (!what.split) s.Li = s.Lc = RGB{};

@@ -30,7 +30,6 @@ class PovrayPreview final : public SampleProvider {
                   std::span<ExactSample> out) override;
 
  private:
-  RGB Bilinear(const std::vector<RGB>& image, const Point2i& p) const;
   const PovrayProvider& exact_;
   int width_, height_, previewWidth_, previewHeight_, radius_;
   std::vector<RGB> Li_, Lc_;
