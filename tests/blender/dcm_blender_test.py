@@ -87,8 +87,12 @@ def errors(dcm, blender, src, tmp):
     open(text, "w").write("not a blend file\n")
     refused([text, "-o", out, "--blender", blender], text, "not a .blend file")
     refused([blend, "-o", out, "--blender", os.path.join(tmp, "no-blender")], "no-blender", "not found")
-    env = dict(os.environ, DCM_BLENDER_TEST_FAULT="crash-on-eval")
+    # Blender dies mid-round: its scratch folder (made by dcm under TMPDIR) goes too.
+    scratch = os.path.join(tmp, "scratch")
+    os.mkdir(scratch)
+    env = dict(os.environ, DCM_BLENDER_TEST_FAULT="crash-on-eval", TMPDIR=scratch)
     refused([blend, "-o", out, "--blender", blender], blend, "signal", env=env)
+    assert os.listdir(scratch) == [], os.listdir(scratch)
     refused([blend, "-o", os.path.join(tmp, "no-such-dir", "out.exr"), "--blender", blender], "no-such-dir")
     refused([blend, "-o", out, "--blender", blender, "--target-psnr", "40"], "--target-psnr: not with dcm blender",
             code=2)

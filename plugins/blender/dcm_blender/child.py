@@ -37,6 +37,8 @@ def parse_args(argv):
     ap.add_argument("--border-tile", type=int, default=0,
                     help="tests: render every round within borders over tiles of this size")
     ap.add_argument("--mask-scale", type=int, default=4, help="mask texels per pixel and side")
+    ap.add_argument("--workdir", default="",
+                    help="scratch folder for masks and renders, made and removed by dcm (default: one of its own)")
     ap.add_argument("--verbose", action="store_true", help="the time of each render call on stderr")
     ap.add_argument("--protocol-fd", type=int, default=-1, help="descriptor of the protocol's output")
     ap.add_argument("--verify-restore", action="store_true",
@@ -128,7 +130,8 @@ def main(argv):
     if not hello.startswith("dcm-pipe "):
         proto.send("error expected 'dcm-pipe 1', got '%s'" % hello[:60])
         return 1
-    workdir = tempfile.mkdtemp(prefix="dcm-blender-")
+    own_workdir = not args.workdir
+    workdir = tempfile.mkdtemp(prefix="dcm-blender-") if own_workdir else args.workdir
     session = scene.Session(args, workdir)
     before = session.fingerprint() if args.verify_restore else None
     status = 0
@@ -155,7 +158,8 @@ def main(argv):
         status = 1
     finally:
         session.restore()
-        shutil.rmtree(workdir, ignore_errors=True)
+        if own_workdir:
+            shutil.rmtree(workdir, ignore_errors=True)
     if before is not None and session.fingerprint() != before:
         import difflib
         diff = difflib.unified_diff(before.splitlines(), session.fingerprint().splitlines(), lineterm="")
