@@ -27,6 +27,7 @@ std::string_view ToString(SampleReason r) {
     case SampleReason::kThinObject: return "thin_object";
     case SampleReason::kFallback: return "fallback";
     case SampleReason::kFull: return "full";
+    case SampleReason::kPreviewStandIn: return "preview_stand_in";
     case SampleReason::kCount: break;
   }
   return "?";

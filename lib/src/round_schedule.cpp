@@ -172,6 +172,17 @@ Status ReconstructWithPreview(SampleProvider& exact, SampleProvider& preview,
       const bool small = double(wanted.size()) < schedule.minRoundShare * total;
       if (wanted.empty() || stats.rounds == schedule.maxRounds || small) {
         stats.previewStandIns = int64_t(wanted.size());
+        // What was not rendered is not exact: the sample map and the counts say so.
+        const int W = out->workWidth;
+        for (const Point2i& p : wanted) {
+          SampleReason& reason = out->sampleMap[size_t(p.y) * size_t(W) + size_t(p.x)];
+          if (reason != SampleReason::kInterpolated && reason != SampleReason::kPreviewStandIn) {
+            --out->stats.byReason[size_t(reason)];
+            --out->stats.exactPixels;
+          }
+          reason = SampleReason::kPreviewStandIn;
+          ++out->stats.byReason[size_t(SampleReason::kPreviewStandIn)];
+        }
         break;
       }
       const auto exactStart = std::chrono::steady_clock::now();

@@ -115,6 +115,15 @@ TEST(RoundSchedule, TheLastRoundLeavesStandInsAndSaysSo) {
   // beyond the one round are counted, not silently made up.
   EXPECT_GT(stats.previewStandIns, 0);
   EXPECT_EQ(truth.TotalEvaluations(), stats.pixelsPerRound.at(0));
+  // The sample map shows them, and they do not count as exact.
+  int64_t standIns = 0, exactInMap = 0;
+  for (SampleReason r : planned.sampleMap) {
+    standIns += r == SampleReason::kPreviewStandIn;
+    exactInMap += r != SampleReason::kPreviewStandIn && r != SampleReason::kInterpolated;
+  }
+  EXPECT_EQ(standIns, stats.previewStandIns);
+  EXPECT_EQ(exactInMap, planned.stats.exactPixels);
+  EXPECT_LE(planned.stats.exactPixels, truth.TotalEvaluations()) << "exact pixels were rendered";
 }
 
 TEST(RoundSchedule, MinRoundShareStopsBeforeASmallRound) {
@@ -129,7 +138,8 @@ TEST(RoundSchedule, MinRoundShareStopsBeforeASmallRound) {
   ASSERT_TRUE(ReconstructWithPreview(truth, preview, {}, schedule, &planned, &stats).ok());
   EXPECT_EQ(stats.rounds, 0);
   EXPECT_EQ(truth.TotalEvaluations(), 0);
-  EXPECT_EQ(stats.previewStandIns, planned.stats.exactPixels);
+  EXPECT_GT(stats.previewStandIns, 0);
+  EXPECT_EQ(planned.stats.exactPixels, 0) << "nothing was rendered, nothing is exact";
 }
 
 TEST(RoundSchedule, BadSchedulesAndPreviewsAreRefused) {

@@ -80,6 +80,7 @@ std::array<uint8_t, 3> ReasonColor(SampleReason reason) {
     case SampleReason::kThinObject: return {255, 40, 40};       // red
     case SampleReason::kFallback: return {255, 170, 0};         // orange
     case SampleReason::kFull: return {150, 150, 255};           // lavender
+    case SampleReason::kPreviewStandIn: return {120, 80, 160};  // dull purple
     case SampleReason::kCount: break;
   }
   return {128, 64, 0};  // brown: an unknown reason (never expected)

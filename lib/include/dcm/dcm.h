@@ -83,7 +83,8 @@ enum {
   DCM_REASON_THIN_OBJECT = 6,
   DCM_REASON_FALLBACK = 7,
   DCM_REASON_FULL = 8,
-  DCM_REASON_COUNT = 9
+  DCM_REASON_PREVIEW_STAND_IN = 9, /**< left at its preview value (dcmSetRoundCost); since API version 3 */
+  DCM_REASON_COUNT = 10
 };
 
 /** Evaluates `count` pixels exactly. `xy` holds 2*count ints (x0, y0, x1, y1,

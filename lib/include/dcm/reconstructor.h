@@ -25,6 +25,9 @@ enum class SampleReason : uint8_t {
   kThinObject,        ///< interior pixel on another surface than its interpolants (3.1)
   kFallback,          ///< interior of a block no direction explains
   kFull,              ///< full evaluation (baseline)
+  /// wanted exact, left at a preview's stand-in value after the last round
+  /// (RoundSchedule::kPreview); not counted as exact
+  kPreviewStandIn,
   kCount
 };
 inline constexpr int kSampleReasonCount = int(SampleReason::kCount);

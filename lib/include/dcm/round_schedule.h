@@ -33,7 +33,7 @@ enum class RoundSchedule : uint8_t {
   /// provider evaluates them in one call; the engine runs again on the exact
   /// samples and asks for the pixels whose choice changed; and so on, up to
   /// `maxRounds` calls. Pixels still wanted after the last round keep their
-  /// preview value (reported as preview stand-ins).
+  /// preview value (SampleReason::kPreviewStandIn, not counted as exact).
   kPreview,
 };
 std::string_view ToString(RoundSchedule);
