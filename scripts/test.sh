@@ -15,8 +15,8 @@ cmake --build "$build" -j2
 # UndefinedBehaviorSanitizer (scripts/sanitize.sh runs everything; ~1 min here).
 [ "${DCM_NO_SANITIZE:-0}" = 1 ] || DCM_ASAN_BUILD_DIR="$build-asan" "$here/scripts/sanitize.sh" --quick
 # A short fuzz run (libFuzzer, clang-14): a fixed seed and a fixed number of
-# inputs per target, so that the run is the same on every machine and a
-# landing is not decided by how fast the machine was (docs/FUZZING.md). The
+# inputs per target, so that a landing is not decided by how fast the machine
+# was (docs/FUZZING.md). The
 # counts take about 10-20 s per target here; 300 s is only a cap.
 if [ "${DCM_NO_FUZZ:-0}" != 1 ]; then
   export DCM_FUZZ_SEED=${DCM_FUZZ_SEED:-1} DCM_FUZZ_BUILD_DIR="$build-fuzz"
