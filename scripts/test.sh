@@ -16,8 +16,8 @@ cmake --build "$build" -j2
 [ "${DCM_NO_SANITIZE:-0}" = 1 ] || DCM_ASAN_BUILD_DIR="$build-asan" "$here/scripts/sanitize.sh" --quick
 # A short fuzz run (libFuzzer, clang-14): a fixed seed and a fixed number of
 # inputs per target, so that a landing is not decided by how fast the machine
-# was (docs/FUZZING.md). The
-# counts take about 10-20 s per target here; 300 s is only a cap.
+# was (docs/FUZZING.md). The counts take about 10-20 s per target here; 300 s
+# is only a cap.
 if [ "${DCM_NO_FUZZ:-0}" != 1 ]; then
   export DCM_FUZZ_SEED=${DCM_FUZZ_SEED:-1} DCM_FUZZ_BUILD_DIR="$build-fuzz"
   DCM_FUZZ_RUNS=100000 "$here/scripts/fuzz.sh" 300 fuzz_scene fuzz_pipe
