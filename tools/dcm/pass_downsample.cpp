@@ -59,11 +59,11 @@ bool InCryptoLayer(const std::string& channel, const std::string& layer, int* ra
 
 std::vector<float> BoxMeanPlane(const std::vector<float>& plane, int width, int height, int n) {
   std::vector<float> out(size_t(width / n) * size_t(height / n));
-  const double w = 1.0 / double(n * n);
+  // As dcm::BoxDownsample sums the beauty: in double, row by row, then / n^2.
   ForEachBox(width, height, n, [&](size_t o, const std::vector<size_t>& box) {
     double sum = 0;
     for (size_t i : box) sum += double(plane[i]);
-    out[o] = float(sum * w);
+    out[o] = float(sum / double(box.size()));
   });
   return out;
 }

@@ -13,7 +13,8 @@
 namespace dcm::cli {
 
 /// Box mean of an N x N box per output pixel (radiance, colour, normal,
-/// depth: what a film filter averages).
+/// depth, coverage: what a film filter averages), with the beauty's
+/// arithmetic (dcm::BoxDownsample).
 std::vector<float> BoxMeanPlane(const std::vector<float>& plane, int width, int height, int n);
 
 /// The value most of the box's pixels hold (the first in scan order on a

@@ -257,7 +257,11 @@ Status BuildOutputImage(const OutputLayout& layout, const std::vector<std::strin
 
   // The input channels the layout reads. EXR compresses all channels of a
   // block of scanlines together: each part is decoded once, as float, and
-  // only UINT channels (IDs above 2^24 would not survive float) apart.
+  // only UINT channels (IDs above 2^24 would not survive float) apart. A
+  // part of the frame reads only the input rows its region covers.
+  const int rowBegin = region ? region->min.y * downsample : 0;
+  const int rowEnd = region ? region->max.y * downsample : inHeight;
+  const int rows = rowEnd - rowBegin;
   struct Part {
     int nchannels = 0;
     size_t pixels = 0;
@@ -273,8 +277,9 @@ Status BuildOutputImage(const OutputLayout& layout, const std::vector<std::strin
       auto in = OIIO::ImageInput::open(path);
       if (!in) return fail(OIIO::geterror());
       const OIIO::ImageSpec spec = in->spec(s.subimage, 0);
-      ch->ids.resize(size_t(spec.width) * size_t(spec.height));
-      if (!in->read_image(s.subimage, 0, s.index, s.index + 1, OIIO::TypeDesc::UINT, ch->ids.data()))
+      ch->ids.resize(size_t(spec.width) * size_t(rows));
+      if (!in->read_scanlines(s.subimage, 0, spec.y + rowBegin, spec.y + rowEnd, 0, s.index, s.index + 1,
+                              OIIO::TypeDesc::UINT, ch->ids.data()))
         return fail(in->geterror());
       return Status::Ok();
     }
@@ -285,9 +290,10 @@ Status BuildOutputImage(const OutputLayout& layout, const std::vector<std::strin
       if (!in) return fail(OIIO::geterror());
       const OIIO::ImageSpec spec = in->spec(s.subimage, 0);
       part.nchannels = spec.nchannels;
-      part.pixels = size_t(spec.width) * size_t(spec.height);
+      part.pixels = size_t(spec.width) * size_t(rows);
       part.values.resize(part.pixels * size_t(part.nchannels));
-      if (!in->read_image(s.subimage, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, part.values.data()))
+      if (!in->read_scanlines(s.subimage, 0, spec.y + rowBegin, spec.y + rowEnd, 0, 0, spec.nchannels,
+                              OIIO::TypeDesc::FLOAT, part.values.data()))
         return fail(in->geterror());
     }
     ch->values.resize(part.pixels);
@@ -295,6 +301,7 @@ Status BuildOutputImage(const OutputLayout& layout, const std::vector<std::strin
     return Status::Ok();
   };
   std::vector<size_t> passes;  // output channels that are passes
+  std::vector<size_t> fromInputs;  // output channels read from the inputs: whole rows of the output
   for (const auto& c : layout.channels) {
     toolkit::OutputChannel ch;
     ch.name = c.name;
@@ -309,15 +316,9 @@ Status BuildOutputImage(const OutputLayout& layout, const std::vector<std::strin
           break;
         }
         DCM_RETURN_IF_ERROR(read(*layout.alpha, &ch));
-        if (downsample > 1) {
-          // The coverage of the output pixel: the mean of its input pixels'.
-          std::vector<RGB> plane(ch.values.size());
-          for (size_t i = 0; i < plane.size(); ++i) plane[i] = RGB(ch.values[i], 0.f, 0.f);
-          int w = 0, h = 0;
-          const auto small = BoxDownsample(plane, inWidth, inHeight, downsample, &w, &h);
-          ch.values.resize(small.size());
-          for (size_t i = 0; i < small.size(); ++i) ch.values[i] = small[i].r;
-        }
+        // The coverage of the output pixel: the mean of its input pixels'.
+        if (downsample > 1) ch.values = BoxMeanPlane(ch.values, inWidth, rows, downsample);
+        fromInputs.push_back(out->channels.size());
         break;
       case OutputLayout::Kind::kPass: {
         const auto& s = layout.passes[size_t(c.index)];
@@ -325,27 +326,28 @@ Status BuildOutputImage(const OutputLayout& layout, const std::vector<std::strin
         ch.raw = s.raw;
         DCM_RETURN_IF_ERROR(read(s, &ch));
         passes.push_back(out->channels.size());
+        fromInputs.push_back(out->channels.size());
         break;
       }
     }
     out->channels.push_back(std::move(ch));
   }
   if (downsample > 1 && !passes.empty())
-    DCM_RETURN_IF_ERROR(DownsamplePasses(&out->channels, passes, layout.cryptoLayers, inWidth, inHeight, downsample));
+    DCM_RETURN_IF_ERROR(DownsamplePasses(&out->channels, passes, layout.cryptoLayers, inWidth, rows, downsample));
   if (region) {
-    // The alpha and the passes cover the whole data window: cut them to the part.
+    // What was read holds the region's rows across the whole width: cut to its columns.
     const size_t W = size_t(run.data.width());
     auto cut = [&](auto& plane) {
-      if (plane.size() != W * size_t(run.data.height())) return;  // the beauty: the part's already
+      if (plane.empty()) return;
       std::remove_reference_t<decltype(plane)> mine;
       mine.reserve(size_t(region->area()));
-      for (int y = region->min.y; y < region->max.y; ++y)
+      for (int y = 0; y < region->height(); ++y)
         for (int x = region->min.x; x < region->max.x; ++x) mine.push_back(plane[size_t(y) * W + size_t(x)]);
       plane = std::move(mine);
     };
-    for (auto& ch : out->channels) {
-      cut(ch.values);
-      cut(ch.ids);
+    for (size_t c : fromInputs) {
+      cut(out->channels[c].values);
+      cut(out->channels[c].ids);
     }
   }
   return Status::Ok();
