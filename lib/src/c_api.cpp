@@ -268,12 +268,11 @@ bool CanSetGuide(DCMReconstructor r, const char* function) noexcept {
   }
 }
 
-/// Copies a guide of three floats per pixel (width*height*3, row-major) into
-/// `out` (RGB for tau, Vec3f for normals); NULL clears it.
+/// Copies an image of three floats per pixel (n*3, row-major) into `out`
+/// (RGB for tau and previews, Vec3f for normals); NULL clears it.
 template <typename Triple>
-void CopyTriples(const DCMReconstructor r, const float* v, std::vector<Triple>* out) {
+void CopyTriples(const float* v, size_t n, std::vector<Triple>* out) {
   if (!v) return out->clear();
-  const size_t n = size_t(r->width) * size_t(r->height);
   out->resize(n);
   for (size_t i = 0; i < n; ++i) (*out)[i] = {v[3 * i], v[3 * i + 1], v[3 * i + 2]};
 }
@@ -465,12 +464,12 @@ DCM_API void dcmSetShaderIds(DCMReconstructor r, const uint32_t* ids) {
 
 DCM_API void dcmSetTexture(DCMReconstructor r, const float* rgb) {
   if (!CanSetGuide(r, "dcmSetTexture")) return;
-  Guard(r, "dcmSetTexture", [&] { CopyTriples(r, rgb, &r->texture); });
+  Guard(r, "dcmSetTexture", [&] { CopyTriples(rgb, size_t(r->width) * size_t(r->height), &r->texture); });
 }
 
 DCM_API void dcmSetNormals(DCMReconstructor r, const float* xyz) {
   if (!CanSetGuide(r, "dcmSetNormals")) return;
-  Guard(r, "dcmSetNormals", [&] { CopyTriples(r, xyz, &r->normals); });
+  Guard(r, "dcmSetNormals", [&] { CopyTriples(xyz, size_t(r->width) * size_t(r->height), &r->normals); });
 }
 
 DCM_API void dcmSetSampleFunction(DCMReconstructor r, DCMSampleFunction fn, void* user, int flags) {
@@ -517,14 +516,9 @@ DCM_API void dcmSetPreview(DCMReconstructor r, int width, int height, const floa
                           " must be 1x1 up to the image size (call dcmSetImageSize() first)");
     if (!li != !lc) return SetError(r, DCM_ERROR_INVALID_ARGUMENT, "dcmSetPreview: li and lc go together");
     const size_t n = size_t(width) * size_t(height);
-    auto copy = [n](const float* v, std::vector<dcm::RGB>* out) {
-      if (!v) return;
-      out->resize(n);
-      for (size_t i = 0; i < n; ++i) (*out)[i] = {v[3 * i], v[3 * i + 1], v[3 * i + 2]};
-    };
-    copy(rgb, &r->previewL);
-    copy(li, &r->previewLi);
-    copy(lc, &r->previewLc);
+    CopyTriples(rgb, n, &r->previewL);
+    CopyTriples(li, n, &r->previewLi);
+    CopyTriples(lc, n, &r->previewLc);
     r->previewWidth = width;
     r->previewHeight = height;
   });
