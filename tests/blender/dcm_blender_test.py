@@ -147,6 +147,9 @@ def main():
         print("blender not found: skipped")
         return 77
     tmp = tempfile.mkdtemp(prefix="dcm-blender-test-")
+    # Every Blender this test starts makes its session folder here, removed with tmp.
+    os.environ["TMPDIR"] = os.path.join(tmp, "tmpdir")
+    os.mkdir(os.environ["TMPDIR"])
     try:
         {"exact": exact, "errors": errors}[what](dcm, blender, src, tmp)
         print("ok")
