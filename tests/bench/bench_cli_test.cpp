@@ -3,6 +3,11 @@
 // against each other.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <thread>
 
 #include <algorithm>
 #include <cmath>
@@ -182,6 +187,45 @@ TEST(BenchQuick, RoomOutputsAreSane) {
 }  // namespace
 
 namespace {
+
+// SIGTERM while the bench runs: nothing of the run appears (no table, error
+// map or plot, no temporary), and the folders of --out that it made are gone.
+TEST(BenchQuick, SignalMidRunLeavesNothing) {
+  const fs::path parent = fs::temp_directory_path() / ("dcm_bench_signal_" + std::to_string(::getpid()));
+  fs::remove_all(parent);
+  fs::create_directories(parent);
+  const fs::path out = parent / "made" / "by bench";
+  const std::string scene = std::string(DCM_SOURCE_DIR) + "/examples/scenes/room.json";
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    ::execl(DCM_BINARY, DCM_BINARY, "bench", scene.c_str(), "--quick", "--threads", "1", "--out", out.c_str(),
+            "--quiet", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // With matplotlib, the signal comes once the first output (an error map) is
+  // written as a temporary: the plots take a second or more after it. Without,
+  // a second into the sweeps (the quick bench of the room takes several).
+  const auto holdsAFile = [&] {
+    std::error_code ec;
+    return fs::exists(out, ec) && !fs::is_empty(out, ec);
+  };
+  if (DCM_HAVE_MATPLOTLIB) {
+    for (int i = 0; i < 120000 && !holdsAFile() && ::waitpid(pid, nullptr, WNOHANG) == 0; ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  } else {
+    for (int i = 0; i < 600 && !fs::exists(out); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    std::this_thread::sleep_for(std::chrono::seconds(1));
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, WNOHANG), 0) << "dcm bench ended before the signal";
+  ::kill(pid, SIGTERM);
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << "status " << status;
+  EXPECT_FALSE(fs::exists(parent / "made")) << "the folders the run made are left";
+  EXPECT_TRUE(fs::is_empty(parent));
+  fs::remove_all(parent);
+}
 
 TEST(BenchNoise, SppSweepAgainstAConvergedReference) {
   // dcm bench --spp on a path-traced room at 64x64: the noise points exist

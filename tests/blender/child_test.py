@@ -24,6 +24,9 @@ def main():
         print("blender not found: skipped")
         return 77
     tmp = tempfile.mkdtemp(prefix="dcm-blender-child-test-")
+    # Every Blender this test starts makes its session folder here, removed with tmp.
+    os.environ["TMPDIR"] = os.path.join(tmp, "tmpdir")
+    os.mkdir(os.environ["TMPDIR"])
     try:
         blend = bs.make_scene(blender, src, tmp)
         digest = hashlib.sha256(open(blend, "rb").read()).hexdigest()

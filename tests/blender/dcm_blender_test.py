@@ -1,6 +1,7 @@
 """`dcm blender` on the tiny test scene: the exact pixels equal a full Cycles
 render of the same file, the .blend is unchanged, and bad input ends with a
-message naming the file and the step, exit 1, no output and no Blender left.
+message naming the file and the step, exit 1, no output and no Blender left;
+a signal to dcm (SIGTERM, SIGKILL) leaves no output, no Blender and no scratch folder.
 
     /usr/bin/python3 dcm_blender_test.py DCM BLENDER SOURCE_DIR exact|errors
 Exit 77 (skipped) when Blender is missing."""
@@ -8,9 +9,11 @@ import hashlib
 import json
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
+import time
 
 import numpy as np
 
@@ -93,6 +96,7 @@ def errors(dcm, blender, src, tmp):
     env = dict(os.environ, DCM_BLENDER_TEST_FAULT="crash-on-eval", TMPDIR=scratch)
     refused([blend, "-o", out, "--blender", blender], blend, "signal", env=env)
     assert os.listdir(scratch) == [], os.listdir(scratch)
+    signalled(dcm, blender, blend, out, scratch)
     refused([blend, "-o", os.path.join(tmp, "no-such-dir", "out.exr"), "--blender", blender], "no-such-dir")
     refused([blend, "-o", out, "--blender", blender, "--target-psnr", "40"], "--target-psnr: not with dcm blender",
             code=2)
@@ -104,12 +108,48 @@ def errors(dcm, blender, src, tmp):
     refused([eevee, "-o", out, "--blender", blender], eevee, "Cycles only")
 
 
+def signalled(dcm, blender, blend, out, scratch):
+    """A signal to dcm while Blender renders: dcm's handler (SIGTERM) or its
+    supervisor (SIGKILL) ends Blender, and the scratch folder's guardian
+    removes the folder once dcm is gone (its last removal 3 s after dcm's
+    death; 10 s allow for a loaded machine)."""
+    env = dict(os.environ, TMPDIR=scratch)
+
+    def guardian_left():
+        return subprocess.run(["pgrep", "-f", "dcm-scratch-guardian " + scratch + "/"],
+                              capture_output=True).returncode == 0
+
+    for sig in (signal.SIGTERM, signal.SIGKILL):
+        # Enough samples that the full render is still running when the signal comes.
+        p = subprocess.Popen([dcm, "blender", "-q", blend, "-o", out, "--blender", blender, "--full",
+                              "--samples", "100000"], env=env, stdout=subprocess.DEVNULL,
+                             stderr=subprocess.DEVNULL)
+        deadline = time.time() + 60
+        while time.time() < deadline and not os.listdir(scratch):
+            time.sleep(0.1)
+        assert os.listdir(scratch), "dcm made no scratch folder in 60 s"
+        time.sleep(2)
+        assert p.poll() is None, "dcm ended before the signal"
+        p.send_signal(sig)
+        assert p.wait(timeout=30) == -sig, p.returncode
+        deadline = time.time() + 10
+        while time.time() < deadline and (os.listdir(scratch) or guardian_left() or not no_blender_left(blend)):
+            time.sleep(0.1)
+        assert os.listdir(scratch) == [], (sig, os.listdir(scratch))
+        assert not guardian_left(), sig
+        assert no_blender_left(blend), (sig, "a Blender is still running")
+        assert not os.path.exists(out), sig
+
+
 def main():
     dcm, blender, src, what = sys.argv[1:5]
     if not shutil.which(blender):
         print("blender not found: skipped")
         return 77
     tmp = tempfile.mkdtemp(prefix="dcm-blender-test-")
+    # Every Blender this test starts makes its session folder here, removed with tmp.
+    os.environ["TMPDIR"] = os.path.join(tmp, "tmpdir")
+    os.mkdir(os.environ["TMPDIR"])
     try:
         {"exact": exact, "errors": errors}[what](dcm, blender, src, tmp)
         print("ok")

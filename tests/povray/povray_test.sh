@@ -55,6 +55,17 @@ clean() {
   [[ ! -e $2 ]] || fail "$1: the output $2 exists"
   [[ -z $(ls -A "$TMPDIR") ]] || fail "$1: scratch left: $(ls -A "$TMPDIR")"
   if running; then fail "$1: a POV-Ray process is left: $(pgrep -af "^$pov")"; fi
+  if guardian; then fail "$1: a scratch guardian is left: $(pgrep -af dcm-scratch-guardian)"; fi
+}
+# scratch_gone: after dcm was killed, its scratch folder's guardian removes the
+# folder and ends (its last removal is 3 s after dcm's death; 6 s allow for load).
+guardian() { pgrep -f "dcm-scratch-guardian $TMPDIR/" >/dev/null; }
+scratch_gone() {
+  for _ in $(seq 120); do
+    [[ -z $(ls -A "$TMPDIR") ]] && ! guardian && return 0
+    sleep 0.05
+  done
+  fail "the scratch folder or its guardian outlived dcm by 6 s: $(ls -A "$TMPDIR"; pgrep -af dcm-scratch-guardian)"
 }
 # expect NAME CODE PATTERN OUTPUT -- COMMAND...: exit CODE, stderr matching PATTERN, then clean.
 expect() {
@@ -129,7 +140,7 @@ EOS
   wait $pid
   rc=$?
   [[ $rc -eq 143 ]] || fail "SIGTERM: exit $rc, not 143 (killed by SIGTERM)"
-  sleep 0.2
+  scratch_gone
   clean "SIGTERM" "$out"
   ok "SIGTERM during a render: no output, no scratch, no POV-Ray"
   # SIGKILL: nothing of dcm runs to clean up, but its supervisor takes POV-Ray along.
@@ -141,8 +152,9 @@ EOS
   wait $pid 2>/dev/null
   for _ in $(seq 60); do running || break; sleep 0.05; done
   if running; then fail "SIGKILL: POV-Ray still runs 3 s after dcm died: $(pgrep -af "^$pov")"; fi
-  [[ ! -e $out ]] || fail "SIGKILL: the output $out exists"
-  ok "SIGKILL of dcm during a render: POV-Ray ends with it, no output"
+  scratch_gone
+  clean "SIGKILL" "$out"
+  ok "SIGKILL of dcm during a render: POV-Ray ends with it, no output, no scratch"
   ;;
 *) fail "unknown mode $mode" ;;
 esac

@@ -34,6 +34,7 @@ std::atomic<bool> g_installed{false};
 OutputTransaction* g_active = nullptr;
 
 constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP};
+constexpr int kFolderSlot = 3;
 
 // Who owns the temporaries: nobody (0), a commit renaming them (1), a signal
 // handler removing them (2). A signal that arrives in any thread during a
@@ -50,6 +51,14 @@ void OnSignal(int sig) {
   }
   for (auto& slot : g_slots)
     if (slot.used.load(std::memory_order_acquire) == 1) ::unlink(slot.path);
+  // The folders made for the outputs, now empty: one pass per folder removes
+  // a chain of them whatever their order in the table.
+  for (int pass = 0; pass < kSlots; ++pass) {
+    bool any = false;
+    for (auto& slot : g_slots)
+      if (slot.used.load(std::memory_order_acquire) == kFolderSlot) any |= ::rmdir(slot.path) == 0;
+    if (!any) break;
+  }
   if (auto hook = g_hook.load()) hook();
   // Die of the signal itself: the default action once the handler returns.
   ::signal(sig, SIG_DFL);
@@ -57,15 +66,16 @@ void OnSignal(int sig) {
 }
 
 /// A slot for `path` (-1 when the table is full or the path too long: the
-/// file is then only removed on the ordinary paths).
-int Register(const std::string& path) {
+/// file is then only removed on the ordinary paths); `kind` 1: a temporary
+/// file, kFolderSlot: a folder made for the outputs.
+int Register(const std::string& path, int kind = 1) {
   if (path.size() >= PATH_MAX) return -1;
   for (int i = 0; i < kSlots; ++i) {
     int expected = 0;
     // 2 = being filled: the handler skips it until it holds the whole path.
     if (g_slots[i].used.compare_exchange_strong(expected, 2, std::memory_order_acquire)) {
       std::memcpy(g_slots[i].path, path.c_str(), path.size() + 1);
-      g_slots[i].used.store(1, std::memory_order_release);
+      g_slots[i].used.store(kind, std::memory_order_release);
       return i;
     }
   }
@@ -273,11 +283,34 @@ OutputTransaction::OutputTransaction() {
 
 OutputTransaction::~OutputTransaction() {
   if (g_active == this) g_active = nullptr;
-  if (committed_) return;
-  for (const auto& p : pending_) {
-    ::unlink(p.temporary.c_str());
-    Release(p.slot);
+  if (!committed_) {
+    for (const auto& p : pending_) {
+      ::unlink(p.temporary.c_str());
+      Release(p.slot);
+    }
   }
+  RemoveFolders(!committed_);
+}
+
+Status OutputTransaction::MakeFolder(const std::string& folder) {
+  std::error_code ec;
+  std::vector<fs::path> missing;  // deepest first
+  for (fs::path p = fs::absolute(folder, ec); !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
+    missing.push_back(p);
+    if (p == p.parent_path()) break;
+  }
+  for (const auto& p : missing) folders_.push_back({p.string(), Register(p.string(), kFolderSlot)});
+  fs::create_directories(folder, ec);
+  if (ec) return Status::Error("cannot create the folder '" + folder + "': " + ec.message());
+  return Status::Ok();
+}
+
+void OutputTransaction::RemoveFolders(bool remove) {
+  for (const auto& [path, slot] : folders_) {
+    Release(slot);
+    if (remove) ::rmdir(path.c_str());  // a folder not empty stays
+  }
+  folders_.clear();
 }
 
 OutputTransaction* OutputTransaction::Active() { return g_active; }
@@ -320,6 +353,7 @@ Status OutputTransaction::Commit() {
     }
     failed = Finish(p);
   }
+  RemoveFolders(!failed.ok());
   return failed;
 }
 

@@ -8,6 +8,7 @@
 
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "dcm/status.h"
@@ -57,13 +58,22 @@ class OutputTransaction {
     bool writeThrough = false;
     int slot = -1;  ///< the temporary's slot for the signal handlers
   };
+  /// Makes `folder` and its missing parents for the outputs: the folders it
+  /// made are removed again (when empty) unless Commit() succeeds, also by the
+  /// signal handlers.
+  Status MakeFolder(const std::string& folder);
+
   /// Takes over a written temporary (internal to WriteAtomically).
   void Add(Pending pending) { pending_.push_back(std::move(pending)); }
   /// The transaction in force, or nullptr.
   static OutputTransaction* Active();
 
  private:
+  /// Releases the folders' slots and, with `remove`, removes the empty ones.
+  void RemoveFolders(bool remove);
+
   std::vector<Pending> pending_;
+  std::vector<std::pair<std::string, int>> folders_;  ///< made by MakeFolder, deepest first, with their slots
   bool committed_ = false;
 };
 

@@ -36,7 +36,9 @@
 #include "common/progress.h"
 #include "common/sample_map.h"
 #include "common/output_guard.h"
+#include "common/output_transaction.h"
 #include "common/stats_json.h"
+#include "dcm/pipe/scratch_folder.h"
 #include "dcm/reconstructor.h"
 #include "embree/embree_provider.h"
 #include "embree/scene_file.h"
@@ -595,8 +597,10 @@ int RunBench(const BenchFlags& f) {
     return kExitUsage;
   }
   std::error_code ec;
-  fs::create_directories(f.out, ec);
-  if (ec) return Fail(Status::Error("cannot create '" + f.out + "': " + ec.message()));
+  // Every output of the run (tables, error maps, plots) appears at the end,
+  // together, or none does; a folder --out that the run made goes with them.
+  toolkit::OutputTransaction transaction;
+  if (Status st = transaction.MakeFolder(f.out); !st.ok()) return Fail(Status::Error("--out: " + st.message()));
   const bool talk = !f.quiet;
   const auto tBench = std::chrono::steady_clock::now();
 
@@ -925,16 +929,22 @@ int RunBench(const BenchFlags& f) {
   const std::string csvPath = (fs::path(f.out) / "bench.csv").string();
   if (Status st = WriteText(csvPath, csv); !st.ok()) return Fail(st);
 
-  // Plots.
+  // Plots: the script reads a copy of the CSV and draws in a scratch folder
+  // (removed even if dcm is killed meanwhile); the PNGs join the transaction.
   std::vector<std::string> plots;
   std::string plotNote;
   if (!f.noPlots) {
     const std::string script = FindPlotScript(f);
+    std::unique_ptr<pipe::ScratchFolder> staging;
     if (script.empty()) {
       plotNote = "plot script tools/bench/plot_tradeoff.py not found (--plot-script)";
+    } else if (Status st = pipe::ScratchFolder::Make("dcm-bench-plots", &staging); !st.ok()) {
+      return Fail(st);
     } else {
-      const std::string cmd = ShellQuote(f.python) + " " + ShellQuote(script) + " " + ShellQuote(csvPath) + " " +
-                              ShellQuote(f.out) + (f.quiet ? " --quiet" : "");
+      const std::string stagedCsv = staging->path() + "/bench.csv";
+      std::ofstream(stagedCsv, std::ios::binary) << csv;
+      const std::string cmd = ShellQuote(f.python) + " " + ShellQuote(script) + " " + ShellQuote(stagedCsv) + " " +
+                              ShellQuote(staging->path()) + (f.quiet ? " --quiet" : "");
       if (talk) std::cerr << "dcm bench: plotting: " << cmd << "\n";
       const int rc = std::system(cmd.c_str());
       if (rc != 0) plotNote = "plot command failed (exit " + std::to_string(rc) + "): " + cmd;
@@ -943,7 +953,15 @@ int RunBench(const BenchFlags& f) {
     for (const auto& ij : inputsJson) {
       for (const char* kind : {"psnr_vs_time", "psnr_vs_exact", "noise"}) {
         const std::string name = ij["scene"].get<std::string>() + "_" + kind + ".png";
-        if (fs::is_regular_file(fs::path(f.out) / name, ec)) plots.push_back(name);
+        if (!staging || !fs::is_regular_file(fs::path(staging->path()) / name, ec)) continue;
+        const fs::path from = fs::path(staging->path()) / name;
+        Status st = toolkit::WriteAtomically((fs::path(f.out) / name).string(), [&](const std::string& tmp) {
+          std::error_code cec;
+          fs::copy_file(from, tmp, fs::copy_options::overwrite_existing, cec);
+          return cec ? Status::Error("cannot copy the plot " + from.string() + ": " + cec.message()) : Status::Ok();
+        });
+        if (!st.ok()) return Fail(st);
+        plots.push_back(name);
       }
     }
   }
@@ -960,6 +978,7 @@ int RunBench(const BenchFlags& f) {
                       {"time_s", Seconds(tBench)}};
   if (Status st = toolkit::WriteJson((fs::path(f.out) / "bench.json").string(), j); !st.ok()) return Fail(st);
   if (Status st = WriteText((fs::path(f.out) / "summary.md").string(), summary.str()); !st.ok()) return Fail(st);
+  if (Status st = transaction.Commit(); !st.ok()) return Fail(st);
   if (!f.quiet) std::cout << summary.str();
   if (talk) {
     std::cout << "dcm bench: " << all.size() << " points in " << Fmt("%.1f", Seconds(tBench)) << " s; wrote "

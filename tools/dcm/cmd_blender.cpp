@@ -35,6 +35,7 @@
 #include "common/sample_map.h"
 #include "common/stats_json.h"
 #include "dcm/pipe/pipe_provider.h"
+#include "dcm/pipe/scratch_folder.h"
 #include "dcm/reconstructor.h"
 #include "dcm/round_schedule.h"
 #include "engine_flags.h"
@@ -77,29 +78,6 @@ std::string PercentDecoded(const std::string& s) {
 double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 /// A word quoted for /bin/sh.
-/// The child's scratch folder (its masks and renders, Blender's session
-/// folder), made here and removed when the run ends, so that a Blender that
-/// dies mid-round leaves nothing.
-class ScratchFolder {
- public:
-  Status Make() {
-    const char* tmp = std::getenv("TMPDIR");
-    std::string templ = std::string(tmp && *tmp ? tmp : "/tmp") + "/dcm-blender-XXXXXX";
-    if (!::mkdtemp(templ.data()))
-      return Status::Error("cannot make a scratch folder '" + templ + "': " + std::strerror(errno));
-    path_ = templ;
-    return Status::Ok();
-  }
-  ~ScratchFolder() {
-    std::error_code ec;
-    if (!path_.empty()) fs::remove_all(path_, ec);
-  }
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
-};
-
 std::string ShellQuote(const std::string& s) {
   std::string q = "'";
   for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
@@ -237,13 +215,15 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   // Every output of the run appears at its Commit(), or none; a signal ends Blender too.
   toolkit::OutputTransaction outputs;
   toolkit::SetSignalHook(pipe::KillAllChildren);
-  ScratchFolder scratch;  // outlives the provider: removed once Blender has ended
-  if (Status st = scratch.Make(); !st.ok()) return Fail(st.message());
+  // The child's masks and renders and Blender's session folder: outlives the
+  // provider, so that it is removed once Blender has ended.
+  std::unique_ptr<pipe::ScratchFolder> scratch;
+  if (Status st = pipe::ScratchFolder::Make("dcm-blender", &scratch); !st.ok()) return Fail(st.message());
   const auto t0 = Clock::now();
   // Blender's own session folder goes inside the scratch folder too (TMPDIR).
-  std::string command = "TMPDIR=" + ShellQuote(scratch.path()) + " " + ShellQuote(blender) + " -b " +
+  std::string command = "TMPDIR=" + ShellQuote(scratch->path()) + " " + ShellQuote(blender) + " -b " +
                         ShellQuote(f.scene) + " --python " + ShellQuote(child) + " -- --protocol-fd 3 --workdir " +
-                        ShellQuote(scratch.path());
+                        ShellQuote(scratch->path());
   if (f.samples > 0) command += " --samples " + std::to_string(f.samples);
   if (f.previewSamples > 0) command += " --preview-samples " + std::to_string(f.previewSamples);
   if (frame >= 0) command += " --frame " + std::to_string(frame);

@@ -11,6 +11,7 @@
 
 #include "dcm/pipe/pipe_provider.h"
 #include "povray_process.h"
+#include "dcm/pipe/scratch_folder.h"
 #include "scratch_dir.h"
 
 namespace dcm::povray {
@@ -115,18 +116,18 @@ Status PovrayProvider::Open(const PovrayOptions& options, std::unique_ptr<Povray
   std::unique_ptr<PovrayProvider> p(new PovrayProvider(options));
   p->options_.scene = std::filesystem::absolute(options.scene, ec).string();
   DCM_RETURN_IF_ERROR(FindExecutable(options.povray, &p->povrayPath_));
-  DCM_RETURN_IF_ERROR(MakeScratch(&p->scratch_));
+  std::unique_ptr<pipe::ScratchFolder> scratch;
+  DCM_RETURN_IF_ERROR(pipe::ScratchFolder::Make("dcm-povray", &scratch));
+  p->scratch_ = scratch->path();
+  p->scratchFolder_ = std::move(scratch);
   DCM_RETURN_IF_ERROR(WriteSceneIni(p->scratch_, p->options_.scene));
   *out = std::move(p);
   return Status::Ok();
 }
 
-PovrayProvider::~PovrayProvider() { RemoveScratch(scratch_); }
+PovrayProvider::~PovrayProvider() = default;
 
-void SignalCleanup() {
-  pipe::KillAllChildren();
-  RemoveScratchOnSignal();
-}
+void SignalCleanup() { pipe::KillAllChildren(); }
 
 PovrayEnv PovrayProvider::Env() const {
   return PovrayEnv{povrayPath_, options_.scene, std::filesystem::path(options_.scene).filename().string(), scratch_,

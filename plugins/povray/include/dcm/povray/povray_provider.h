@@ -16,6 +16,10 @@
 #include "dcm/sample_provider.h"
 #include "dcm/status.h"
 
+namespace dcm::pipe {
+class ScratchFolder;
+}  // namespace dcm::pipe
+
 namespace dcm::povray {
 
 /// The passes of the convention, by their `Declare=Pass=N` number.
@@ -127,7 +131,8 @@ class PovrayProvider final : public SampleProvider {
 
   PovrayOptions options_;
   std::string povrayPath_;  ///< the executable found
-  std::string scratch_;     ///< the private folder
+  std::shared_ptr<pipe::ScratchFolder> scratchFolder_;  ///< removed with the provider
+  std::string scratch_;     ///< its path
   PovrayRunStats stats_;
   bool haveGuides_ = false;
   std::vector<uint32_t> objectId_, shaderId_;
@@ -140,7 +145,8 @@ class PovrayProvider final : public SampleProvider {
 };
 
 /// For the SIGINT/SIGTERM/SIGHUP handlers (toolkit::SetSignalHook): kills
-/// every POV-Ray process and removes the scratch folders. Async-signal-safe.
+/// every POV-Ray process (the scratch folder's guardian removes the folder once
+/// dcm is gone). Async-signal-safe.
 void SignalCleanup();
 
 }  // namespace dcm::povray
