@@ -108,6 +108,13 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
   identity["alpha"] = f.alpha;
   const nlohmann::json settings = toolkit::PartSettings(cmd, DCM_VERSION, options, identity);
 
+  // The part keeps the inputs' layout (beauty names, alpha, passes cut to
+  // the region, metadata) so that the merged frame is the whole run's.
+  OutputLayout layout;
+  if (st = PlanOutputLayout(provider, f.aov.inputs, f.aov.samples, f.alpha, options.downsample, &layout); !st.ok())
+    return aov_common::Fail(cmd, st.message());
+  options.recordInterpolation = layout.Reconstructs();
+
   aov_common::Outputs outputs(cmd);
   Reconstruction r;
   RegionInfo info;
@@ -145,16 +152,11 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
   toolkit::Metadata meta = ProvenanceMetadata(f, provider, options);
   AddPartMetadata(tile, region, settings, r, info, &meta);
 
-  // The part keeps the inputs' layout (beauty names, alpha, passes cut to
-  // the region, metadata) so that the merged frame is the whole run's.
-  OutputLayout layout;
-  if (st = PlanOutputLayout(provider, f.aov.inputs, f.alpha, options.downsample, &layout); !st.ok())
-    return aov_common::Fail(cmd, st.message());
   ExrReconstruction run;
   run.result = r;
   run.display = run.data = {{0, 0}, {frame.x, frame.y}};
   toolkit::OutputImage image;
-  st = BuildOutputImage(layout, f.aov.inputs, run, options.downsample, {}, &image, &region);
+  st = BuildOutputImage(provider, layout, f.aov.inputs, run, options.downsample, {}, &image, &region);
   int rc = outputs.Write(st.ok() ? toolkit::WritePartImage(f.output, std::move(image), meta) : st);
   if (rc) return rc;
   if (!f.sampleMap.empty() && (rc = outputs.Write(toolkit::WriteSampleMap(f.sampleMap, r)))) return rc;
@@ -241,11 +243,13 @@ int RunReconstruct(const ReconstructFlags& f) {
   // The output's channels are known from the headers: --ch is checked
   // before the engine runs.
   OutputLayout layout;
-  st = PlanOutputLayout(*provider, f.aov.inputs, f.alpha, options.downsample, &layout);
+  st = PlanOutputLayout(*provider, f.aov.inputs, f.aov.samples, f.alpha, options.downsample, &layout);
   if (!st.ok()) return aov_common::Fail(cmd, st.message());
   std::vector<size_t> order;
   if (st = toolkit::SelectChannels(layout.Names(), f.exr.channels, &order); !st.ok())
     return aov_common::Fail(cmd, st.message(), kExitUsage);
+  // The engine keeps its interpolation record only for channels written.
+  options.recordInterpolation = layout.Reconstructs(order);
   if (f.engine.verbose)
     for (const auto& note : layout.notes) std::cerr << "dcm " << cmd << ": " << note << "\n";
   aov_common::Outputs outputs(cmd);  // before the run: --progressive writes during it
@@ -264,7 +268,7 @@ int RunReconstruct(const ReconstructFlags& f) {
 
   // All outputs appear together at Commit(), or none.
   toolkit::OutputImage image;
-  st = BuildOutputImage(layout, f.aov.inputs, run, options.downsample, meta, &image);
+  st = BuildOutputImage(*provider, layout, f.aov.inputs, run, options.downsample, meta, &image);
   int rc = outputs.Write(st.ok() ? toolkit::WriteOutputExr(f.output, image, f.exr) : st);
   if (rc) return rc;
   if (!f.sampleMap.empty() && (rc = outputs.Write(toolkit::WriteSampleMap(f.sampleMap, r)))) return rc;
