@@ -378,6 +378,20 @@ TEST(OutputLayout, SparsePassesAreReconstructedWithTheBeautysInterpolation) {
     EXPECT_NEAR(sparse.Plane("depth")[i], in.Plane("depth")[i], 1.0) << "(" << x << "," << y << ")";
   }
   EXPECT_GT(interpolated, int64_t(n) / 2);
+
+  // --ch: a pass chosen is the same; none chosen, none is reconstructed.
+  for (const auto& [channels, name] : {std::pair{"R,G,B,depth", "ch.exr"}, std::pair{"R,G,B", "rgb.exr"}}) {
+    auto ch = rec;
+    ch[3] = dir / name;
+    ch[4] = "--quiet";
+    ch.insert(ch.end(), {"--ch", channels});
+    r = RunDcm(ch, dir);
+    ASSERT_EQ(r.exitCode, 0) << channels << ": " << r.err;
+  }
+  const Exr ch = ReadExr(dir / "ch.exr");
+  EXPECT_THAT(ch.names(), ::testing::UnorderedElementsAre("R", "G", "B", "depth"));
+  EXPECT_EQ(ch.Plane("depth"), sparse.Plane("depth"));
+  EXPECT_EQ(ReadExr(dir / "rgb.exr").Plane("R"), sparse.Plane("R"));
 }
 
 // Sparse parts carry the reconstructed passes of their region: merged, they

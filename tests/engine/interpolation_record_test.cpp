@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ostream>
 #include <string>
 
 #include "dcm/window_provider.h"
@@ -42,6 +44,8 @@ struct Case {
   ReconstructionOptions options;
   bool unitTexture = false;
 };
+
+void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
 
 std::vector<Case> Cases() {
   std::vector<Case> cases;
@@ -97,6 +101,8 @@ TEST_P(InterpolationRecordCase, ABeautyChannelReconstructsToTheBeautysBits) {
   EXPECT_EQ(r.stats.usedSplit, c.unitTexture);
 
   const InterpolationRecord& record = *r.interpolation;
+  std::printf("%s: record of %.1f bytes per working pixel\n", c.name.c_str(),
+              double(record.MemoryBytes()) / double(r.workImage.size()));
   EXPECT_EQ(record.window(), (Bounds2i{{0, 0}, {r.workWidth, r.workHeight}}));
   for (int ch = 0; ch < 3; ++ch) {
     std::vector<float> out;

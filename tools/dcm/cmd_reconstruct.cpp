@@ -10,6 +10,7 @@
 // pixels the engine asks for and reports the error against the full input.
 // With --samples (the file-based round trip): the inputs carry the guides and
 // the samples files the pixels rendered for `dcm plan`.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -248,8 +249,15 @@ int RunReconstruct(const ReconstructFlags& f) {
   std::vector<size_t> order;
   if (st = toolkit::SelectChannels(layout.Names(), f.exr.channels, &order); !st.ok())
     return aov_common::Fail(cmd, st.message(), kExitUsage);
-  // The engine keeps its interpolation record only for channels written.
-  options.recordInterpolation = layout.Reconstructs(order);
+  // Only the channels written are built: a pass left out is neither read
+  // nor reconstructed (the engine keeps no record for it).
+  if (!f.exr.channels.empty()) {
+    std::vector<OutputLayout::Channel> kept;
+    std::sort(order.begin(), order.end());
+    for (size_t i : order) kept.push_back(layout.channels[i]);
+    layout.channels = std::move(kept);
+  }
+  options.recordInterpolation = layout.Reconstructs();
   if (f.engine.verbose)
     for (const auto& note : layout.notes) std::cerr << "dcm " << cmd << ": " << note << "\n";
   aov_common::Outputs outputs(cmd);  // before the run: --progressive writes during it

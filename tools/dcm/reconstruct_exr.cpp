@@ -147,13 +147,11 @@ std::vector<std::string> OutputLayout::Names() const {
   return names;
 }
 
-bool OutputLayout::Reconstructs(const std::vector<size_t>& selected) const {
-  auto reconstructed = [&](const Channel& c) {
+bool OutputLayout::Reconstructs() const {
+  return std::any_of(channels.begin(), channels.end(), [&](const Channel& c) {
     return (c.kind == Kind::kPass && passes[size_t(c.index)].reconstructed) ||
            (c.kind == Kind::kAlpha && alpha && alpha->reconstructed);
-  };
-  if (selected.empty()) return std::any_of(channels.begin(), channels.end(), reconstructed);
-  return std::any_of(selected.begin(), selected.end(), [&](size_t i) { return reconstructed(channels[i]); });
+  });
 }
 
 Status PlanOutputLayout(const aov::AovProvider& provider, const std::vector<std::string>& inputs,
@@ -363,52 +361,77 @@ Status BuildOutputImage(const aov::AovProvider& provider, const OutputLayout& la
     for (size_t i = 0; i < part.pixels; ++i) ch->values[i] = part.values[i * size_t(part.nchannels) + size_t(index)];
     return Status::Ok();
   };
-  // A reconstructed channel: each exact pixel of the record's window from
-  // the samples file whose beauty it has, the others as the beauty's record
-  // says; the rows of the output's region like a copied channel's.
+  // The reconstructed channels (sparse mode) at the exact pixels of the
+  // record's window, each pixel from the samples file whose beauty it has;
+  // gathered one samples file at a time (a farm's round trip has many).
   const InterpolationRecord* record = r.interpolation.get();
-  auto reconstruct = [&](const OutputLayout::Source& s, toolkit::OutputChannel* ch) -> Status {
-    if (!record)
-      return Status::Error("channel '" + s.name + "': the reconstruction kept no interpolation record");
+  std::vector<const OutputLayout::Source*> wanted;
+  for (const auto& c : layout.channels) {
+    const OutputLayout::Source* s = c.kind == OutputLayout::Kind::kPass  ? &layout.passes[size_t(c.index)]
+                                    : c.kind == OutputLayout::Kind::kAlpha ? (layout.alpha ? &*layout.alpha : nullptr)
+                                                                           : nullptr;
+    if (s && s->reconstructed) wanted.push_back(s);
+  }
+  std::vector<std::vector<float>> exactOf(wanted.size());
+  Bounds2i w;
+  if (!wanted.empty()) {
+    if (!record) return Status::Error("channel '" + wanted[0]->name + "': the reconstruction kept no interpolation record");
     // The record covers the region's pixels and the window around them.
-    const Bounds2i w = record->window();
+    w = record->window();
     const int x0 = region ? region->min.x * downsample : 0;
     const int x1 = region ? std::min(region->max.x * downsample, inWidth) : inWidth;
     if (w.min.y > rowBegin || w.max.y < std::min(rowEnd, inHeight) || w.min.x > x0 || w.max.x < x1 ||
         w.max.x > inWidth || w.max.y > inHeight)
-      return Status::Error("channel '" + s.name + "': the interpolation record's window " + toolkit::RegionText(w) +
+      return Status::Error("the interpolation record's window " + toolkit::RegionText(w) +
                            " does not cover the output's pixels");
-    const bool ids = s.type == OIIO::TypeDesc::UINT;
-    std::vector<toolkit::OutputChannel> files(s.where.size());
-    for (size_t f = 0; f < s.where.size(); ++f)
-      DCM_RETURN_IF_ERROR(readRows(int(inputs.size() + f), s.where[f].first, s.where[f].second, s.type, s.name,
-                                   w.min.y, w.max.y, &files[f]));
     const size_t ww = size_t(w.width());
-    std::vector<float> exact(ww * size_t(w.height()), 0.f);
+    std::vector<int> fileOf(ww * size_t(w.height()), -1);
     for (int y = w.min.y; y < w.max.y; ++y)
       for (int x = w.min.x; x < w.max.x; ++x) {
         const size_t i = size_t(y - w.min.y) * ww + size_t(x - w.min.x);
         if (!record->IsExact(int64_t(i))) continue;
-        const int file = provider.SamplesFileOf({x, y});
-        if (file < 0 || size_t(file) >= files.size())
-          return Status::Error("channel '" + s.name + "': exact pixel (" + std::to_string(x) + ", " +
-                               std::to_string(y) + ") is in no samples file");
-        const size_t k = size_t(y - w.min.y) * size_t(inWidth) + size_t(x);
-        // A uint ID's bits travel in the float (ChannelKind::kId only copies).
-        if (ids) std::memcpy(&exact[i], &files[size_t(file)].ids[k], sizeof(float));
-        else exact[i] = files[size_t(file)].values[k];
+        fileOf[i] = provider.SamplesFileOf({x, y});
+        if (fileOf[i] < 0 || size_t(fileOf[i]) >= layout.samples.size())
+          return Status::Error("exact pixel (" + std::to_string(x) + ", " + std::to_string(y) +
+                               ") is in no samples file");
       }
+    for (auto& plane : exactOf) plane.assign(fileOf.size(), 0.f);
+    for (size_t f = 0; f < layout.samples.size(); ++f) {
+      if (std::find(fileOf.begin(), fileOf.end(), int(f)) == fileOf.end()) continue;
+      const int file = int(inputs.size() + f);
+      for (size_t k = 0; k < wanted.size(); ++k) {
+        const auto& s = *wanted[k];
+        toolkit::OutputChannel decoded;
+        DCM_RETURN_IF_ERROR(readRows(file, s.where[f].first, s.where[f].second, s.type, s.name, w.min.y, w.max.y, &decoded));
+        for (size_t i = 0; i < fileOf.size(); ++i) {
+          if (fileOf[i] != int(f)) continue;
+          const size_t at = (i / ww) * size_t(inWidth) + size_t(w.min.x) + i % ww;
+          // A uint ID's bits travel in the float (ChannelKind::kId only copies).
+          if (s.type == OIIO::TypeDesc::UINT) std::memcpy(&exactOf[k][i], &decoded.ids[at], sizeof(float));
+          else exactOf[k][i] = decoded.values[at];
+        }
+      }
+      // This file's decoded rows are no longer needed.
+      for (auto it = parts.begin(); it != parts.end();) it = std::get<0>(it->first) == file ? parts.erase(it) : std::next(it);
+    }
+  }
+  // A reconstructed channel: the record applied to its exact values, in the
+  // rows of the output's region like a copied channel's.
+  auto reconstruct = [&](const OutputLayout::Source& s, toolkit::OutputChannel* ch) -> Status {
+    const size_t k = size_t(std::find(wanted.begin(), wanted.end(), &s) - wanted.begin());
+    const bool ids = s.type == OIIO::TypeDesc::UINT;
     std::vector<float> plane;
-    DCM_RETURN_IF_ERROR(record->Apply(exact, s.raw || ids ? ChannelKind::kId : ChannelKind::kContinuous, &plane));
-    const size_t size = size_t(inWidth) * size_t(rows);
+    DCM_RETURN_IF_ERROR(record->Apply(exactOf[k], s.raw || ids ? ChannelKind::kId : ChannelKind::kContinuous, &plane));
+    std::vector<float>().swap(exactOf[k]);
+    const size_t ww = size_t(w.width()), size = size_t(inWidth) * size_t(rows);
     if (ids) ch->ids.assign(size, 0u);
     else ch->values.assign(size, 0.f);
     for (int y = std::max(w.min.y, rowBegin); y < std::min(w.max.y, rowEnd); ++y)
       for (int x = w.min.x; x < w.max.x; ++x) {
         const float v = plane[size_t(y - w.min.y) * ww + size_t(x - w.min.x)];
-        const size_t k = size_t(y - rowBegin) * size_t(inWidth) + size_t(x);
-        if (ids) std::memcpy(&ch->ids[k], &v, sizeof(float));
-        else ch->values[k] = v;
+        const size_t at = size_t(y - rowBegin) * size_t(inWidth) + size_t(x);
+        if (ids) std::memcpy(&ch->ids[at], &v, sizeof(float));
+        else ch->values[at] = v;
       }
     return Status::Ok();
   };

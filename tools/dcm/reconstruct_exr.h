@@ -96,10 +96,9 @@ struct OutputLayout {
   Point2i inputSize;                ///< the inputs' data window's size
   /// The output channel names.
   std::vector<std::string> Names() const;
-  /// Whether any output channel (of `selected`, indices into `channels`;
-  /// all when empty) is reconstructed from the samples (sparse mode): the
-  /// engine must then keep its interpolation record.
-  bool Reconstructs(const std::vector<size_t>& selected = {}) const;
+  /// Whether any output channel is reconstructed from the samples (sparse
+  /// mode): the engine must then keep its interpolation record.
+  bool Reconstructs() const;
 };
 
 /// Plans the output of `provider` (opened from `inputs` and, in sparse mode,
