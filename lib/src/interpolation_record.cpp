@@ -15,6 +15,7 @@ namespace dcm {
 namespace {
 /// Marks a term read while its pixel was exact: the channel's exact value,
 /// not what an earlier step wrote there (a pixel filled, then evaluated).
+/// Pixel indices fit the other 31 bits: images hold at most 2^30 pixels.
 constexpr uint32_t kExactBit = 0x80000000u;
 constexpr uint32_t kPixelMask = 0x7fffffffu;
 }  // namespace

@@ -49,7 +49,7 @@ struct NeighbourTerms {
 
 class InterpolationRecorder {
  public:
-  InterpolationRecorder(const SampleStore& store) : store_(store) {}
+  explicit InterpolationRecorder(const SampleStore& store) : store_(store) {}
 
   /// A parallel phase begins (Engine::ForEach).
   void NextPhase() { ++phase_; }
