@@ -109,6 +109,7 @@ Status Engine::EvaluateBordersAdaptively(const std::vector<Block>& edges, bool b
         }
         if (nearest[0] >= 0 && nearest[1] >= 0 &&
             !contrast_.Differ(store_.ValueAt(nearest[0]), store_.ValueAt(nearest[1]))) {
+          if (record_) record_->Fill(ij, nearest[0], nearest[1], 0.5f);
           store_.SetFilled(ij, Lerp(store_.ValueAt(nearest[0]), store_.ValueAt(nearest[1]), 0.5f));
           crossingFilled[size_t(ij)] = 1;
           ++filled;
@@ -157,6 +158,7 @@ Status Engine::EvaluateBordersAdaptively(const std::vector<Block>& edges, bool b
         const int64_t ij = index(s, j);
         const bool same0 = surf.Same(ij, i0), same1 = surf.Same(ij, i1);
         const float t = (same0 == same1) ? float(j - last) / float(k - last) : (same0 ? 0.f : 1.f);
+        if (record_) record_->Fill(ij, i0, i1, t);
         store_.SetFilled(ij, Lerp(v0, v1, t));
       }
       last = k;

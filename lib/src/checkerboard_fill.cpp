@@ -8,7 +8,8 @@
 
 namespace dcm::detail {
 
-bool NeighbourEstimate(const SampleStore& store, const ContrastTest& contrast, Point2i q, bool test, Value* out) {
+bool NeighbourEstimate(const SampleStore& store, const ContrastTest& contrast, Point2i q, bool test, Value* out,
+                       NeighbourTerms* terms) {
   // Neighbours 2k and 2k + 1 are opposite; the first two pairs are the axes.
   static constexpr int kDx[8] = {1, -1, 0, 0, 1, -1, 1, -1};
   static constexpr int kDy[8] = {0, 0, 1, -1, 1, -1, -1, 1};
@@ -27,13 +28,15 @@ bool NeighbourEstimate(const SampleStore& store, const ContrastTest& contrast, P
     v[k] = store.ValueAt(i);
   }
   const Value* used[8];
+  int64_t usedIndex[8];
   double weight[8];
   int n = 0;
   double total = 0;
   for (int pair = 0; pair < 4; ++pair) {
     if (!usable[2 * pair] || !usable[2 * pair + 1]) continue;
     const double w = pair < 2 ? 1.0 : 0.5;
-    for (int k = 2 * pair; k <= 2 * pair + 1; ++k) used[n] = &v[k], weight[n++] = 0.5 * w;
+    for (int k = 2 * pair; k <= 2 * pair + 1; ++k)
+      used[n] = &v[k], usedIndex[n] = store.Index(q.x + kDx[k], q.y + kDy[k]), weight[n++] = 0.5 * w;
     total += w;
   }
   if (n == 0) return false;
@@ -43,6 +46,10 @@ bool NeighbourEstimate(const SampleStore& store, const ContrastTest& contrast, P
     for (int k = 0; k < 8; ++k)
       if (usable[k] && contrast.Misses(v[k], estimate)) return false;
   *out = estimate;
+  if (terms) {
+    terms->count = n;
+    for (int k = 0; k < n; ++k) terms->index[k] = usedIndex[k], terms->weight[k] = weight[k];
+  }
   return true;
 }
 
@@ -63,8 +70,10 @@ Status Engine::ResolveDeferred(bool write) {
   ForEach(deferred, [&](int64_t& i, size_t k) {
     const int x = int(i % store_.width()), y = int(i / store_.width());
     Value v;
-    if (NeighbourEstimate(store_, contrast_, {x, y}, true, &v)) {
+    NeighbourTerms terms;
+    if (NeighbourEstimate(store_, contrast_, {x, y}, true, &v, record_ ? &terms : nullptr)) {
       filled[k] = 1;
+      if (write && record_) record_->Weighted(i, terms);
       if (write) store_.SetInterpolated(i, v);
     } else {
       store_.Request(x, y, deferred_[size_t(i)]);
@@ -80,8 +89,12 @@ Status Engine::ResolveDeferred(bool write) {
 void Engine::WriteFilledDeferred() {
   ForEach(filledDeferred_, [&](int64_t& i, size_t) {
     Value v;
-    if (NeighbourEstimate(store_, contrast_, {int(i % store_.width()), int(i / store_.width())}, false, &v))
+    NeighbourTerms terms;
+    if (NeighbourEstimate(store_, contrast_, {int(i % store_.width()), int(i / store_.width())}, false, &v,
+                          record_ ? &terms : nullptr)) {
+      if (record_) record_->Weighted(i, terms);
       store_.SetInterpolated(i, v);
+    }
   });
 }
 

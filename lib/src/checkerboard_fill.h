@@ -11,6 +11,7 @@
 
 #include "block.h"
 #include "contrast_test.h"
+#include "interpolation_recorder.h"
 #include "sample_store.h"
 
 namespace dcm::detail {
@@ -24,7 +25,9 @@ inline bool EvaluatedFirst(int x, int y) { return ((x + y) & 1) == 0; }
 /// ramp), axis pairs weighted 1 and diagonal pairs 1/2.
 /// With `test`, false when no opposite pair exists or any of those
 /// neighbours differs significantly from the estimate (weighed at its own
-/// tau); without, false only when no opposite pair exists.
-bool NeighbourEstimate(const SampleStore& store, const ContrastTest& contrast, Point2i q, bool test, Value* out);
+/// tau); without, false only when no opposite pair exists. `terms`, when
+/// given, receives the neighbours and weights of the estimate.
+bool NeighbourEstimate(const SampleStore& store, const ContrastTest& contrast, Point2i q, bool test, Value* out,
+                       NeighbourTerms* terms = nullptr);
 
 }  // namespace dcm::detail

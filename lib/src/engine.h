@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <span>
 #include <string_view>
 #include <tuple>
@@ -19,6 +20,7 @@
 #include "block.h"
 #include "contrast_test.h"
 #include "dcm/reconstructor.h"
+#include "interpolation_recorder.h"
 #include "least_discrepancy_direction.h"
 #include "oriented_interpolation.h"
 #include "sample_store.h"
@@ -66,6 +68,7 @@ class Engine {
  private:
   template <typename T, typename F>
   void ForEach(std::vector<T>& items, F&& f) {
+    if (record_) record_->NextPhase();
     tbb::parallel_for(tbb::blocked_range<size_t>(0, items.size(), grain_),
                       [&](const tbb::blocked_range<size_t>& r) {
                         for (size_t i = r.begin(); i != r.end(); ++i) f(items[i], i);
@@ -253,6 +256,9 @@ class Engine {
   /// The interpolants of interior pixels per (width, height, direction) of
   /// the oriented leaves and their neighbouring directions (PrepareElements).
   std::map<std::tuple<int, int, int>, OrientedElements> elements_;
+  /// ReconstructionOptions::recordInterpolation: the steps that write
+  /// pixels record themselves here (interpolation_recorder.h); null otherwise.
+  std::unique_ptr<InterpolationRecorder> record_;
 };
 
 }  // namespace dcm::detail

@@ -49,12 +49,15 @@ void Engine::InterpolateOriented(const Leaf& leaf, OrientedPass pass) {
       }
       if (pass == OrientedPass::kThinObjects) continue;
       Value v = Evaluate(store_, in);
+      const bool record = record_ && pass == OrientedPass::kFinal;
+      if (record && !lazy) record_->Weighted(i, in);
       if (lazy) {
         // The centre sample corrects the parent's interpolation with a tent
         // that is 1 at the centre and 0 on the border; the result stays in
         // the range of the samples used.
         const double w = std::max(0.0, 1 - std::fabs(x - leaf.centre.x) / hx) *
                          std::max(0.0, 1 - std::fabs(y - leaf.centre.y) / hy);
+        if (record) record_->Lazy(i, in, leaf.centre, w);
         for (int c = 0; c < 3; ++c) {
           v.a[c] = std::clamp(float(v.a[c] + w * leaf.delta.a[c]), leaf.lo.a[c], leaf.hi.a[c]);
           v.b[c] = std::clamp(float(v.b[c] + w * leaf.delta.b[c]), leaf.lo.b[c], leaf.hi.b[c]);
@@ -72,7 +75,11 @@ Status Engine::InterpolateLeaves() {
   const bool denoise = settings_.denoise;
   Progress(0.9f, "thin objects and interpolation");
   PrepareElements(orientedLeaves_);
-  if (!denoise) ForEach(smoothLeaves_, [&](Leaf& l, size_t) { WriteSmooth(l); });
+  auto writeSmooth = [&](Leaf& l, size_t) {
+    WriteSmooth(l);
+    if (record_) record_->Smooth(l.block);
+  };
+  if (!denoise) ForEach(smoothLeaves_, writeSmooth);
   ForEach(orientedLeaves_, [&](Leaf& l, size_t) {
     InterpolateOriented(l, denoise ? OrientedPass::kThinObjects : OrientedPass::kFinal);
   });
@@ -88,7 +95,7 @@ Status Engine::InterpolateLeaves() {
     stats_.stageTimes.denoising += denoising;
     stats_.stageTimes.interpolation -= denoising;
     Progress(0.95f, "interpolation");
-    ForEach(smoothLeaves_, [&](Leaf& l, size_t) { WriteSmooth(l); });
+    ForEach(smoothLeaves_, writeSmooth);
     ForEach(orientedLeaves_, [&](Leaf& l, size_t) { InterpolateOriented(l, OrientedPass::kFinal); });
     // Nothing to evaluate unless the thin-object pass missed a pixel.
     DCM_RETURN_IF_ERROR(Flush());

@@ -32,7 +32,8 @@ Status Engine::EvaluateLazily(std::vector<EdgeBlock>& eb, int size, std::vector<
     leaf.centre = c;
     // A correction the noise may explain is noise: spread over the block by
     // the tent, it would move both sides of the edge (kLazyCorrectionMinSd).
-    if (!contrast_.WithinNoise(exact, predicted, settings_.lazyCorrectionGate))
+    const bool corrected = !contrast_.WithinNoise(exact, predicted, settings_.lazyCorrectionGate);
+    if (corrected)
       leaf.delta = {exact.a - predicted.a, exact.b - predicted.b};
     leaf.lo = leaf.hi = exact;
     for (Point2i p : e.border) {
@@ -44,6 +45,7 @@ Status Engine::EvaluateLazily(std::vector<EdgeBlock>& eb, int size, std::vector<
         leaf.lo.b[ch] = std::min(leaf.lo.b[ch], v.b[ch]), leaf.hi.b[ch] = std::max(leaf.hi.b[ch], v.b[ch]);
       }
     }
+    if (record_) record_->LazyLeaf(c, in, e.border, !corrected);
     accepted[i] = 1;
   });
   for (size_t i = 0; i < eb.size(); ++i) {

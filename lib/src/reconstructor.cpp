@@ -62,6 +62,7 @@ Engine::Engine(SampleProvider& provider, const ReconstructionOptions& opt, const
   request_.split = settings.split;
   request_.variance = settings.noisy;
   stats_.settings = settings;
+  if (opt.recordInterpolation) record_ = std::make_unique<InterpolationRecorder>(store_);
 }
 
 Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
@@ -127,6 +128,7 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
     out->workHeight = H;
     out->workImage = store_.TakeRadiance();
     out->sampleMap = store_.TakeReasons();
+    out->interpolation = record_ ? record_->Finish(W, H, out->sampleMap) : nullptr;
     out->image = BoxDownsample(out->workImage, W, H, opt_.downsample, &out->width, &out->height);
     RecordLeaves(out);
   });

@@ -197,6 +197,10 @@ Status ReconstructRegion(SampleProvider& provider, const ReconstructionOptions& 
   out->stats.exactPixels =
       out->stats.totalPixels - out->stats.byReason[size_t(SampleReason::kInterpolated)];
 
+  // The record covers the whole window: a part's channels are reconstructed
+  // in it and cut as the image was.
+  out->interpolation = std::move(r.interpolation);
+  if (out->interpolation) out->interpolation->SetOrigin(window.min);
   if (info) info->windowStats = r.stats;
   return Status::Ok();
 }

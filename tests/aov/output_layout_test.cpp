@@ -6,7 +6,11 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <cstring>
 #include <filesystem>
+#include <map>
+#include <set>
+#include <sstream>
 
 #include "test_util.h"
 
@@ -241,6 +245,188 @@ TEST(OutputLayout, PartsTakeTheFormatFromMerge) {
   for (const char* c : {"id", "shader"})
     EXPECT_EQ(m.spec.channelformat(m.spec.channelindex(c)), OIIO::TypeDesc::FLOAT) << c;
   EXPECT_EQ(m.spec.get_string_attribute("compression"), "piz");
+}
+
+
+/// The sparse round trip's scene: the generic beauty and guides, and passes
+/// a renderer writes with the beauty: a depth (object ID x 10 plus a gentle
+/// ramp), a half colour pass, an alpha, and a uint ID per pixel (beyond
+/// float's 2^24: its bits must survive).
+std::vector<TestChannel> SparseSceneChannels(const Scene& sc) {
+  const int w = sc.width, h = sc.height;
+  auto ch = sc.GenericChannels(false);
+  ch.push_back(Fill("depth", w, h, [&](int x, int y) { return 10.f * float(sc.ObjectId(x, y)) + 0.01f * float(x + y); }));
+  TestChannel diffuse = Fill("diffuse.R", w, h, [&](int x, int y) { return 0.5f * sc.L(x, y).r; });
+  diffuse.half = true;
+  ch.push_back(diffuse);
+  ch.push_back(Fill("A", w, h, [&](int x, int y) { return sc.ObjectId(x, y) == sc.ObjectId(0, 0) ? 0.25f : 1.f; }));
+  TestChannel ids{"pixel", {}, {}, false};
+  for (int i = 0; i < w * h; ++i) ids.ids.push_back(uint32_t(i + 1) * 2654435761u);
+  ch.push_back(ids);
+  return ch;
+}
+
+/// The scripted renderer: every channel of `full` but the guides, at the
+/// pixels of a plan list, and the mask.
+void RenderPasses(const std::vector<TestChannel>& full, int w, int h, const std::string& list, const std::string& out,
+                  std::set<int64_t>* rendered) {
+  std::vector<TestChannel> ch;
+  for (const auto& c : full) {
+    if (c.name == "id" || c.name == "shader") continue;
+    TestChannel z = c;
+    std::fill(z.values.begin(), z.values.end(), 0.f);
+    std::fill(z.ids.begin(), z.ids.end(), 0u);
+    ch.push_back(z);
+  }
+  ch.push_back(Fill("mask", w, h, [](int, int) { return 0.f; }));
+  std::istringstream in(ReadText(list));
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    int x = -1, y = -1;
+    std::istringstream(line) >> x >> y;
+    const size_t i = size_t(y) * size_t(w) + size_t(x);
+    rendered->insert(int64_t(i));
+    size_t k = 0;
+    for (const auto& c : full) {
+      if (c.name == "id" || c.name == "shader") continue;
+      if (!c.ids.empty()) ch[k].ids[i] = c.ids[i];
+      else ch[k].values[i] = c.values[i];
+      ++k;
+    }
+    ch.back().values[i] = 1.f;
+  }
+  WriteExr(out, w, h, ch);
+}
+
+/// Plans rounds on `guides` (with `extra` flags, e.g. --tile) until done,
+/// rendering each into a new samples file appended to `samples`.
+void PlanUntilDone(const ScratchDir& dir, const std::vector<TestChannel>& full, const Scene& sc,
+                   const std::vector<std::string>& extra, std::vector<std::string>* samples, std::set<int64_t>* rendered) {
+  for (int round = 0; round < 64; ++round) {
+    std::vector<std::string> plan = {"plan", dir / "guides.exr", "--list", dir / "next.txt", "--quiet"};
+    for (const auto& s : *samples) plan.insert(plan.end(), {"--samples", s});
+    plan.insert(plan.end(), extra.begin(), extra.end());
+    auto r = RunDcm(plan, dir);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    if (r.out == "done\n") return;
+    const std::string s = dir / ("samples_" + std::to_string(samples->size()) + ".exr");
+    RenderPasses(full, sc.width, sc.height, dir / "next.txt", s, rendered);
+    samples->push_back(s);
+  }
+  FAIL() << "plan did not finish in 64 rounds";
+}
+
+// Sparse mode (the `dcm plan` round trip): the passes the samples files
+// carry are reconstructed with the beauty's interpolation record, the guides
+// render's channels the samples lack are copied; the output has the dense
+// run's channels and types, and at the exact pixels the input's bits (c).
+TEST(OutputLayout, SparsePassesAreReconstructedWithTheBeautysInterpolation) {
+  ScratchDir dir;
+  Scene sc{72, 56};
+  const auto full = SparseSceneChannels(sc);
+  WriteExr(dir / "dense.exr", sc.width, sc.height, full);
+  WriteExr(dir / "guides.exr", sc.width, sc.height, sc.GenericChannels(false, /*guidesOnly=*/true));
+  std::vector<std::string> samples;
+  std::set<int64_t> rendered;
+  PlanUntilDone(dir, full, sc, {}, &samples, &rendered);
+  ASSERT_FALSE(samples.empty());
+  std::vector<std::string> rec = {"reconstruct", dir / "guides.exr", "-o", dir / "sparse.exr", "-v"};
+  for (const auto& s : samples) rec.insert(rec.end(), {"--samples", s});
+  auto r = RunDcm(rec, dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("alpha A reconstructed"));
+  EXPECT_THAT(r.err, HasSubstr("2 passes copied, 3 reconstructed from the samples"));
+  r = RunDcm({"reconstruct", dir / "dense.exr", "-o", dir / "dense_out.exr", "--quiet"}, dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+
+  const Exr in = ReadExr(dir / "dense.exr"), dense = ReadExr(dir / "dense_out.exr"), sparse = ReadExr(dir / "sparse.exr");
+  ASSERT_EQ(sparse.names(), dense.names());
+  for (int c = 0; c < dense.spec.nchannels; ++c)
+    EXPECT_EQ(sparse.spec.channelformat(c), dense.spec.channelformat(c)) << dense.names()[size_t(c)];
+  // The beauty is the dense run's (PlanRoundTrip); the guides are copied.
+  for (const char* name : {"R", "G", "B", "id", "shader"}) EXPECT_EQ(sparse.Plane(name), dense.Plane(name)) << name;
+
+  const size_t n = size_t(sc.width) * size_t(sc.height);
+  const int pixel = in.spec.channelindex("pixel");
+  const auto& inIds = in.ids.at(size_t(pixel));
+  const auto& outIds = sparse.ids.at(size_t(pixel));
+  std::map<uint32_t, size_t> sourceOf;
+  for (int64_t i : rendered) sourceOf[inIds[size_t(i)]] = size_t(i);
+  int64_t interpolated = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const int x = int(i % size_t(sc.width)), y = int(i / size_t(sc.width));
+    if (rendered.count(int64_t(i))) {
+      // Exact pixels: the renderer's values, bit for bit.
+      for (const char* name : {"depth", "diffuse.R", "A"}) {
+        const float a = in.Plane(name)[i], b = sparse.Plane(name)[i];
+        ASSERT_EQ(std::memcmp(&a, &b, sizeof a), 0) << name << " at (" << x << "," << y << ")";
+      }
+      ASSERT_EQ(outIds[i], inIds[i]) << "(" << x << "," << y << ")";
+      continue;
+    }
+    ++interpolated;
+    // An ID: the value of one exact pixel on the same surface, never a blend.
+    const auto src = sourceOf.find(outIds[i]);
+    ASSERT_NE(src, sourceOf.end()) << "(" << x << "," << y << "): " << outIds[i] << " is no exact pixel's ID";
+    const int sx = int(src->second % size_t(sc.width)), sy = int(src->second / size_t(sc.width));
+    EXPECT_TRUE(sc.ObjectId(x, y) == sc.ObjectId(sx, sy) && sc.ShaderId(x, y) == sc.ShaderId(sx, sy))
+        << "(" << x << "," << y << ") took the ID of (" << sx << "," << sy << ")";
+    // Depth never across surfaces: objects lie 10 apart, the ramp changes
+    // by 0.02 per pixel, so a value within 1 of the truth comes from the
+    // pixel's own surface (the sources lie within one 16-pixel block).
+    EXPECT_NEAR(sparse.Plane("depth")[i], in.Plane("depth")[i], 1.0) << "(" << x << "," << y << ")";
+  }
+  EXPECT_GT(interpolated, int64_t(n) / 2);
+
+  // --ch: a pass chosen is the same; none chosen, none is reconstructed.
+  for (const auto& [channels, name] : {std::pair{"R,G,B,depth", "ch.exr"}, std::pair{"R,G,B", "rgb.exr"}}) {
+    auto ch = rec;
+    ch[3] = dir / name;
+    ch[4] = "--quiet";
+    ch.insert(ch.end(), {"--ch", channels});
+    r = RunDcm(ch, dir);
+    ASSERT_EQ(r.exitCode, 0) << channels << ": " << r.err;
+  }
+  const Exr ch = ReadExr(dir / "ch.exr");
+  EXPECT_THAT(ch.names(), ::testing::UnorderedElementsAre("R", "G", "B", "depth"));
+  EXPECT_EQ(ch.Plane("depth"), sparse.Plane("depth"));
+  EXPECT_EQ(ReadExr(dir / "rgb.exr").Plane("R"), sparse.Plane("R"));
+}
+
+// Sparse parts carry the reconstructed passes of their region: merged, they
+// are the whole frame's output, every channel bit for bit.
+TEST(OutputLayout, SparseTilesMergeToTheWholeOutput) {
+  ScratchDir dir;
+  Scene sc{96, 80};
+  const auto full = SparseSceneChannels(sc);
+  WriteExr(dir / "guides.exr", sc.width, sc.height, sc.GenericChannels(false, /*guidesOnly=*/true));
+  std::vector<std::string> samples;
+  std::set<int64_t> rendered;
+  // The whole frame's rounds, then each tile's (its window's halo).
+  PlanUntilDone(dir, full, sc, {}, &samples, &rendered);
+  for (const char* tile : {"0/2", "1/2"}) PlanUntilDone(dir, full, sc, {"--tile", tile}, &samples, &rendered);
+  auto with = [&](std::vector<std::string> args) {
+    for (const auto& s : samples) args.insert(args.end(), {"--samples", s});
+    args.push_back("--quiet");
+    return args;
+  };
+  auto r = RunDcm(with({"reconstruct", dir / "guides.exr", "-o", dir / "whole.exr"}), dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  for (const auto& [tile, name] : {std::pair{"0/2", "t0.exr"}, std::pair{"1/2", "t1.exr"}}) {
+    r = RunDcm(with({"reconstruct", dir / "guides.exr", "--tile", tile, "-o", dir / name}), dir);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+  }
+  r = RunDcm({"merge", dir / "t0.exr", dir / "t1.exr", "-o", dir / "m.exr", "--quiet"}, dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const Exr whole = ReadExr(dir / "whole.exr"), merged = ReadExr(dir / "m.exr");
+  ASSERT_EQ(merged.names(), whole.names());
+  EXPECT_GE(whole.spec.channelindex("depth"), 0);
+  for (int c = 0; c < whole.spec.nchannels; ++c) {
+    EXPECT_EQ(merged.spec.channelformat(c), whole.spec.channelformat(c)) << whole.names()[size_t(c)];
+    EXPECT_EQ(merged.planes[size_t(c)], whole.planes[size_t(c)]) << whole.names()[size_t(c)];
+    EXPECT_EQ(merged.ids[size_t(c)], whole.ids[size_t(c)]) << whole.names()[size_t(c)];
+  }
 }
 
 }  // namespace

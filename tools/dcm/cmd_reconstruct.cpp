@@ -10,6 +10,7 @@
 // pixels the engine asks for and reports the error against the full input.
 // With --samples (the file-based round trip): the inputs carry the guides and
 // the samples files the pixels rendered for `dcm plan`.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -108,6 +109,13 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
   identity["alpha"] = f.alpha;
   const nlohmann::json settings = toolkit::PartSettings(cmd, DCM_VERSION, options, identity);
 
+  // The part keeps the inputs' layout (beauty names, alpha, passes cut to
+  // the region, metadata) so that the merged frame is the whole run's.
+  OutputLayout layout;
+  if (st = PlanOutputLayout(provider, f.aov.inputs, f.aov.samples, f.alpha, options.downsample, &layout); !st.ok())
+    return aov_common::Fail(cmd, st.message());
+  options.recordInterpolation = layout.Reconstructs();
+
   aov_common::Outputs outputs(cmd);
   Reconstruction r;
   RegionInfo info;
@@ -145,16 +153,11 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
   toolkit::Metadata meta = ProvenanceMetadata(f, provider, options);
   AddPartMetadata(tile, region, settings, r, info, &meta);
 
-  // The part keeps the inputs' layout (beauty names, alpha, passes cut to
-  // the region, metadata) so that the merged frame is the whole run's.
-  OutputLayout layout;
-  if (st = PlanOutputLayout(provider, f.aov.inputs, f.alpha, options.downsample, &layout); !st.ok())
-    return aov_common::Fail(cmd, st.message());
   ExrReconstruction run;
   run.result = r;
   run.display = run.data = {{0, 0}, {frame.x, frame.y}};
   toolkit::OutputImage image;
-  st = BuildOutputImage(layout, f.aov.inputs, run, options.downsample, {}, &image, &region);
+  st = BuildOutputImage(provider, layout, f.aov.inputs, run, options.downsample, {}, &image, &region);
   int rc = outputs.Write(st.ok() ? toolkit::WritePartImage(f.output, std::move(image), meta) : st);
   if (rc) return rc;
   if (!f.sampleMap.empty() && (rc = outputs.Write(toolkit::WriteSampleMap(f.sampleMap, r)))) return rc;
@@ -241,11 +244,20 @@ int RunReconstruct(const ReconstructFlags& f) {
   // The output's channels are known from the headers: --ch is checked
   // before the engine runs.
   OutputLayout layout;
-  st = PlanOutputLayout(*provider, f.aov.inputs, f.alpha, options.downsample, &layout);
+  st = PlanOutputLayout(*provider, f.aov.inputs, f.aov.samples, f.alpha, options.downsample, &layout);
   if (!st.ok()) return aov_common::Fail(cmd, st.message());
   std::vector<size_t> order;
   if (st = toolkit::SelectChannels(layout.Names(), f.exr.channels, &order); !st.ok())
     return aov_common::Fail(cmd, st.message(), kExitUsage);
+  // Only the channels written are built: a pass left out is neither read
+  // nor reconstructed (the engine keeps no record for it).
+  if (!f.exr.channels.empty()) {
+    std::vector<OutputLayout::Channel> kept;
+    std::sort(order.begin(), order.end());
+    for (size_t i : order) kept.push_back(layout.channels[i]);
+    layout.channels = std::move(kept);
+  }
+  options.recordInterpolation = layout.Reconstructs();
   if (f.engine.verbose)
     for (const auto& note : layout.notes) std::cerr << "dcm " << cmd << ": " << note << "\n";
   aov_common::Outputs outputs(cmd);  // before the run: --progressive writes during it
@@ -264,7 +276,7 @@ int RunReconstruct(const ReconstructFlags& f) {
 
   // All outputs appear together at Commit(), or none.
   toolkit::OutputImage image;
-  st = BuildOutputImage(layout, f.aov.inputs, run, options.downsample, meta, &image);
+  st = BuildOutputImage(*provider, layout, f.aov.inputs, run, options.downsample, meta, &image);
   int rc = outputs.Write(st.ok() ? toolkit::WriteOutputExr(f.output, image, f.exr) : st);
   if (rc) return rc;
   if (!f.sampleMap.empty() && (rc = outputs.Write(toolkit::WriteSampleMap(f.sampleMap, r)))) return rc;

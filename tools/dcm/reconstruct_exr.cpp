@@ -4,7 +4,9 @@
 #include <cctype>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <map>
+#include <tuple>
 
 #include "common/image_io.h"
 #include "common/stats_json.h"
@@ -145,8 +147,15 @@ std::vector<std::string> OutputLayout::Names() const {
   return names;
 }
 
-Status PlanOutputLayout(const aov::AovProvider& provider, const std::vector<std::string>& inputs, bool alpha,
-                        int downsample, OutputLayout* out) {
+bool OutputLayout::Reconstructs() const {
+  return std::any_of(channels.begin(), channels.end(), [&](const Channel& c) {
+    return (c.kind == Kind::kPass && passes[size_t(c.index)].reconstructed) ||
+           (c.kind == Kind::kAlpha && alpha && alpha->reconstructed);
+  });
+}
+
+Status PlanOutputLayout(const aov::AovProvider& provider, const std::vector<std::string>& inputs,
+                        const std::vector<std::string>& samples, bool alpha, int downsample, OutputLayout* out) {
   *out = OutputLayout{};
   std::vector<std::string> beauty = provider.BeautyChannels();
   if (beauty.size() != 3) {
@@ -154,10 +163,7 @@ Status PlanOutputLayout(const aov::AovProvider& provider, const std::vector<std:
     out->notes.push_back("output: the beauty is no single channel of the inputs; written as R, G, B");
   }
   const std::string alphaName = AlphaBeside(beauty[0]);
-  const bool copyPasses = provider.dense();
-  if (!provider.dense())
-    out->notes.push_back("output: sparse mode: the inputs' other passes are those of the guide render; not written");
-  else if (downsample > 1)
+  if (downsample > 1)
     out->notes.push_back("output: --downsample " + std::to_string(downsample) +
                          ": passes box-filtered, IDs by majority, Cryptomatte by rank");
 
@@ -166,9 +172,11 @@ Status PlanOutputLayout(const aov::AovProvider& provider, const std::vector<std:
   std::vector<std::string> cryptoLayers;
   const Bounds2i window = provider.DataWindow();
   out->inputSize = {window.width(), window.height()};
-  for (size_t f = 0; f < inputs.size(); ++f) {
-    auto in = OIIO::ImageInput::open(inputs[f]);
-    if (!in) return Status::Error("cannot read '" + inputs[f] + "': " + OIIO::geterror());
+  // Each file's channels of this image, first file first (as the provider
+  // reads them), its metadata into the output's.
+  auto channelsOf = [&](const std::string& path, std::vector<OutputLayout::Source>* list) -> Status {
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) return Status::Error("cannot read '" + path + "': " + OIIO::geterror());
     for (int sub = 0; in->seek_subimage(sub, 0); ++sub) {
       const OIIO::ImageSpec& spec = in->spec();
       const Bounds2i data{{spec.x, spec.y}, {spec.x + spec.width, spec.y + spec.height}};
@@ -182,9 +190,52 @@ Status PlanOutputLayout(const aov::AovProvider& provider, const std::vector<std:
       }
       for (int c = 0; c < spec.nchannels; ++c) {
         const std::string& name = spec.channelnames[size_t(c)];
-        if (std::any_of(all.begin(), all.end(), [&](const auto& s) { return s.name == name; })) continue;
-        all.push_back({int(f), sub, c, name, KeptType(spec.channelformat(c)), false});
+        if (std::any_of(list->begin(), list->end(), [&](const auto& s) { return s.name == name; })) continue;
+        list->push_back({0, sub, c, name, KeptType(spec.channelformat(c)), false, false, {}});
       }
+    }
+    return Status::Ok();
+  };
+  for (size_t f = 0; f < inputs.size(); ++f) {
+    const size_t first = all.size();
+    DCM_RETURN_IF_ERROR(channelsOf(inputs[f], &all));
+    for (size_t k = first; k < all.size(); ++k) all[k].file = int(f);
+  }
+  // Sparse mode: the channels every samples file holds, read where each
+  // rendered (the beauty's and the mask's are the provider's).
+  int reconstructed = 0;
+  if (!provider.dense() && !samples.empty()) {
+    out->samples = samples;
+    std::vector<std::vector<OutputLayout::Source>> files(samples.size());
+    for (size_t f = 0; f < samples.size(); ++f) DCM_RETURN_IF_ERROR(channelsOf(samples[f], &files[f]));
+    const auto& masks = provider.MaskChannels();
+    std::vector<std::string> partial;
+    for (const auto& s : files[0]) {
+      if (std::find(beauty.begin(), beauty.end(), s.name) != beauty.end() ||
+          std::find(masks.begin(), masks.end(), s.name) != masks.end())
+        continue;
+      OutputLayout::Source r = s;
+      r.reconstructed = true;
+      for (const auto& file : files) {
+        const auto it = std::find_if(file.begin(), file.end(), [&](const auto& c) { return c.name == s.name; });
+        if (it == file.end()) break;
+        r.where.push_back({it->subimage, it->index});
+      }
+      const auto in = std::find_if(all.begin(), all.end(), [&](const auto& c) { return c.name == s.name; });
+      if (r.where.size() != samples.size()) {
+        if (in == all.end()) partial.push_back(s.name);
+        continue;
+      }
+      // The inputs' guides render gives the alpha, coverage, at every pixel.
+      if (in != all.end() && s.name == alphaName) continue;
+      ++reconstructed;
+      if (in != all.end()) *in = r;
+      else all.push_back(r);
+    }
+    if (!partial.empty()) {
+      std::string names;
+      for (const auto& p : partial) names += (names.empty() ? "" : ", ") + p;
+      out->notes.push_back("output: not in every samples file, not written: " + names);
     }
   }
   out->cryptoLayers = cryptoLayers;
@@ -213,7 +264,7 @@ Status PlanOutputLayout(const aov::AovProvider& provider, const std::vector<std:
     } else if (!alphaName.empty() && s.name == alphaName) {
       out->alpha = s;
       if (inPlace) out->channels.push_back({Kind::kAlpha, 0, alphaName});  // else after the beauty, below
-    } else if (copyPasses) {
+    } else {
       out->channels.push_back({Kind::kPass, int(out->passes.size()), s.name});
       out->passes.push_back(s);
     }
@@ -228,16 +279,20 @@ Status PlanOutputLayout(const aov::AovProvider& provider, const std::vector<std:
   }
   if (alpha && alphaName.empty())
     out->notes.push_back("output: --alpha: the beauty's channels (" + beauty[0] + ", ...) have no alpha beside them");
-  out->notes.push_back("output: channels " + std::to_string(out->channels.size()) + " (" +
-                       (out->alpha ? "alpha " + alphaName + " from the inputs"
-                                   : haveAlpha ? "alpha " + alphaName + " = 1" : "no alpha") +
-                       ", " + std::to_string(out->passes.size()) + " passes " +
-                       (downsample > 1 ? "downsampled" : "copied") + "), " +
-                       std::to_string(out->attributes.size()) + " metadata attributes of the inputs");
+  const int copied = int(out->passes.size()) - reconstructed + (out->alpha && out->alpha->reconstructed ? 1 : 0);
+  out->notes.push_back(
+      "output: channels " + std::to_string(out->channels.size()) + " (" +
+      (out->alpha ? "alpha " + alphaName + (out->alpha->reconstructed ? " reconstructed" : " from the inputs")
+                  : haveAlpha ? "alpha " + alphaName + " = 1" : "no alpha") +
+      ", " + std::to_string(copied) + " passes " + (downsample > 1 ? "downsampled" : "copied") +
+      (reconstructed ? ", " + std::to_string(out->passes.size() - size_t(copied)) +
+                           " reconstructed from the samples with the beauty's interpolation"
+                     : std::string()) +
+      "), " + std::to_string(out->attributes.size()) + " metadata attributes of the inputs");
   return Status::Ok();
 }
 
-Status BuildOutputImage(const OutputLayout& layout, const std::vector<std::string>& inputs,
+Status BuildOutputImage(const aov::AovProvider& provider, const OutputLayout& layout, const std::vector<std::string>& inputs,
                         const ExrReconstruction& run, int downsample, const toolkit::Metadata& provenance,
                         toolkit::OutputImage* out, const Bounds2i* region) {
   const Reconstruction& r = run.result;
@@ -267,38 +322,122 @@ Status BuildOutputImage(const OutputLayout& layout, const std::vector<std::strin
     size_t pixels = 0;
     std::vector<float> values;  // interleaved
   };
-  std::map<std::pair<int, int>, Part> parts;
-  auto read = [&](const OutputLayout::Source& s, toolkit::OutputChannel* ch) -> Status {
-    const std::string& path = inputs[size_t(s.file)];
+  // (file, subimage, first row, end row); the samples files after the inputs
+  std::map<std::tuple<int, int, int, int>, Part> parts;
+  auto path = [&](int file) -> const std::string& {
+    return size_t(file) < inputs.size() ? inputs[size_t(file)] : layout.samples[size_t(file) - inputs.size()];
+  };
+  // Rows [y0, y1) of channel `index` of (file, subimage): as float, or UINT
+  // into `ids`.
+  auto readRows = [&](int file, int subimage, int index, OIIO::TypeDesc type, const std::string& name, int y0, int y1,
+                      toolkit::OutputChannel* ch) -> Status {
     auto fail = [&](const std::string& why) {
-      return Status::Error("cannot read channel '" + s.name + "' of '" + path + "': " + why);
+      return Status::Error("cannot read channel '" + name + "' of '" + path(file) + "': " + why);
     };
-    if (s.type == OIIO::TypeDesc::UINT) {
-      auto in = OIIO::ImageInput::open(path);
+    if (type == OIIO::TypeDesc::UINT) {
+      auto in = OIIO::ImageInput::open(path(file));
       if (!in) return fail(OIIO::geterror());
-      const OIIO::ImageSpec spec = in->spec(s.subimage, 0);
-      ch->ids.resize(size_t(spec.width) * size_t(rows));
-      if (!in->read_scanlines(s.subimage, 0, spec.y + rowBegin, spec.y + rowEnd, 0, s.index, s.index + 1,
+      const OIIO::ImageSpec spec = in->spec(subimage, 0);
+      ch->ids.resize(size_t(spec.width) * size_t(y1 - y0));
+      if (!in->read_scanlines(subimage, 0, spec.y + y0, spec.y + y1, 0, index, index + 1,
                               OIIO::TypeDesc::UINT, ch->ids.data()))
         return fail(in->geterror());
       return Status::Ok();
     }
-    auto [it, fresh] = parts.try_emplace({s.file, s.subimage});
+    auto [it, fresh] = parts.try_emplace({file, subimage, y0, y1});
     Part& part = it->second;
     if (fresh) {
-      auto in = OIIO::ImageInput::open(path);
+      auto in = OIIO::ImageInput::open(path(file));
       if (!in) return fail(OIIO::geterror());
-      const OIIO::ImageSpec spec = in->spec(s.subimage, 0);
+      const OIIO::ImageSpec spec = in->spec(subimage, 0);
       part.nchannels = spec.nchannels;
-      part.pixels = size_t(spec.width) * size_t(rows);
+      part.pixels = size_t(spec.width) * size_t(y1 - y0);
       part.values.resize(part.pixels * size_t(part.nchannels));
-      if (!in->read_scanlines(s.subimage, 0, spec.y + rowBegin, spec.y + rowEnd, 0, 0, spec.nchannels,
+      if (!in->read_scanlines(subimage, 0, spec.y + y0, spec.y + y1, 0, 0, spec.nchannels,
                               OIIO::TypeDesc::FLOAT, part.values.data()))
         return fail(in->geterror());
     }
     ch->values.resize(part.pixels);
-    for (size_t i = 0; i < part.pixels; ++i) ch->values[i] = part.values[i * size_t(part.nchannels) + size_t(s.index)];
+    for (size_t i = 0; i < part.pixels; ++i) ch->values[i] = part.values[i * size_t(part.nchannels) + size_t(index)];
     return Status::Ok();
+  };
+  // The reconstructed channels (sparse mode) at the exact pixels of the
+  // record's window, each pixel from the samples file whose beauty it has;
+  // gathered one samples file at a time (a farm's round trip has many).
+  const InterpolationRecord* record = r.interpolation.get();
+  std::vector<const OutputLayout::Source*> wanted;
+  for (const auto& c : layout.channels) {
+    const OutputLayout::Source* s = c.kind == OutputLayout::Kind::kPass  ? &layout.passes[size_t(c.index)]
+                                    : c.kind == OutputLayout::Kind::kAlpha ? (layout.alpha ? &*layout.alpha : nullptr)
+                                                                           : nullptr;
+    if (s && s->reconstructed) wanted.push_back(s);
+  }
+  std::vector<std::vector<float>> exactOf(wanted.size());
+  Bounds2i w;
+  if (!wanted.empty()) {
+    if (!record) return Status::Error("channel '" + wanted[0]->name + "': the reconstruction kept no interpolation record");
+    // The record covers the region's pixels and the window around them.
+    w = record->window();
+    const int x0 = region ? region->min.x * downsample : 0;
+    const int x1 = region ? std::min(region->max.x * downsample, inWidth) : inWidth;
+    if (w.min.y > rowBegin || w.max.y < std::min(rowEnd, inHeight) || w.min.x > x0 || w.max.x < x1 ||
+        w.max.x > inWidth || w.max.y > inHeight)
+      return Status::Error("the interpolation record's window " + toolkit::RegionText(w) +
+                           " does not cover the output's pixels");
+    const size_t ww = size_t(w.width());
+    std::vector<int> fileOf(ww * size_t(w.height()), -1);
+    for (int y = w.min.y; y < w.max.y; ++y)
+      for (int x = w.min.x; x < w.max.x; ++x) {
+        const size_t i = size_t(y - w.min.y) * ww + size_t(x - w.min.x);
+        if (!record->IsExact(int64_t(i))) continue;
+        fileOf[i] = provider.SamplesFileOf({x, y});
+        if (fileOf[i] < 0 || size_t(fileOf[i]) >= layout.samples.size())
+          return Status::Error("exact pixel (" + std::to_string(x) + ", " + std::to_string(y) +
+                               ") is in no samples file");
+      }
+    for (auto& plane : exactOf) plane.assign(fileOf.size(), 0.f);
+    for (size_t f = 0; f < layout.samples.size(); ++f) {
+      if (std::find(fileOf.begin(), fileOf.end(), int(f)) == fileOf.end()) continue;
+      const int file = int(inputs.size() + f);
+      for (size_t k = 0; k < wanted.size(); ++k) {
+        const auto& s = *wanted[k];
+        toolkit::OutputChannel decoded;
+        DCM_RETURN_IF_ERROR(readRows(file, s.where[f].first, s.where[f].second, s.type, s.name, w.min.y, w.max.y, &decoded));
+        for (size_t i = 0; i < fileOf.size(); ++i) {
+          if (fileOf[i] != int(f)) continue;
+          const size_t at = (i / ww) * size_t(inWidth) + size_t(w.min.x) + i % ww;
+          // A uint ID's bits travel in the float (ChannelKind::kId only copies).
+          if (s.type == OIIO::TypeDesc::UINT) std::memcpy(&exactOf[k][i], &decoded.ids[at], sizeof(float));
+          else exactOf[k][i] = decoded.values[at];
+        }
+      }
+      // This file's decoded rows are no longer needed.
+      for (auto it = parts.begin(); it != parts.end();) it = std::get<0>(it->first) == file ? parts.erase(it) : std::next(it);
+    }
+  }
+  // A reconstructed channel: the record applied to its exact values, in the
+  // rows of the output's region like a copied channel's.
+  auto reconstruct = [&](const OutputLayout::Source& s, toolkit::OutputChannel* ch) -> Status {
+    const size_t k = size_t(std::find(wanted.begin(), wanted.end(), &s) - wanted.begin());
+    const bool ids = s.type == OIIO::TypeDesc::UINT;
+    std::vector<float> plane;
+    DCM_RETURN_IF_ERROR(record->Apply(exactOf[k], s.raw || ids ? ChannelKind::kId : ChannelKind::kContinuous, &plane));
+    std::vector<float>().swap(exactOf[k]);
+    const size_t ww = size_t(w.width()), size = size_t(inWidth) * size_t(rows);
+    if (ids) ch->ids.assign(size, 0u);
+    else ch->values.assign(size, 0.f);
+    for (int y = std::max(w.min.y, rowBegin); y < std::min(w.max.y, rowEnd); ++y)
+      for (int x = w.min.x; x < w.max.x; ++x) {
+        const float v = plane[size_t(y - w.min.y) * ww + size_t(x - w.min.x)];
+        const size_t at = size_t(y - rowBegin) * size_t(inWidth) + size_t(x);
+        if (ids) std::memcpy(&ch->ids[at], &v, sizeof(float));
+        else ch->values[at] = v;
+      }
+    return Status::Ok();
+  };
+  auto read = [&](const OutputLayout::Source& s, toolkit::OutputChannel* ch) -> Status {
+    if (s.reconstructed) return reconstruct(s, ch);
+    return readRows(s.file, s.subimage, s.index, s.type, s.name, rowBegin, rowEnd, ch);
   };
   std::vector<size_t> passes;  // output channels that are passes
   std::vector<size_t> fromInputs;  // output channels read from the inputs: whole rows of the output

@@ -71,6 +71,12 @@ struct OutputLayout {
     std::string name;
     OIIO::TypeDesc type;  ///< stored as FLOAT, HALF or UINT
     bool raw = false;     ///< an ID (AovProvider::IdChannels, UINT) or a Cryptomatte hash: -d leaves it alone
+    /// Sparse mode: held by every samples file, read there at the exact
+    /// pixels and reconstructed with the beauty's interpolation record (IDs,
+    /// `raw`, by ChannelKind::kId); `where` is its (subimage, index) in each
+    /// samples file. Otherwise copied from input `file`.
+    bool reconstructed = false;
+    std::vector<std::pair<int, int>> where;
   };
   enum class Kind { kBeauty, kAlpha, kPass };
   /// One output channel: a beauty component (`index` 0..2), the alpha, or
@@ -82,30 +88,41 @@ struct OutputLayout {
   };
   std::vector<Channel> channels;  ///< in the output's order (the input's)
   std::optional<Source> alpha;    ///< the input's alpha; none: A = 1 (--alpha) or no alpha
-  std::vector<Source> passes;     ///< carried over: dense mode (downsampled by pass_downsample.h)
+  std::vector<Source> passes;     ///< carried over (downsampled by pass_downsample.h)
+  std::vector<std::string> samples;  ///< sparse mode: the samples files the reconstructed channels are read from
   std::vector<std::string> cryptoLayers;  ///< the inputs' Cryptomatte layer names (their metadata)
   OIIO::ParamValueList attributes;  ///< the inputs' metadata (IsStructuralAttribute excluded)
   std::vector<std::string> notes;   ///< what the output keeps and what not, for -v
   Point2i inputSize;                ///< the inputs' data window's size
   /// The output channel names.
   std::vector<std::string> Names() const;
+  /// Whether any output channel is reconstructed from the samples (sparse
+  /// mode): the engine must then keep its interpolation record.
+  bool Reconstructs() const;
 };
 
-/// Plans the output of `provider` (opened from `inputs`): the beauty under
-/// its input names (provider.BeautyChannels(), else R, G, B), the input's
-/// alpha (the channel beside the beauty's R named A), or A = 1 when `alpha`
-/// and the input has none; in dense mode every other channel of the inputs. A file that cannot be read is an error naming it.
-Status PlanOutputLayout(const aov::AovProvider& provider, const std::vector<std::string>& inputs, bool alpha,
-                        int downsample, OutputLayout* out);
+/// Plans the output of `provider` (opened from `inputs` and, in sparse mode,
+/// `samples`): the beauty under its input names (provider.BeautyChannels(),
+/// else R, G, B), the input's alpha (the channel beside the beauty's R named
+/// A), or A = 1 when `alpha` and the input has none; every other channel of
+/// the inputs. In sparse mode the channels every samples file holds (but the
+/// beauty and the mask) are reconstructed from them, in the inputs' place
+/// where the inputs hold them too (but the alpha, which the inputs' guides
+/// render gives at every pixel); the alpha too when only they hold it. A
+/// file that cannot be read is an error naming it.
+Status PlanOutputLayout(const aov::AovProvider& provider, const std::vector<std::string>& inputs,
+                        const std::vector<std::string>& samples, bool alpha, int downsample, OutputLayout* out);
 
 /// The output image of `run` laid out as `layout` says: the beauty
-/// reconstructed, the alpha and passes read from `inputs` (with `downsample`
-/// > 1 the alpha box-filtered, the passes as DownsamplePasses filters them),
-/// the inputs' metadata plus `provenance`. With `region` (a part of the
-/// output's data window, --tile/--region), `run.result` holds that region
-/// only: the image's data window is the region, the alpha and the passes are
-/// cut to it.
-Status BuildOutputImage(const OutputLayout& layout, const std::vector<std::string>& inputs,
+/// reconstructed, the alpha and passes read from `inputs` or, reconstructed
+/// ones, from the samples files at the exact pixels (each pixel from the
+/// samples file whose beauty it has, AovProvider::SamplesFileOf) and
+/// reconstructed with `run.result.interpolation` (with `downsample` > 1 the
+/// alpha box-filtered, the passes as DownsamplePasses filters them), the
+/// inputs' metadata plus `provenance`. With `region` (a part of the output's
+/// data window, --tile/--region), `run.result` holds that region only: the
+/// image's data window is the region, the alpha and the passes are cut to it.
+Status BuildOutputImage(const aov::AovProvider& provider, const OutputLayout& layout, const std::vector<std::string>& inputs,
                         const ExrReconstruction& run, int downsample, const toolkit::Metadata& provenance,
                         toolkit::OutputImage* out, const Bounds2i* region = nullptr);
 

@@ -214,6 +214,12 @@ struct ReconstructionOptions {
   /// level knows). Costs one extra pass over the image per level when set.
   std::function<void(int level, int width, int height, const std::vector<RGB>& workImage)> onLevel;
 
+  /// Keep Reconstruction::interpolation, the record of how every pixel got
+  /// its value, to reconstruct other channels (passes) the same way
+  /// (dcm/interpolation_record.h). Not a setting of the method: the image
+  /// is the same bits either way; costs memory and time only when set.
+  bool recordInterpolation = false;
+
   /// Guo 1998 as described in section 2 of the paper: no thin-object test,
   /// object-ID test, no texture split, interpolation blind to surfaces.
   static ReconstructionOptions Guo();

@@ -3,11 +3,13 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string_view>
 #include <utility>
 #include <vector>
 
 #include "dcm/color.h"
+#include "dcm/interpolation_record.h"
 #include "dcm/options.h"
 #include "dcm/sample_provider.h"
 #include "dcm/status.h"
@@ -153,6 +155,10 @@ struct Reconstruction {
   std::vector<SampleReason> sampleMap;  ///< per working pixel
   std::vector<BlockRecord> blocks;    ///< final leaf blocks
   ReconstructionStats stats;
+  /// With ReconstructionOptions::recordInterpolation: how each working
+  /// pixel got its value, to reconstruct other channels the same way (its
+  /// window() places it in the provider's working image); null otherwise.
+  std::shared_ptr<InterpolationRecord> interpolation;
 };
 
 /// Whether a reconstruction with `options` of a provider with `caps` uses the

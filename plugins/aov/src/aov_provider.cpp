@@ -462,11 +462,14 @@ struct AovProvider::Data {
   std::vector<uint32_t> objectId, shaderId;
   std::vector<RGB> tau, L, Li, Lc, var;
   std::vector<Vec3f> normal;
-  std::vector<uint8_t> have;  ///< sparse mode: 1 where a sample was read
+  /// Sparse mode: where a sample was read, 1 + the index of the last
+  /// samples file that holds it (the one whose values the pixel has); 0 elsewhere.
+  std::vector<uint32_t> have;
   int64_t haveCount = 0;
   std::vector<std::string> notes, warnings, sampleChannels;
   std::vector<std::string> beautyChannels;  ///< AovProvider::BeautyChannels
   std::vector<std::string> idChannels;      ///< AovProvider::IdChannels
+  std::vector<std::string> maskChannels;    ///< AovProvider::MaskChannels
 };
 
 namespace {
@@ -939,7 +942,8 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
     for (const auto& m : options.mappings) variance |= (m.role == Role::kVarR);
     if (variance) d->var.assign(n, RGB{});
     d->have.assign(n, 0);
-    for (const auto& path : options.samples) {
+    for (size_t file = 0; file < options.samples.size(); ++file) {
+      const std::string& path = options.samples[file];
       ChannelSet s;
       DCM_RETURN_IF_ERROR(s.Add(path));
       if (!(s.windows() == d->windows))
@@ -968,6 +972,20 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
       }
       s.Want(ChannelsOf(s, fileRoles));
       Evaluator ev(s);
+      // The names the output gives the beauty and leaves out: the
+      // samples' own (the inputs carry no beauty in sparse mode).
+      for (const auto& term : fileRoles[size_t(Role::kMask)]->terms)
+        for (const auto& name : term)
+          if (std::find(d->maskChannels.begin(), d->maskChannels.end(), name) == d->maskChannels.end())
+            d->maskChannels.push_back(name);
+      if (file == 0 && d->beautyChannels.empty()) {
+        for (int c = 0; c < 3; ++c) {
+          const auto& e = fileRoles[size_t(Comp(kL, c))];
+          if (e && e->crypto.empty() && e->terms.size() == 1 && e->terms[0].size() == 1)
+            d->beautyChannels.push_back(e->terms[0][0]);
+        }
+        if (d->beautyChannels.size() != 3) d->beautyChannels.clear();
+      }
       std::vector<float> maskPlane;
       DCM_RETURN_IF_ERROR(ev.Eval(*fileRoles[size_t(Role::kMask)], &maskPlane));
       std::vector<uint8_t> mask(n);
@@ -977,11 +995,11 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
       int64_t count = 0;
       for (size_t i = 0; i < n; ++i) {
         count += mask[i];
-        d->have[i] |= mask[i];
+        if (mask[i]) d->have[i] = uint32_t(file + 1);
       }
       d->notes.push_back("samples file " + Quote(path) + ": " + std::to_string(count) + " pixels");
     }
-    for (size_t i = 0; i < n; ++i) d->haveCount += d->have[i];
+    for (size_t i = 0; i < n; ++i) d->haveCount += d->have[i] != 0;
     d->sampleChannels.clear();
     auto names = [&](const std::string& base) {
       for (int c = 0; c < 3; ++c) d->sampleChannels.push_back(base + kComp[c]);
@@ -1101,12 +1119,17 @@ bool AovProvider::HasSample(Point2i p) const {
   if (p.x < 0 || p.y < 0 || p.x >= d_->width() || p.y >= d_->height()) return false;
   return d_->have.empty() || d_->have[size_t(p.y) * size_t(d_->width()) + size_t(p.x)] != 0;
 }
+int AovProvider::SamplesFileOf(Point2i p) const {
+  return d_->have.empty() ? -1 : int(d_->have[size_t(p.y) * size_t(d_->width()) + size_t(p.x)]) - 1;
+}
+
 int64_t AovProvider::SampleCount() const {
   return d_->have.empty() ? int64_t(d_->width()) * d_->height() : d_->haveCount;
 }
 const std::vector<RGB>& AovProvider::Beauty() const { return d_->L; }
 const std::vector<std::string>& AovProvider::BeautyChannels() const { return d_->beautyChannels; }
 const std::vector<std::string>& AovProvider::IdChannels() const { return d_->idChannels; }
+const std::vector<std::string>& AovProvider::MaskChannels() const { return d_->maskChannels; }
 const std::vector<std::string>& AovProvider::Notes() const { return d_->notes; }
 const std::vector<std::string>& AovProvider::Warnings() const { return d_->warnings; }
 std::vector<std::string> AovProvider::SampleChannels() const { return d_->sampleChannels; }

@@ -153,15 +153,22 @@ class AovProvider final : public SampleProvider {
   bool dense() const;
   /// Whether pixel (x, y) has an exact sample.
   bool HasSample(Point2i p) const;
+  /// Sparse mode: the index (in AovOptions::samples) of the samples file
+  /// whose values pixel (x, y) has: the last that rendered it. -1 where none
+  /// did, and in dense mode.
+  int SamplesFileOf(Point2i p) const;
   /// Number of pixels with an exact sample.
   int64_t SampleCount() const;
   /// Beauty L of every pixel (row-major); pixels without a sample are 0.
   const std::vector<RGB>& Beauty() const;
   /// The input channels of the beauty L.R, L.G, L.B when each is one channel
   /// of the inputs ("ViewLayer.Combined.R" with the Blender preset, "R"
-  /// generic): the names the output EXR keeps. Empty when L is an expression
-  /// (--map L=a+b) or the inputs do not carry it (sparse mode).
+  /// generic): the names the output EXR keeps. In sparse mode, where the
+  /// inputs do not carry it, those of the first samples file. Empty when L
+  /// is an expression (--map L=a+b).
   const std::vector<std::string>& BeautyChannels() const;
+  /// Sparse mode: the samples files' channels read as the mask.
+  const std::vector<std::string>& MaskChannels() const;
   /// The input channels read as object or shader IDs (not Cryptomatte
   /// layers): integers, which a conversion to half would change above 2048.
   const std::vector<std::string>& IdChannels() const;
