@@ -10,7 +10,7 @@
 //
 // Builds only with the Embree plugin (like `dcm render`); AOV inputs only when
 // plugins/aov is available.
-#if __has_include("embree/embree_provider.h")
+#if __has_include("dcm/embree/embree_provider.h")
 
 #include <algorithm>
 #include <chrono>
@@ -38,8 +38,8 @@
 #include "common/output_guard.h"
 #include "common/stats_json.h"
 #include "dcm/reconstructor.h"
-#include "embree/embree_provider.h"
-#include "embree/scene_file.h"
+#include "dcm/embree/embree_provider.h"
+#include "dcm/embree/scene_file.h"
 #include "engine_flags.h"
 #include "flag_checks.h"
 
@@ -1037,4 +1037,4 @@ Registration reg(
 }  // namespace
 }  // namespace dcm::cli
 
-#endif  // __has_include("embree/embree_provider.h")
+#endif  // __has_include("dcm/embree/embree_provider.h")
