@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
     for (float t : {0.03f, 0.06f, 0.1f, 0.12f, 0.14f, 0.15f, 0.25f}) {
       testing::AnalyticProvider provider(n, n, testing::FurnishedScene(n, n));
       ReconstructionOptions o = base;
-      o.SetContrastThreshold(t);
+      o.contrastThreshold = t;
       Reconstruction r;
       const Status s = Reconstruct(provider, o, &r);
       if (!s.ok()) {

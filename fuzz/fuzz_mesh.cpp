@@ -1,5 +1,5 @@
 // libFuzzer target: the mesh loader of the internal ray tracer
-// (plugins/embree/mesh_loader.cpp: the PLY header check, then Assimp). The
+// (plugins/embree/src/mesh_loader.cpp: the PLY header check, then Assimp). The
 // first byte picks the extension (.ply or .obj: Assimp chooses its reader by
 // it, then by the content); the rest is written to a file and loaded.
 //
@@ -19,7 +19,7 @@
 #include <fstream>
 #include <string>
 
-#include "embree/mesh_loader.h"
+#include "dcm/embree/mesh_loader.h"
 
 namespace {
 

@@ -1,5 +1,5 @@
 // libFuzzer target: the scene-file parser of the internal ray tracer
-// (plugins/embree/scene_file.cpp, json_fields.cpp).
+// (plugins/embree/src/scene_file.cpp, json_fields.cpp).
 //
 // Besides crashes and sanitizer reports, it checks the parser's contract: a
 // scene that parses OK satisfies everything SCENE-FORMAT.md promises (finite
@@ -17,7 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "embree/scene_file.h"
+#include "dcm/embree/scene_file.h"
 
 namespace {
 

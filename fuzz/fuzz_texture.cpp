@@ -1,5 +1,5 @@
 // libFuzzer target: image textures of the internal ray tracer
-// (plugins/embree/textures.cpp: the declared-size check, then OpenImageIO's
+// (plugins/embree/src/textures.cpp: the declared-size check, then OpenImageIO's
 // TextureSystem). The first byte picks the extension the file is written
 // with (OpenImageIO chooses its reader by it, then by the content); the rest
 // is the file. The texture is created and looked up at three points with a
@@ -23,7 +23,7 @@
 #include <memory>
 #include <string>
 
-#include "embree/textures.h"
+#include "dcm/embree/textures.h"
 
 namespace {
 

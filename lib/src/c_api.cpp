@@ -152,7 +152,7 @@ bool CheckArgs(DCMReconstructor r, const char* name, const char* function) noexc
   }
 }
 
-// The option names are those of dcm/option_names.h (FindIntOption, ...): one
+// The option names are those of dcm/option_names.h (SetIntOption, ...): one
 // table, shared with the Python module.
 std::string UnknownOption(const char* kind, const char* name) {
   return std::string("unknown ") + kind + " option '" + name + "'";
@@ -358,8 +358,8 @@ DCM_API void dcmSetString(DCMReconstructor r, const char* name, const char* valu
 DCM_API void dcmSetInt(DCMReconstructor r, const char* name, int value) {
   if (!CheckArgs(r, name, "dcmSetInt")) return;
   Guard(r, "dcmSetInt", [&] {
-    if (int* p = dcm::FindIntOption(r->options, name)) *p = value;
-    else if (bool* b = dcm::FindBoolOption(r->options, name)) *b = value != 0;
+    if (dcm::SetIntOption(r->options, name, value)) return;
+    if (bool* b = dcm::FindBoolOption(r->options, name)) *b = value != 0;
     else SetError(r, DCM_ERROR_INVALID_ARGUMENT, UnknownOption("integer", name));
   });
 }
@@ -375,13 +375,12 @@ DCM_API void dcmSetFloat(DCMReconstructor r, const char* name, float value) {
                         std::string("option ") + name + ": must be in (0, " + (n == "budget" ? "1]" : "99] dB") +
                             " (0: none), got " + std::to_string(value));
       (n == "budget" ? r->budget : r->targetPsnr) = double(value);
-    } else if (float* f = dcm::FindFloatOption(r->options, name)) {
-      *f = value;
-    } else if (int* p = dcm::FindIntOption(r->options, name)) {
+    } else if (dcm::SetFloatOption(r->options, name, value)) {
+    } else if (dcm::KindOfOption(name) == dcm::OptionKind::kInt) {
       if (!(std::nearbyint(value) == value) || std::fabs(value) > 1e9f)
         return SetError(r, DCM_ERROR_INVALID_ARGUMENT,
                         std::string("option ") + name + ": expected a whole number, got " + std::to_string(value));
-      *p = int(value);
+      dcm::SetIntOption(r->options, name, int(value));
     } else {
       SetError(r, DCM_ERROR_INVALID_ARGUMENT, UnknownOption("float", name));
     }
@@ -400,8 +399,8 @@ DCM_API int dcmGetInt(DCMReconstructor r, const char* name) {
   if (!CheckArgs(r, name, "dcmGetInt")) return 0;
   int result = 0;
   Guard(r, "dcmGetInt", [&] {
-    if (int* p = dcm::FindIntOption(r->options, name)) result = *p;
-    else if (bool* b = dcm::FindBoolOption(r->options, name)) result = *b ? 1 : 0;
+    if (dcm::GetIntOption(r->options, name, &result)) return;
+    if (bool* b = dcm::FindBoolOption(r->options, name)) result = *b ? 1 : 0;
     else SetError(r, DCM_ERROR_INVALID_ARGUMENT, UnknownOption("integer", name));
   });
   return result;
@@ -413,8 +412,8 @@ DCM_API float dcmGetFloat(DCMReconstructor r, const char* name) {
   Guard(r, "dcmGetFloat", [&] {
     if (std::string_view(name) == "target_psnr") result = float(r->targetPsnr);
     else if (std::string_view(name) == "budget") result = float(r->budget);
-    else if (float* f = dcm::FindFloatOption(r->options, name)) result = *f;
-    else if (int* p = dcm::FindIntOption(r->options, name)) result = float(*p);
+    else if (dcm::GetFloatOption(r->options, name, &result)) return;
+    else if (int i = 0; dcm::GetIntOption(r->options, name, &i)) result = float(i);
     else SetError(r, DCM_ERROR_INVALID_ARGUMENT, UnknownOption("float", name));
   });
   return result;

@@ -1,23 +1,25 @@
 #include <array>
 #include <cmath>
 #include <iterator>
+#include <optional>
 #include <string>
 #include <utility>
 
 #include "dcm/options.h"
 #include "dcm/option_names.h"
+#include "dcm/reconstructor.h"
 
 namespace dcm {
 
 ReconstructionOptions ReconstructionOptions::Guo() {
   ReconstructionOptions o;
+  // Every regime alike: the paper has one.
   o.elementaryBlock = 8;  // Guo's and the paper's elementary blocks
-  o.noisyElementaryBlock = 0;
-  o.SetContrastThreshold(0.06f);
-  o.SetContrastMetric(ContrastMetric::kMitchell);
-  o.SetDirections(8);
+  o.contrastThreshold = 0.06f;
+  o.contrastMetric = ContrastMetric::kMitchell;
+  o.directions = 8;
   o.objectTest = ObjectTest::kObjectId;
-  o.SetThinObjects(ThinObjectTest::kOff);
+  o.thinObjects = ThinObjectTest::kOff;
   o.neighbourDirections = 0;
   o.surfaceAware = false;
   o.textureSplit = false;
@@ -39,7 +41,7 @@ ReconstructionOptions ReconstructionOptions::Guo() {
 ReconstructionOptions ReconstructionOptions::Paper() {
   ReconstructionOptions o = Guo();
   o.objectTest = ObjectTest::kObjectAndShader;
-  o.SetThinObjects(ThinObjectTest::kNoneMatches);
+  o.thinObjects = ThinObjectTest::kNoneMatches;
   o.textureSplit = true;
   o.fallback = true;  // "switching back to a full sampling for these few critical cases"
   o.fallbackMaxChanges = 4;  // more than two edges: more than two objects on the border
@@ -101,21 +103,16 @@ Status ReconstructionOptions::Validate() const {
   auto bad = [](const std::string& field, const std::string& why) {
     return Status::Error("option " + field + ": " + why);
   };
-  if (!IsPowerOfTwo(elementaryBlock) || elementaryBlock > 256)
-    return bad("elementaryBlock", "must be a power of two from 1 to 256, got " + std::to_string(elementaryBlock));
-  if (noisyElementaryBlock != 0 && (!IsPowerOfTwo(noisyElementaryBlock) || noisyElementaryBlock > 256))
-    return bad("noisyElementaryBlock",
-               "must be 0 or a power of two from 1 to 256, got " + std::to_string(noisyElementaryBlock));
-  if (!IsPowerOfTwo(minBlock) || minBlock > elementaryBlock)
-    return bad("minBlock", "must be a power of two from 1 to elementaryBlock (" + std::to_string(elementaryBlock) +
+  if (elementaryBlock && (!IsPowerOfTwo(*elementaryBlock) || *elementaryBlock > 256))
+    return bad("elementaryBlock", "must be a power of two from 1 to 256, got " + std::to_string(*elementaryBlock));
+  const int block = LargestElementaryBlock(*this);  // unset: a noisy regime's smaller block is raised to minBlock
+  if (!IsPowerOfTwo(minBlock) || minBlock > block)
+    return bad("minBlock", "must be a power of two from 1 to elementaryBlock (" + std::to_string(block) +
                                "), got " + std::to_string(minBlock));
-  if (!(contrastThreshold >= 0) || !std::isfinite(contrastThreshold))
+  if (contrastThreshold && (!(*contrastThreshold >= 0) || !std::isfinite(*contrastThreshold)))
     return bad("contrastThreshold", "must be a finite number >= 0");
-  if (!(contrastThresholdSupersampled >= 0) || !std::isfinite(contrastThresholdSupersampled))
-    return bad("contrastThresholdSupersampled", "must be a finite number >= 0");
-  if (directions < 1 || directions > 64) return bad("directions", "must be from 1 to 64, got " + std::to_string(directions));
-  if (directionsSupersampled < 1 || directionsSupersampled > 64)
-    return bad("directionsSupersampled", "must be from 1 to 64, got " + std::to_string(directionsSupersampled));
+  if (directions && (*directions < 1 || *directions > 64))
+    return bad("directions", "must be from 1 to 64, got " + std::to_string(*directions));
   if (!(creaseAngle >= 0 && creaseAngle <= 180)) return bad("creaseAngle", "must be from 0 to 180 degrees");
   if (!(noiseSignificance >= 0) || !std::isfinite(noiseSignificance))
     return bad("noiseSignificance", "must be a finite number >= 0");
@@ -142,18 +139,19 @@ Status ReconstructionOptions::Validate() const {
 namespace {
 using Options = ReconstructionOptions;
 
+/// A named option: a plain field, or one with a regime-aware default
+/// (`regime`), which a sentinel value unsets (SetIntOption, SetFloatOption).
 template <typename T>
 struct NamedField {
   std::string_view name;
-  T Options::*member;
+  T Options::*member = nullptr;
+  std::optional<T> Options::*regime = nullptr;
 };
 
 constexpr NamedField<int> kIntOptions[] = {
-    {"elementary_block", &Options::elementaryBlock},
-    {"noisy_elementary_block", &Options::noisyElementaryBlock},
+    {"elementary_block", nullptr, &Options::elementaryBlock},
     {"min_block", &Options::minBlock},
-    {"directions", &Options::directions},
-    {"directions_supersampled", &Options::directionsSupersampled},
+    {"directions", nullptr, &Options::directions},
     {"fallback_max_changes", &Options::fallbackMaxChanges},
     {"fallback_shading_changes", &Options::fallbackShadingChanges},
     {"simple_surface_changes", &Options::simpleSurfaceChanges},
@@ -165,8 +163,7 @@ constexpr NamedField<int> kIntOptions[] = {
     {"batch_size", &Options::batchSize},
 };
 constexpr NamedField<float> kFloatOptions[] = {
-    {"contrast_threshold", &Options::contrastThreshold},
-    {"contrast_threshold_supersampled", &Options::contrastThresholdSupersampled},
+    {"contrast_threshold", nullptr, &Options::contrastThreshold},
     {"noise_significance", &Options::noiseSignificance},
     {"probe_lc_share", &Options::probeLcShare},
     {"crease_angle", &Options::creaseAngle},
@@ -188,37 +185,92 @@ constexpr NamedField<bool> kBoolOptions[] = {
     {"denoise_samples", &Options::denoiseSamples},
 };
 constexpr std::string_view kStringOptions[] = {
-    "method", "object_test", "thin_objects", "thin_objects_supersampled",
-    "contrast_metric", "contrast_metric_supersampled", "smooth_refinement",
+    "method", "object_test", "thin_objects", "contrast_metric", "smooth_refinement",
 };
+/// The value of a regime-aware string option that unsets it.
+constexpr std::string_view kRegimeDefault = "default";
 
 template <typename T, size_t N>
-T* FindField(const NamedField<T> (&table)[N], Options& o, std::string_view name) {
+const NamedField<T>* Find(const NamedField<T> (&table)[N], std::string_view name) {
   for (const auto& e : table)
-    if (name == e.name) return &(o.*e.member);
+    if (name == e.name) return &e;
   return nullptr;
 }
 
-template <typename T, size_t N>
-bool Has(const NamedField<T> (&table)[N], std::string_view name) {
-  for (const auto& e : table)
-    if (name == e.name) return true;
-  return false;
+/// Sets the option `e` of `o`; `unset` restores a regime-aware one's default.
+template <typename T>
+void Assign(const NamedField<T>& e, Options& o, T value, bool unset) {
+  if (!e.regime) o.*e.member = value;
+  else if (unset) (o.*e.regime).reset();
+  else o.*e.regime = value;
+}
+
+/// The value of the option `e` of `o`; `unset` for a regime-aware one without a value.
+template <typename T>
+T Read(const NamedField<T>& e, const Options& o, T unset) {
+  return e.regime ? (o.*e.regime).value_or(unset) : o.*e.member;
+}
+
+/// A string option with a regime-aware default: kRegimeDefault unsets it.
+template <typename E>
+Status ParseRegime(std::string_view value, std::optional<E>* out) {
+  if (value == kRegimeDefault) {
+    out->reset();
+    return Status::Ok();
+  }
+  E e;
+  DCM_RETURN_IF_ERROR(Parse(value, &e));
+  *out = e;
+  return Status::Ok();
 }
 }  // namespace
 
 OptionKind KindOfOption(std::string_view name) {
   for (std::string_view s : kStringOptions)
     if (name == s) return OptionKind::kString;
-  if (Has(kIntOptions, name)) return OptionKind::kInt;
-  if (Has(kFloatOptions, name)) return OptionKind::kFloat;
-  if (Has(kBoolOptions, name)) return OptionKind::kBool;
+  if (Find(kIntOptions, name)) return OptionKind::kInt;
+  if (Find(kFloatOptions, name)) return OptionKind::kFloat;
+  if (Find(kBoolOptions, name)) return OptionKind::kBool;
   return OptionKind::kUnknown;
 }
 
-int* FindIntOption(Options& o, std::string_view name) { return FindField(kIntOptions, o, name); }
-float* FindFloatOption(Options& o, std::string_view name) { return FindField(kFloatOptions, o, name); }
-bool* FindBoolOption(Options& o, std::string_view name) { return FindField(kBoolOptions, o, name); }
+bool SetIntOption(Options& o, std::string_view name, int value) {
+  const NamedField<int>* e = Find(kIntOptions, name);
+  if (e) Assign(*e, o, value, value == 0);
+  return e != nullptr;
+}
+
+bool SetFloatOption(Options& o, std::string_view name, float value) {
+  const NamedField<float>* e = Find(kFloatOptions, name);
+  if (e) Assign(*e, o, value, value < 0.f);
+  return e != nullptr;
+}
+
+bool GetIntOption(const Options& o, std::string_view name, int* value) {
+  const NamedField<int>* e = Find(kIntOptions, name);
+  if (e) *value = Read(*e, o, 0);
+  return e != nullptr;
+}
+
+bool GetFloatOption(const Options& o, std::string_view name, float* value) {
+  const NamedField<float>* e = Find(kFloatOptions, name);
+  if (e) *value = Read(*e, o, -1.f);
+  return e != nullptr;
+}
+
+bool* FindBoolOption(Options& o, std::string_view name) {
+  const NamedField<bool>* e = Find(kBoolOptions, name);
+  return e ? &(o.*e->member) : nullptr;
+}
+
+Status ResetOption(Options* o, std::string_view name) {
+  if (name == "thin_objects") return o->thinObjects.reset(), Status::Ok();
+  if (name == "contrast_metric") return o->contrastMetric.reset(), Status::Ok();
+  if (const NamedField<int>* e = Find(kIntOptions, name); e && e->regime) return Assign(*e, *o, 0, true), Status::Ok();
+  if (const NamedField<float>* e = Find(kFloatOptions, name); e && e->regime)
+    return Assign(*e, *o, 0.f, true), Status::Ok();
+  return Status::Error("option " + std::string(name) + ": has no default that depends on the regime");
+}
 
 Status SetStringOption(Options* o, std::string_view name, std::string_view value) {
   if (name == "method") {
@@ -229,10 +281,8 @@ Status SetStringOption(Options* o, std::string_view name, std::string_view value
     return Status::Ok();
   }
   if (name == "object_test") return Parse(value, &o->objectTest);
-  if (name == "thin_objects") return Parse(value, &o->thinObjects);
-  if (name == "thin_objects_supersampled") return Parse(value, &o->thinObjectsSupersampled);
-  if (name == "contrast_metric") return Parse(value, &o->contrastMetric);
-  if (name == "contrast_metric_supersampled") return Parse(value, &o->contrastMetricSupersampled);
+  if (name == "thin_objects") return ParseRegime(value, &o->thinObjects);
+  if (name == "contrast_metric") return ParseRegime(value, &o->contrastMetric);
   if (name == "smooth_refinement") return Parse(value, &o->smoothRefinement);
   return Status::Error("unknown string option '" + std::string(name) + "'");
 }

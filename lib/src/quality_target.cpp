@@ -361,7 +361,7 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   auto runAt = [&](double t, std::optional<Run>* result) -> Status {
     ReconstructionOptions o = options;
     if (t < 0) o.fullEvaluation = true;
-    else o.SetContrastThreshold(float(t));
+    else o.contrastThreshold = float(t);
     Run r;
     r.threshold = t;
     if (options.onLevel) {
@@ -391,10 +391,9 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
     return Status::Ok();
   };
 
-  const bool rules = UsesSupersampledRules(options, caps);
+  const double threshold = double(ResolveSettings(options, caps).contrastThreshold);
   // Contrasts are at most 1 but for the display-weighted metric's brightest sets.
-  const double t0 = limit > 0 ? std::min(kStartFactorBudget * double(options.ContrastThresholdFor(rules)), 1.0)
-                              : kStartFactor * double(options.ContrastThresholdFor(rules));
+  const double t0 = limit > 0 ? std::min(kStartFactorBudget * threshold, 1.0) : kStartFactor * threshold;
   auto meets = [&](const Run& r) { return goal.targetPsnr > 0 && r.estimate.low >= goal.targetPsnr; };
 
   std::optional<Run> best, tried;

@@ -9,18 +9,37 @@
 namespace dcm {
 namespace detail {
 
+namespace {
+// dcm's values of the options with a regime-aware default, per regime
+// (which data chose each: docs/TUNING.md).
+constexpr int kElementaryBlock = 16;
+constexpr int kNoisyElementaryBlock = 8;
+constexpr float kContrastThreshold = 0.14f;
+constexpr float kSupersampledContrastThreshold = 0.15f;
+constexpr ContrastMetric kContrastMetric = ContrastMetric::kMitchell;
+constexpr ContrastMetric kSupersampledContrastMetric = ContrastMetric::kDisplayWeighted;
+constexpr int kDirections = 8;
+constexpr int kSupersampledDirections = 16;
+constexpr ThinObjectTest kThinObjects = ThinObjectTest::kEndDiffers;
+constexpr ThinObjectTest kSupersampledThinObjects = ThinObjectTest::kNoneMatches;
+}  // namespace
+
 Settings Resolve(const ReconstructionOptions& o, const ProviderCapabilities& caps) {
   Settings s;
   s.noisy = caps.variance && o.noiseSignificance > 0.f;
   s.split = o.textureSplit && caps.texture && caps.splitRadiance && !o.fullEvaluation;
-  s.elementaryBlock = o.ElementaryBlockFor(s.noisy);
-  s.supersampledRules = o.SupersampledRules(s.noisy);
-  s.contrastMetric = o.ContrastMetricFor(s.supersampledRules);
-  s.contrastThreshold = o.ContrastThresholdFor(s.supersampledRules);
+  // Never below the finest block.
+  s.elementaryBlock = std::max(o.elementaryBlock.value_or(s.noisy ? kNoisyElementaryBlock : kElementaryBlock), o.minBlock);
+  // The supersampled rules serve supersampled input whose samples are not
+  // noisy: with noise, the noise regime's rules hold at any supersampling.
+  s.supersampledRules = o.downsample >= 2 && !s.noisy;
+  const bool ss = s.supersampledRules;
+  s.contrastMetric = o.contrastMetric.value_or(ss ? kSupersampledContrastMetric : kContrastMetric);
+  s.contrastThreshold = o.contrastThreshold.value_or(ss ? kSupersampledContrastThreshold : kContrastThreshold);
   s.contrastSignificance = s.noisy ? o.noiseSignificance : 0.f;
-  s.directions = o.DirectionsFor(s.supersampledRules);
-  s.thinObjects = o.ThinObjectsFor(s.supersampledRules);
-  s.crossingFillReach = o.CrossingFillReachFor(s.supersampledRules);
+  s.directions = o.directions.value_or(ss ? kSupersampledDirections : kDirections);
+  s.thinObjects = o.thinObjects.value_or(ss ? kSupersampledThinObjects : kThinObjects);
+  s.crossingFillReach = ss ? o.crossingFillReach : 0;
   // Noisy samples keep the probes: they are also samples the denoising fits
   // use.
   s.smoothRefinement = o.smoothRefinement == SmoothRefinement::kCentreProbe && caps.hardShadowsGuided && !s.noisy
@@ -31,7 +50,8 @@ Settings Resolve(const ReconstructionOptions& o, const ProviderCapabilities& cap
                 (o.objectTest == ObjectTest::kObjectAndShader || o.objectTest == ObjectTest::kObjectOrShader);
   s.normals = caps.normal && o.creaseAngle > 0.f;
   s.objectTest = s.objectIds ? o.objectTest : ObjectTest::kNone;
-  s.creaseAngle = s.normals ? o.WorkCreaseAngle() : 0.f;
+  // One threshold of curvature per output pixel at every supersampling.
+  s.creaseAngle = !s.normals ? 0.f : o.downsample > 1 ? o.creaseAngle / float(o.downsample) : o.creaseAngle;
   s.denoise = s.noisy && o.denoiseSamples && !o.fullEvaluation;
   s.denoiseRadius = s.elementaryBlock;
   s.denoiseGate = std::max(o.noiseSignificance, kDenoiseGateMinSd);
@@ -41,12 +61,12 @@ Settings Resolve(const ReconstructionOptions& o, const ProviderCapabilities& cap
 
 }  // namespace detail
 
-bool UsesSupersampledRules(const ReconstructionOptions& options, const ProviderCapabilities& caps) {
-  return detail::Resolve(options, caps).supersampledRules;
+ResolvedSettings ResolveSettings(const ReconstructionOptions& options, const ProviderCapabilities& caps) {
+  return detail::Resolve(options, caps);
 }
 
-SmoothRefinement UsedSmoothRefinement(const ReconstructionOptions& options, const ProviderCapabilities& caps) {
-  return detail::Resolve(options, caps).smoothRefinement;
+int LargestElementaryBlock(const ReconstructionOptions& options) {
+  return options.elementaryBlock.value_or(std::max(detail::kElementaryBlock, detail::kNoisyElementaryBlock));
 }
 
 }  // namespace dcm

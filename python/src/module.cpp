@@ -56,10 +56,16 @@ std::string JoinNames(OptionKind kind) {
 
 /// Sets one option by its C API name from a Python value: str for string
 /// options; int (or a whole float) for integer options; int or float for
-/// float options; bool (or 0/1) for bool options. Wrong names and values
-/// raise ValueError, wrong types TypeError, naming the option.
+/// float options; bool (or 0/1) for bool options; None for dcm's default of
+/// the regime (an option whose default depends on it). Wrong names and
+/// values raise ValueError, wrong types TypeError, naming the option.
 void SetOption(Settings* s, const std::string& name, py::handle value) {
   ReconstructionOptions& o = s->options;
+  if (value.is_none() && KindOfOption(name) != OptionKind::kUnknown) {
+    const Status st = ResetOption(&o, name);
+    if (!st.ok()) throw py::value_error(st.message());
+    return;
+  }
   const bool isBool = py::isinstance<py::bool_>(value);
   const bool isInt = !isBool && py::isinstance<py::int_>(value);
   const bool isFloat = py::isinstance<py::float_>(value);
@@ -87,13 +93,13 @@ void SetOption(Settings* s, const std::string& name, py::handle value) {
         wrongType("an int");
       }
       if (v < INT_MIN || v > INT_MAX) throw py::value_error("option " + name + ": out of range");
-      *FindIntOption(o, name) = int(v);
+      SetIntOption(o, name, int(v));
       if (name == "batch_size") s->batchSizeSet = true;
       return;
     }
     case OptionKind::kFloat:
       if (!isInt && !isFloat) wrongType("a float");
-      *FindFloatOption(o, name) = value.cast<float>();
+      SetFloatOption(o, name, value.cast<float>());
       return;
     case OptionKind::kBool:
       if (isBool) {

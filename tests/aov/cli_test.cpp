@@ -157,9 +157,10 @@ TEST(DcmReconstruct, DownsampleComparesAtOutputResolution) {
 }
 
 // Supersampled input whose samples are not noisy has its own threshold,
-// directions, thin-object test and crossing fill (dcm/options.h): the stats record the
-// settings and whether the run used those rules, -v says which it uses and
-// why, and the flags set them at every supersampling.
+// directions, thin-object test and crossing fill (ResolveSettings): the stats
+// record the settings and whether the run used those rules (the options
+// leave them unset), -v says which it uses and why, and the flags set them
+// at every supersampling.
 TEST(DcmReconstruct, SupersampledInputHasItsOwnDefaults) {
   ScratchDir dir;
   Scene sc{64, 64};
@@ -175,44 +176,57 @@ TEST(DcmReconstruct, SupersampledInputHasItsOwnDefaults) {
     return std::pair(ReadJson(dir / "s.json"), r.err);
   };
   const ReconstructionOptions defaults;
-  auto said = [](const ReconstructionOptions& o, bool rules, const std::string& why) {
+  // dcm's settings at `downsample`, with noisy samples or not.
+  auto resolved = [&](int downsample, bool noisy) {
+    ReconstructionOptions o = defaults;
+    o.downsample = downsample;
+    ProviderCapabilities caps;
+    caps.variance = noisy;
+    return ResolveSettings(o, caps);
+  };
+  auto said = [](const ResolvedSettings& r, const std::string& why) {
     std::ostringstream s;
-    s << "contrast " << ToString(o.ContrastMetricFor(rules)) << ", threshold " << o.ContrastThresholdFor(rules)
-      << ", " << o.DirectionsFor(rules) << " directions, thin-object test " << ToString(o.ThinObjectsFor(rules))
-      << ", crossing fill " << o.CrossingFillReachFor(rules) << " (" << why << ")";
+    s << "contrast " << ToString(r.contrastMetric) << ", threshold " << r.contrastThreshold << ", " << r.directions
+      << " directions, thin-object test " << ToString(r.thinObjects) << ", crossing fill " << r.crossingFillReach
+      << " (" << why << ")";
     return s.str();
   };
   const auto [final1, final1Err] = run("in.exr", {});
   EXPECT_FALSE(bool(final1["used"]["supersampled_rules"]));
-  EXPECT_THAT(final1Err, HasSubstr(said(defaults, false, "final resolution")));
+  EXPECT_THAT(final1Err, HasSubstr(said(resolved(1, false), "final resolution")));
   // No shadow guide: the smooth blocks keep their centre probes.
   EXPECT_FALSE(bool(final1["capabilities"]["hard_shadows_guided"]));
   EXPECT_THAT(final1Err, HasSubstr("smooth blocks: centre-probe\n"));
   const auto [x2, x2Err] = run("in.exr", {"--downsample", "2"});
   EXPECT_TRUE(bool(x2["used"]["supersampled_rules"]));
-  EXPECT_THAT(x2Err, HasSubstr(said(defaults, true, "supersampled rules: --downsample 2")));
-  EXPECT_FLOAT_EQ(float(x2["options"]["contrast_threshold_supersampled"]), defaults.contrastThresholdSupersampled);
-  EXPECT_EQ(x2["options"]["thin_objects_supersampled"], std::string(ToString(defaults.thinObjectsSupersampled)));
-  EXPECT_EQ(x2["options"]["contrast_metric_supersampled"], std::string(ToString(defaults.contrastMetricSupersampled)));
-  EXPECT_NE(defaults.contrastMetricSupersampled, defaults.contrastMetric);
-  EXPECT_EQ(x2["options"]["directions_supersampled"], defaults.directionsSupersampled);
-  EXPECT_NE(defaults.directionsSupersampled, defaults.directions);
+  const ResolvedSettings ss = resolved(2, false);
+  EXPECT_THAT(x2Err, HasSubstr(said(ss, "supersampled rules: --downsample 2")));
+  for (const char* f : {"elementary_block", "contrast_threshold", "contrast_metric", "directions", "thin_objects"})
+    EXPECT_TRUE(x2["options"][f].is_null()) << f << ": unset, the regime's default";
+  EXPECT_FLOAT_EQ(float(x2["settings"]["contrast_threshold"]), ss.contrastThreshold);
+  EXPECT_EQ(x2["settings"]["thin_objects"], std::string(ToString(ss.thinObjects)));
+  EXPECT_EQ(x2["settings"]["contrast_metric"], std::string(ToString(ss.contrastMetric)));
+  EXPECT_NE(x2["settings"]["contrast_metric"], final1["settings"]["contrast_metric"]);
+  EXPECT_EQ(x2["settings"]["directions"], ss.directions);
+  EXPECT_NE(x2["settings"]["directions"], final1["settings"]["directions"]);
   EXPECT_EQ(x2["options"]["crossing_fill_reach"], defaults.crossingFillReach);
+  EXPECT_EQ(x2["settings"]["crossing_fill_reach"], defaults.crossingFillReach);
   // Noisy samples (a variance channel): the noise regime's settings.
   const auto [noisy, noisyErr] = run("noisy.exr", {"--downsample", "2"});
   EXPECT_FALSE(bool(noisy["used"]["supersampled_rules"]));
   EXPECT_EQ(noisy["crossings_filled"], 0);
-  EXPECT_THAT(noisyErr, HasSubstr(said(defaults, false, "noisy samples: the supersampled rules are off")));
+  EXPECT_THAT(noisyErr, HasSubstr(said(resolved(2, true), "noisy samples: the supersampled rules are off")));
   // The flags set both regimes.
   const auto [set, setErr] =
       run("in.exr", {"--downsample", "2", "--threshold", "0.1", "--thin-test", "any-differs", "--crossing-fill", "0",
                      "--contrast", "display", "--directions", "4"});
-  for (const char* f : {"contrast_threshold", "contrast_threshold_supersampled"})
-    EXPECT_FLOAT_EQ(float(set["options"][f]), 0.1f) << f;
-  for (const char* f : {"thin_objects", "thin_objects_supersampled"}) EXPECT_EQ(set["options"][f], "any-differs") << f;
-  for (const char* f : {"contrast_metric", "contrast_metric_supersampled"}) EXPECT_EQ(set["options"][f], "display") << f;
-  for (const char* f : {"directions", "directions_supersampled"}) EXPECT_EQ(set["options"][f], 4) << f;
-  EXPECT_EQ(set["options"]["crossing_fill_reach"], 0);
+  for (const char* part : {"options", "settings"}) {
+    EXPECT_FLOAT_EQ(float(set[part]["contrast_threshold"]), 0.1f) << part;
+    EXPECT_EQ(set[part]["thin_objects"], "any-differs") << part;
+    EXPECT_EQ(set[part]["contrast_metric"], "display") << part;
+    EXPECT_EQ(set[part]["directions"], 4) << part;
+    EXPECT_EQ(set[part]["crossing_fill_reach"], 0) << part;
+  }
   EXPECT_EQ(set["crossings_filled"], 0);
 }
 
@@ -298,8 +312,11 @@ TEST(DcmReconstruct, StatsHaveTheTimePerStageAndTheResolvedSettings) {
   // The settings the stages used: the supersampled input (--downsample 2,
   // no variance) takes the supersampled rules' contrast threshold.
   ASSERT_TRUE(bool(s["used"]["supersampled_rules"]));
-  EXPECT_EQ(double(s["settings"]["contrast_threshold"]), double(s["options"]["contrast_threshold_supersampled"]));
-  EXPECT_EQ(s["settings"]["directions"], s["options"]["directions_supersampled"]);
+  ReconstructionOptions x2;
+  x2.downsample = 2;
+  const ResolvedSettings expected = ResolveSettings(x2, ProviderCapabilities{});
+  EXPECT_EQ(float(double(s["settings"]["contrast_threshold"])), expected.contrastThreshold);  // written as the short decimal
+  EXPECT_EQ(s["settings"]["directions"], expected.directions);
   EXPECT_FALSE(bool(s["settings"]["noisy"]));
   EXPECT_FALSE(s["settings"].contains("split"));  // "used" reports it
   EXPECT_THAT(r.err, HasSubstr("time per stage: surfaces "));

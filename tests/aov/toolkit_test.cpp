@@ -216,14 +216,14 @@ TEST(StatsJson, WritesAtomically) {
   s.exactPixels = 7;
   s.byReason[size_t(SampleReason::kCorner)] = 7;
   auto j = toolkit::StatsToJson(s);
-  j["options"] = toolkit::OptionsToJson(ReconstructionOptions{});
+  j["options"] = toolkit::OptionsToJson(ReconstructionOptions::Guo());  // a threshold set: 0.06
   ASSERT_TRUE(toolkit::WriteJson(dir / "s.json", j).ok());
   const auto back = nlohmann::json::parse(ReadText(dir / "s.json"));
   EXPECT_EQ(back["exact_fraction"], 0.07);
   EXPECT_EQ(back["by_reason"]["corner"], 7);
   // Float options read back as the same float, written as a short decimal.
   const auto& t = back["options"]["contrast_threshold"];
-  EXPECT_EQ(float(double(t)), ReconstructionOptions{}.contrastThreshold);
+  EXPECT_EQ(float(double(t)), *ReconstructionOptions::Guo().contrastThreshold);
   EXPECT_LE(t.dump().size(), 10u) << t.dump();
   EXPECT_FALSE(toolkit::WriteJson(dir / "no/s.json", j).ok());
   EXPECT_EQ(dir.Files(), std::vector<std::string>{"s.json"});

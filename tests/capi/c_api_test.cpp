@@ -86,13 +86,18 @@ TEST(CApi, VersionMatchesHeader) {
 TEST(CApi, MethodPresetsResetEveryOption) {
   DCMReconstructor r = dcmNewReconstructor();
   ASSERT_NE(r, nullptr);
-  // dcm's defaults (whatever their values) are what method "dcm" restores.
+  // dcm's defaults are what method "dcm" restores: the block and the
+  // threshold depend on the regime, so they read as unset (0, -1).
   const int block = dcmGetInt(r, "elementary_block");
   const float threshold = dcmGetFloat(r, "contrast_threshold");
+  EXPECT_EQ(block, 0);
+  EXPECT_EQ(threshold, -1.f);
   EXPECT_EQ(dcmGetBool(r, "surface_aware"), 1);
   EXPECT_EQ(dcmGetBool(r, "adaptive_borders"), 1);
-  dcmSetInt(r, "elementary_block", block * 2);
-  dcmSetFloat(r, "contrast_threshold", threshold + 1.f);
+  dcmSetInt(r, "elementary_block", 32);
+  dcmSetFloat(r, "contrast_threshold", 0.3f);
+  EXPECT_EQ(dcmGetInt(r, "elementary_block"), 32);
+  EXPECT_FLOAT_EQ(dcmGetFloat(r, "contrast_threshold"), 0.3f);
   dcmSetBool(r, "surface_aware", 0);
   dcmSetString(r, "method", "dcm");
   EXPECT_EQ(dcmGetInt(r, "elementary_block"), block) << "a preset resets overrides";
@@ -102,26 +107,38 @@ TEST(CApi, MethodPresetsResetEveryOption) {
   EXPECT_EQ(dcmGetBool(r, "checkerboard"), 1);
   EXPECT_GT(dcmGetInt(r, "simple_surface_changes"), 2);
   EXPECT_GE(dcmGetInt(r, "fallback_shading_changes"), 0);
-  // Supersampled input has its own threshold (of another metric),
-  // directions and fill (dcm only).
-  EXPECT_NE(dcmGetFloat(r, "contrast_threshold_supersampled"), threshold);
-  EXPECT_GT(dcmGetInt(r, "directions_supersampled"), dcmGetInt(r, "directions"));
+  // The directions too depend on the regime (more under the supersampled
+  // rules), and the crossing fill applies under those rules only (dcm only).
+  EXPECT_EQ(dcmGetInt(r, "directions"), 0);
   EXPECT_GT(dcmGetInt(r, "crossing_fill_reach"), 0);
-  dcmSetString(r, "thin_objects_supersampled", "any-differs");
-  dcmSetString(r, "thin_objects_supersampled", "sometimes");  // recorded as an error, taken below
+  // A value set serves every regime; 0 (a negative float) unsets it again.
+  dcmSetInt(r, "directions", 4);
+  EXPECT_EQ(dcmGetInt(r, "directions"), 4);
+  dcmSetFloat(r, "directions", 0.f);
+  EXPECT_EQ(dcmGetInt(r, "directions"), 0);
+  dcmSetFloat(r, "contrast_threshold", -1.f);
+  EXPECT_EQ(dcmGetFloat(r, "contrast_threshold"), -1.f);
+  dcmSetString(r, "thin_objects", "any-differs");
+  dcmSetString(r, "thin_objects", "default");
+  dcmSetString(r, "thin_objects", "sometimes");  // recorded as an error, taken below
   DCMError bad;
   EXPECT_NE(TakeError(r, &bad).find("thin-object test"), std::string::npos);
   EXPECT_EQ(bad, DCM_ERROR_INVALID_ARGUMENT);
-  dcmSetString(r, "contrast_metric_supersampled", "mitchell");
-  dcmSetString(r, "contrast_metric_supersampled", "loud");
+  dcmSetString(r, "contrast_metric", "mitchell");
+  dcmSetString(r, "contrast_metric", "loud");
   EXPECT_NE(TakeError(r, &bad).find("contrast metric: unknown value 'loud'"), std::string::npos);
   EXPECT_EQ(bad, DCM_ERROR_INVALID_ARGUMENT);
+  // The twins of API version 3 are gone.
+  dcmSetInt(r, "directions_supersampled", 16);
+  EXPECT_NE(TakeError(r, &bad).find("unknown integer option 'directions_supersampled'"), std::string::npos);
   dcmSetString(r, "method", "paper");
   EXPECT_EQ(dcmGetBool(r, "checkerboard"), 0);
   EXPECT_EQ(dcmGetInt(r, "simple_surface_changes"), 2);
   EXPECT_EQ(dcmGetInt(r, "fallback_shading_changes"), -1);  // every change counts
-  EXPECT_EQ(dcmGetFloat(r, "contrast_threshold_supersampled"), dcmGetFloat(r, "contrast_threshold"));
-  EXPECT_EQ(dcmGetInt(r, "directions_supersampled"), dcmGetInt(r, "directions"));
+  // The paper's values serve every regime.
+  EXPECT_GT(dcmGetFloat(r, "contrast_threshold"), 0.f);
+  EXPECT_GT(dcmGetInt(r, "directions"), 0);
+  EXPECT_GT(dcmGetInt(r, "elementary_block"), 0);
   EXPECT_EQ(dcmGetInt(r, "crossing_fill_reach"), 0);
   EXPECT_EQ(dcmGetBool(r, "surface_aware"), 0);
   EXPECT_EQ(dcmGetBool(r, "texture_split"), 1);
@@ -462,14 +479,14 @@ int EvaluateNoisy(void* user, const int* xy, int count, float* rgb, float* li, f
 TEST(CApi, NoisySampleFunctionReportsVariance) {
   // With the variance reported, the engine does not chase the noise: fewer
   // exact pixels than with the noise taken at face value (noise_significance
-  // 0), on the same samples and the same lattice (noisy_elementary_block 0:
-  // the 16-pixel blocks of noiseless samples for both).
+  // 0), on the same samples and the same lattice (elementary_block 16: the
+  // blocks of noiseless samples for both).
   auto exactPixels = [](float significance, bool* sawVariance) {
     NoisyScene scene;
     DCMReconstructor r = Make(scene);
     dcmSetNoisySampleFunction(r, EvaluateNoisy, &scene, DCM_SAMPLE_THREAD_SAFE);
     dcmSetFloat(r, "noise_significance", significance);
-    dcmSetInt(r, "noisy_elementary_block", 0);
+    dcmSetInt(r, "elementary_block", 16);
     EXPECT_FLOAT_EQ(dcmGetFloat(r, "noise_significance"), significance);
     EXPECT_EQ(dcmExecute(r), DCM_ERROR_NONE) << TakeError(r);
     *sawVariance = scene.sawVarianceBuffer;

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "embree/integrator.h"
+#include "dcm/embree/integrator.h"
 #include "test_scenes.h"
 
 namespace dcm::embree {

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <string>
 
-#include "embree/scene_file.h"
+#include "dcm/embree/scene_file.h"
 #include "test_scenes.h"
 
 namespace dcm::embree {

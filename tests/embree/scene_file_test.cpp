@@ -3,8 +3,8 @@
 
 #include <string>
 
-#include "embree/embree_provider.h"
-#include "embree/scene_file.h"
+#include "dcm/embree/embree_provider.h"
+#include "dcm/embree/scene_file.h"
 #include "test_scenes.h"
 
 namespace dcm::embree {

@@ -6,7 +6,7 @@
 #include <fstream>
 #include <random>
 
-#include "embree/scene_file.h"
+#include "dcm/embree/scene_file.h"
 
 namespace dcm::embree::testing {
 

@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "dcm/sample_provider.h"
-#include "embree/embree_provider.h"
-#include "embree/scene.h"
+#include "dcm/embree/embree_provider.h"
+#include "dcm/embree/scene.h"
 
 namespace dcm::embree::testing {
 

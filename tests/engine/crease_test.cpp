@@ -80,13 +80,15 @@ TEST(Crease, TheAngleIsPerOutputPixel) {
   // A surface whose normal turns by 20 degrees per work pixel: at final
   // resolution, below the 30-degree threshold, no crease; as the 2x
   // supersampled input of an output pixel that turns by 40, a crease at
-  // every pixel (WorkCreaseAngle 15), so the normals change what is sampled
+  // every pixel (15 degrees per work pixel), so the normals change what is sampled
   // (every pixel its own surface: measured 2829 exact pixels with normals,
   // 6386 without).
   ReconstructionOptions o;
-  EXPECT_EQ(o.WorkCreaseAngle(), 30.f);
+  ProviderCapabilities withNormals;
+  withNormals.normal = true;
+  EXPECT_EQ(ResolveSettings(o, withNormals).creaseAngle, 30.f);
   o.downsample = 2;
-  EXPECT_EQ(o.WorkCreaseAngle(), 15.f);
+  EXPECT_EQ(ResolveSettings(o, withNormals).creaseAngle, 15.f);
   const SceneFunction curved = [](int x, int) {
     PixelTruth t;
     const float a = 0.349f * float(std::abs(x % 14 - 7));  // 20 degrees per pixel, back and forth

@@ -26,12 +26,12 @@ TEST(SmoothRefinement, NoCentreProbesWhereTheGuidesShowTheHardShadows) {
   guided.hardShadowsGuided = true;
   AnalyticProvider withProbes(N, N, scene, probed), withoutProbes(N, N, scene, guided);
   const Reconstruction a = ReconstructOrFail(withProbes, {}), b = ReconstructOrFail(withoutProbes, {});
-  EXPECT_EQ(UsedSmoothRefinement({}, withProbes.Capabilities()), SmoothRefinement::kCentreProbe);
-  EXPECT_EQ(UsedSmoothRefinement({}, withoutProbes.Capabilities()), SmoothRefinement::kNever);
+  EXPECT_EQ(ResolveSettings({}, withProbes.Capabilities()).smoothRefinement, SmoothRefinement::kCentreProbe);
+  EXPECT_EQ(ResolveSettings({}, withoutProbes.Capabilities()).smoothRefinement, SmoothRefinement::kNever);
   // Noisy samples keep the probes (the denoising fits use them too).
   ProviderCapabilities noisy = withoutProbes.Capabilities();
   noisy.variance = true;
-  EXPECT_EQ(UsedSmoothRefinement({}, noisy), SmoothRefinement::kCentreProbe);
+  EXPECT_EQ(ResolveSettings({}, noisy).smoothRefinement, SmoothRefinement::kCentreProbe);
   const auto corner = size_t(SampleReason::kCorner);
   EXPECT_EQ(b.stats.byReason[corner], 25);  // the 5x5 corners of the 16-pixel lattice
   const int64_t blocks = (N / 16) * (N / 16);

@@ -147,7 +147,8 @@ void ExpectRejected(SampleProvider& p, Set set, const std::string& field, const 
 
 TEST(Invariants, InvalidOptionsNameTheField) {
   AnalyticProvider p(8, 8, Constant(RGB::Gray(1)));
-  ExpectRejected(p, [](ReconstructionOptions& o) { o.minBlock = 2 * o.elementaryBlock; }, "minBlock");
+  // Unset, the elementary block is at least the noiseless regime's; the finest block may not exceed it.
+  ExpectRejected(p, [](ReconstructionOptions& o) { o.minBlock = 2 * LargestElementaryBlock(o); }, "minBlock");
   // A negative count of directions is no count; more than half the
   // directions is every direction (whatever their number), up to 32.
   ExpectRejected(p, [](ReconstructionOptions& o) { o.neighbourDirections = -1; }, "neighbourDirections", "got -1");
@@ -166,12 +167,15 @@ TEST(Invariants, InvalidOptionsNameTheField) {
   ExpectRejected(p, [](ReconstructionOptions& o) { o.crossingFillReach = -1; }, "crossingFillReach", "got -1");
   // TBB crashed on an arena of 10^7 threads; the library refuses it as the CLI does.
   ExpectRejected(p, [](ReconstructionOptions& o) { o.threads = 10000000; }, "threads", "got 10000000");
-  // Checked at every supersampling, whichever threshold the run uses.
+  // A value set is checked at every supersampling: it serves every regime.
   ExpectRejected(p,
                  [](ReconstructionOptions& o) {
-                   o.contrastThresholdSupersampled = std::numeric_limits<float>::quiet_NaN();
+                   o.downsample = 2;
+                   o.contrastThreshold = std::numeric_limits<float>::quiet_NaN();
                  },
-                 "contrastThresholdSupersampled");
+                 "contrastThreshold");
+  ExpectRejected(p, [](ReconstructionOptions& o) { o.directions = 0; }, "directions", "got 0");
+  ExpectRejected(p, [](ReconstructionOptions& o) { o.elementaryBlock = 12; }, "elementaryBlock", "got 12");
 }
 
 }  // namespace

@@ -22,9 +22,9 @@ TEST(Directions, SixteenUnderTheSupersampledRules) {
   constexpr double kPi = std::numbers::pi;
   ReconstructionOptions sixteen;
   sixteen.downsample = 2;
-  ASSERT_EQ(sixteen.DirectionsFor(true), 16);
+  ASSERT_EQ(ResolveSettings(sixteen, ProviderCapabilities{}).directions, 16);
   ReconstructionOptions eight = sixteen;
-  eight.directionsSupersampled = 8;
+  eight.directions = 8;
   double error8 = 0, error16 = 0;
   int64_t exact8 = 0, exact16 = 0;
   for (const double degrees : {11.25, 33.75, 56.25, 78.75}) {

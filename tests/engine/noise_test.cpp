@@ -40,15 +40,22 @@ ReconstructionOptions Significance(float k) {
   return o;
 }
 
+/// The elementary block of noisy samples under `o`: the noise regime's.
+int NoisyElementaryBlock(const ReconstructionOptions& o) {
+  ProviderCapabilities noisy;
+  noisy.variance = true;
+  return ResolveSettings(o, noisy).elementaryBlock;
+}
+
 TEST(Noise, ZeroVarianceChangesNothing) {
   // A provider that reports a variance of zero everywhere must give the
   // noiseless result bit for bit: the noise terms vanish, nothing else moves.
   // (A provider that reports variance gets the lattice of noisy samples,
-  // noisyElementaryBlock, before any sample is seen: the noiseless run uses
-  // the same lattice.)
+  // the regime's elementary block, before any sample is seen: the noiseless
+  // run uses the same lattice.)
   AnalyticProvider plain(kSize, kSize, FurnishedScene(kSize, kSize));
   ReconstructionOptions sameLattice;
-  sameLattice.elementaryBlock = sameLattice.noisyElementaryBlock;
+  sameLattice.elementaryBlock = NoisyElementaryBlock(sameLattice);
   const Reconstruction expected = ReconstructOrFail(plain, sameLattice);
   const Outcome zero = ReconstructNoisy({0.f, 0.f});
   ASSERT_EQ(zero.r.workImage.size(), expected.workImage.size());
@@ -86,7 +93,7 @@ TEST(Noise, DefaultSignificanceSamplesFarLessThanTheLiteralTests) {
     const NoiseModel m{rel, 0.01f};
     const double aware = ReconstructNoisy(m).r.stats.exactFraction();
     ReconstructionOptions literalOptions = Significance(0.f);
-    literalOptions.elementaryBlock = literalOptions.noisyElementaryBlock;
+    literalOptions.elementaryBlock = NoisyElementaryBlock(ReconstructionOptions{});
     const double literal = ReconstructNoisy(m, literalOptions).r.stats.exactFraction();
     EXPECT_LE(aware, 0.6 * literal) << "relative noise " << rel;
   }
@@ -106,14 +113,14 @@ TEST(Noise, CloserToTheTruthThanTheNoisyFullRender) {
 }
 
 TEST(Noise, NoisySamplesGetTheNoisyLattice) {
-  // Default options on noisy samples: the 8-pixel lattice of
-  // noisyElementaryBlock, bit for bit the run with elementaryBlock = 8, and
-  // not the 16-pixel lattice of noiseless samples.
+  // Default options on noisy samples: the noise regime's 8-pixel lattice,
+  // bit for bit the run with elementaryBlock = 8, and not the 16-pixel
+  // lattice of noiseless samples.
   const NoiseModel m{0.1f, 0.01f};
   const Outcome byDefault = ReconstructNoisy(m);
   ReconstructionOptions eight, sixteen;
-  eight.elementaryBlock = 8, eight.noisyElementaryBlock = 0;
-  sixteen.noisyElementaryBlock = 0;
+  eight.elementaryBlock = 8;
+  sixteen.elementaryBlock = 16;
   const Outcome explicitEight = ReconstructNoisy(m, eight), noiselessLattice = ReconstructNoisy(m, sixteen);
   ASSERT_EQ(byDefault.r.workImage.size(), explicitEight.r.workImage.size());
   for (size_t i = 0; i < byDefault.r.workImage.size(); ++i)

@@ -31,16 +31,20 @@ TEST(Settings, NoisySamplesNeedAVarianceAndASignificance) {
   EXPECT_FALSE(s.denoise);
 }
 
-// The noise regime: its own elementary block, the fits one block wide, the
-// tests weighing the noise at noiseSignificance, the named gates, and the
-// final-resolution rules at any supersampling.
+// The noise regime: its own, finer elementary block, the fits one block
+// wide, the tests weighing the noise at noiseSignificance, the named gates,
+// and the final-resolution rules at any supersampling.
 TEST(Settings, TheNoiseRegime) {
   ReconstructionOptions o;
+  const Settings finalResolution = Resolve(o, Caps(false));
   o.downsample = 2;
   const Settings s = Resolve(o, Caps(true));
-  EXPECT_EQ(s.elementaryBlock, o.noisyElementaryBlock);
+  EXPECT_LT(s.elementaryBlock, finalResolution.elementaryBlock);
   EXPECT_FALSE(s.supersampledRules);
-  EXPECT_EQ(s.contrastThreshold, o.contrastThreshold);
+  EXPECT_EQ(s.contrastThreshold, finalResolution.contrastThreshold);
+  EXPECT_EQ(s.contrastMetric, finalResolution.contrastMetric);
+  EXPECT_EQ(s.directions, finalResolution.directions);
+  EXPECT_EQ(s.thinObjects, finalResolution.thinObjects);
   EXPECT_EQ(s.contrastSignificance, o.noiseSignificance);
   EXPECT_TRUE(s.denoise);
   EXPECT_EQ(s.denoiseRadius, s.elementaryBlock);
@@ -50,35 +54,62 @@ TEST(Settings, TheNoiseRegime) {
   const Settings strict = Resolve(o, Caps(true));
   EXPECT_EQ(strict.denoiseGate, 4.f);
   EXPECT_EQ(strict.lazyCorrectionGate, 4.f);
-  // The elementary block never falls below the finest block.
-  o.noisyElementaryBlock = 2;
+  // The regime's elementary block never falls below the finest block.
+  o.minBlock = finalResolution.elementaryBlock;
   EXPECT_EQ(Resolve(o, Caps(true)).elementaryBlock, o.minBlock);
-  o.noisyElementaryBlock = 0;  // 0: the same as elementaryBlock
-  EXPECT_EQ(Resolve(o, Caps(true)).elementaryBlock, o.elementaryBlock);
+  // A block set serves noisy samples too.
+  o.elementaryBlock = 2 * finalResolution.elementaryBlock;
+  EXPECT_EQ(Resolve(o, Caps(true)).elementaryBlock, *o.elementaryBlock);
+  EXPECT_EQ(LargestElementaryBlock(o), *o.elementaryBlock);
 }
 
-// Supersampled input whose samples are not noisy takes every ...Supersampled
-// twin; final resolution takes the others, and no crossing fill.
-TEST(Settings, TheSupersampledRulesPickTheirTwins) {
+// Supersampled input whose samples are not noisy has its own defaults (a
+// display-weighted contrast, more directions, the paper's thin-object test)
+// and the crossing fill; final resolution has neither. The noiseless
+// elementary block is the same in both, and the largest of any regime.
+TEST(Settings, TheSupersampledRulesHaveTheirOwnDefaults) {
   ReconstructionOptions o;
   const Settings one = Resolve(o, Caps());
   EXPECT_FALSE(one.supersampledRules);
-  EXPECT_EQ(one.elementaryBlock, o.elementaryBlock);
-  EXPECT_EQ(one.contrastThreshold, o.contrastThreshold);
-  EXPECT_EQ(one.contrastMetric, o.contrastMetric);
-  EXPECT_EQ(one.directions, o.directions);
-  EXPECT_EQ(one.thinObjects, o.thinObjects);
   EXPECT_EQ(one.crossingFillReach, 0);
+  EXPECT_EQ(one.elementaryBlock, LargestElementaryBlock(o));
   o.downsample = 2;
   const Settings two = Resolve(o, Caps());
   EXPECT_TRUE(two.supersampledRules);
-  EXPECT_EQ(two.contrastThreshold, o.contrastThresholdSupersampled);
-  EXPECT_EQ(two.contrastMetric, o.contrastMetricSupersampled);
-  EXPECT_EQ(two.directions, o.directionsSupersampled);
-  EXPECT_EQ(two.thinObjects, o.thinObjectsSupersampled);
+  EXPECT_FALSE(Resolve(o, Caps(true)).supersampledRules);
+  EXPECT_EQ(two.elementaryBlock, one.elementaryBlock);
+  EXPECT_NE(two.contrastThreshold, one.contrastThreshold);
+  EXPECT_EQ(two.contrastMetric, ContrastMetric::kDisplayWeighted);
+  EXPECT_EQ(one.contrastMetric, ContrastMetric::kMitchell);
+  EXPECT_GT(two.directions, one.directions);
+  EXPECT_EQ(two.thinObjects, ThinObjectTest::kNoneMatches);
+  EXPECT_EQ(one.thinObjects, ThinObjectTest::kEndDiffers);
   EXPECT_EQ(two.crossingFillReach, o.crossingFillReach);
-  EXPECT_EQ(UsesSupersampledRules(o, Caps()), true);
-  EXPECT_EQ(UsesSupersampledRules(o, Caps(true)), false);
+}
+
+// A value set serves every regime; the published methods set theirs, so
+// they are the same at final resolution, supersampled and noisy.
+TEST(Settings, AValueSetServesEveryRegime) {
+  ReconstructionOptions set;
+  set.elementaryBlock = 32;
+  set.contrastThreshold = 0.2f;
+  set.contrastMetric = ContrastMetric::kDisplay;
+  set.directions = 4;
+  set.thinObjects = ThinObjectTest::kAnyDiffers;
+  for (const ReconstructionOptions& base : {set, ReconstructionOptions::Paper(), ReconstructionOptions::Guo()}) {
+    const Settings one = Resolve(base, Caps());
+    ReconstructionOptions o = base;
+    o.downsample = 2;
+    for (const Settings& s : {Resolve(o, Caps()), Resolve(o, Caps(true)), Resolve(base, Caps(true))}) {
+      EXPECT_EQ(s.elementaryBlock, one.elementaryBlock);
+      EXPECT_EQ(s.contrastThreshold, one.contrastThreshold);
+      EXPECT_EQ(s.contrastMetric, one.contrastMetric);
+      EXPECT_EQ(s.directions, one.directions);
+      EXPECT_EQ(s.thinObjects, one.thinObjects);
+    }
+  }
+  EXPECT_EQ(Resolve(set, Caps()).directions, 4);
+  EXPECT_EQ(LargestElementaryBlock(set), 32);
 }
 
 // Centre probes of smooth blocks are left out where the guides show every
@@ -94,7 +125,7 @@ TEST(Settings, TheSmoothRefinementUsed) {
   guided.variance = false;
   o.smoothRefinement = SmoothRefinement::kAlways;  // only the probe is dropped
   EXPECT_EQ(Resolve(o, guided).smoothRefinement, SmoothRefinement::kAlways);
-  EXPECT_EQ(UsedSmoothRefinement(o, guided), SmoothRefinement::kAlways);
+  EXPECT_EQ(ResolveSettings(o, guided).smoothRefinement, SmoothRefinement::kAlways);
 }
 
 // The split needs tau and the split radiance from the provider, and is off

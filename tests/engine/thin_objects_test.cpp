@@ -61,7 +61,7 @@ TEST(ThinObjects, AStraightEdgeIsNoThinObject) {
   ReconstructionOptions end = any;
   end.thinObjects = ThinObjectTest::kEndDiffers;
   const ReconstructionOptions turn;  // the default: end-differs, then the neighbouring directions
-  ASSERT_EQ(turn.thinObjects, ThinObjectTest::kEndDiffers);
+  ASSERT_EQ(ResolveSettings(turn, ProviderCapabilities{}).thinObjects, ThinObjectTest::kEndDiffers);
   ASSERT_GT(turn.neighbourDirections, 0);
   const auto thin = [](const Reconstruction& r) { return r.stats.byReason[size_t(SampleReason::kThinObject)]; };
   int64_t thinAny = 0, thinEnd = 0, thinTurn = 0;
@@ -125,7 +125,7 @@ TEST(ThinObjects, ANeighbouringDirectionNeverBlendsAcrossAShadowEdge) {
   const auto full = provider.FullRender();
   ReconstructionOptions none, all;
   none.neighbourDirections = 0;
-  ASSERT_GE(all.neighbourDirections * 2, all.directions);  // the default: every direction
+  ASSERT_GE(all.neighbourDirections * 2, ResolveSettings(all, ProviderCapabilities{}).directions);  // the default: every direction
   const Reconstruction rNone = ReconstructOrFail(provider, none), rAll = ReconstructOrFail(provider, all);
   const auto thin = [](const Reconstruction& r) { return r.stats.byReason[size_t(SampleReason::kThinObject)]; };
   // The wall's pixels: wrong by kLit - kShadow where light and shadow blend.

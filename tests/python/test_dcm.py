@@ -84,10 +84,20 @@ class ReconstructExr(unittest.TestCase):
 
     def test_options_by_c_api_names_as_the_flags(self):
         image, stats = self.command("paper", "--method", "paper", "--threshold", "0.1", "--min-block", "2")
-        result = dcm.reconstruct_exr([self.aovs], "generic", method="paper", contrast_threshold=0.1,
-                                     contrast_threshold_supersampled=0.1, min_block=2)
+        result = dcm.reconstruct_exr([self.aovs], "generic", method="paper", contrast_threshold=0.1, min_block=2)
         self.check_same(result, image, stats)
         self.assertEqual(result.stats["method"], "paper")
+
+    def test_none_is_the_regimes_default(self):
+        # None leaves an option with a per-regime default unset: the command's defaults, bit for bit.
+        image, stats = self.command("default")
+        result = dcm.reconstruct_exr([self.aovs], "generic", elementary_block=None, contrast_threshold=None,
+                                     contrast_metric=None, directions=None, thin_objects=None)
+        self.check_same(result, image, stats)
+        # Options without one take no None.
+        with self.assertRaises(ValueError) as e:
+            dcm.reconstruct_exr(self.aovs, preset="generic", min_block=None)
+        self.assertIn("min_block", str(e.exception))
 
     def test_missing_file_names_it(self):
         missing = os.path.join(self.tmp.name, "no-such-render.exr")

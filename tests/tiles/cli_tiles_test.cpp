@@ -361,7 +361,6 @@ TEST(HostileFlags, EdgeValuesAreUsedAsGiven) {
   EXPECT_EQ(r.err, "") << "-q: no progress";
   const nlohmann::json o = ReadJson(dir / "s.json")["options"];
   EXPECT_EQ(o["contrast_threshold"], 0.0);
-  EXPECT_EQ(o["contrast_threshold_supersampled"], 0.0);
   EXPECT_EQ(o["threads"], 1);
   EXPECT_EQ(o["tile_size"], 1);
   EXPECT_EQ(o["crease_angle"], 0.0);
@@ -374,7 +373,6 @@ TEST(HostileFlags, EdgeValuesAreUsedAsGiven) {
   EXPECT_EQ(o["elementary_block"], 4);
   EXPECT_EQ(o["min_block"], 2);
   EXPECT_EQ(o["directions"], 4);
-  EXPECT_EQ(o["directions_supersampled"], 4);
 }
 
 // --help: the groups in order, the defaults the parser shows, -q and the exit

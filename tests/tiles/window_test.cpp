@@ -104,7 +104,7 @@ int64_t CompareTiles(const Case& c, int count, int halo, bool expectOk) {
   }
   int64_t differ = 0, exact = 0;
   std::vector<int> covered(size_t(whole.width) * size_t(whole.height), 0);
-  const int align = std::max(1, c.options.elementaryBlock / std::max(1, c.options.downsample));
+  const int align = std::max(1, LargestElementaryBlock(c.options) / std::max(1, c.options.downsample));
   for (int i = 0; i < count; ++i) {
     Bounds2i region;
     st = TileRegion(whole.width, whole.height, i, count, align, &region);

@@ -16,7 +16,7 @@ import sys
 SCENES = ["room", "room-paper", "cactus", "parquet", "mirror"]
 THRESHOLDS = ["0.015", "0.03", "0.06", "0.1", "0.12", "0.15", "0.25", "0.5"]
 # dcm's default contrast threshold with supersampled input
-# (ReconstructionOptions::contrastThresholdSupersampled): every bundled scene
+# (contrastThreshold under the supersampled rules, lib/src/settings.cpp): every bundled scene
 # is supersampled. main() checks that each scene's bench has that point.
 DEFAULT = "0.15"
 

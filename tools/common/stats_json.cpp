@@ -23,22 +23,25 @@ double Decimal(float v) {
   }
   return std::strtod(buf, nullptr);
 }
+/// An option with a regime-aware default: null where unset (the settings
+/// report the value used).
+template <typename T, typename F>
+nlohmann::json Regime(const std::optional<T>& v, F&& toJson) {
+  return v ? nlohmann::json(toJson(*v)) : nlohmann::json(nullptr);
+}
 }  // namespace
 
 nlohmann::json OptionsToJson(const ReconstructionOptions& o) {
   nlohmann::json j;
-  j["elementary_block"] = o.elementaryBlock;
-  j["noisy_elementary_block"] = o.noisyElementaryBlock;
+  const auto same = [](auto v) { return v; };
+  const auto name = [](auto v) { return std::string(ToString(v)); };
+  j["elementary_block"] = Regime(o.elementaryBlock, same);
   j["min_block"] = o.minBlock;
-  j["contrast_threshold"] = Decimal(o.contrastThreshold);
-  j["contrast_threshold_supersampled"] = Decimal(o.contrastThresholdSupersampled);
-  j["contrast_metric"] = std::string(ToString(o.contrastMetric));
-  j["contrast_metric_supersampled"] = std::string(ToString(o.contrastMetricSupersampled));
-  j["directions"] = o.directions;
-  j["directions_supersampled"] = o.directionsSupersampled;
+  j["contrast_threshold"] = Regime(o.contrastThreshold, Decimal);
+  j["contrast_metric"] = Regime(o.contrastMetric, name);
+  j["directions"] = Regime(o.directions, same);
   j["object_test"] = std::string(ToString(o.objectTest));
-  j["thin_objects"] = std::string(ToString(o.thinObjects));
-  j["thin_objects_supersampled"] = std::string(ToString(o.thinObjectsSupersampled));
+  j["thin_objects"] = Regime(o.thinObjects, name);
   j["crossing_fill_reach"] = o.crossingFillReach;
   j["surface_aware"] = o.surfaceAware;
   j["texture_split"] = o.textureSplit;

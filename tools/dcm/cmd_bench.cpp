@@ -10,7 +10,7 @@
 //
 // Builds only with the Embree plugin (like `dcm render`); AOV inputs only when
 // plugins/aov is available.
-#if __has_include("embree/embree_provider.h")
+#if __has_include("dcm/embree/embree_provider.h")
 
 #include <algorithm>
 #include <chrono>
@@ -40,8 +40,8 @@
 #include "common/stats_json.h"
 #include "dcm/pipe/scratch_folder.h"
 #include "dcm/reconstructor.h"
-#include "embree/embree_provider.h"
-#include "embree/scene_file.h"
+#include "dcm/embree/embree_provider.h"
+#include "dcm/embree/scene_file.h"
 #include "engine_flags.h"
 #include "flag_checks.h"
 
@@ -102,10 +102,10 @@ struct Point {
   double exactFraction = 0;
   double timeIllumS = 0, timeGuidesS = 0, timeEngineS = 0, timeTotalS = 0;
   toolkit::ImageError error;
-  bool supersampledRules = false;  ///< the run used them (ReconstructionStats)
-  /// The smooth blocks' refinement the run used (UsedSmoothRefinement: no
-  /// centre probes where the provider's guides show every hard shadow).
-  SmoothRefinement smoothRefinement = SmoothRefinement::kCentreProbe;
+  /// What the run used (ReconstructionStats::settings): the regime's
+  /// threshold and thin-object test, no centre probes where the provider's
+  /// guides show every hard shadow.
+  ResolvedSettings settings;
 };
 
 /// An input: a scene file or a dense AOV EXR, with a provider factory.
@@ -219,8 +219,8 @@ struct Enhancement {
   void (*on)(ReconstructionOptions*);
 };
 const Enhancement kEnhancements[] = {
-    {"thinObjects", [](ReconstructionOptions* o) { o->SetThinObjects(ThinObjectTest::kOff); },
-     [](ReconstructionOptions* o) { o->SetThinObjects(ThinObjectTest::kNoneMatches); }},
+    {"thinObjects", [](ReconstructionOptions* o) { o->thinObjects = ThinObjectTest::kOff; },
+     [](ReconstructionOptions* o) { o->thinObjects = ThinObjectTest::kNoneMatches; }},
     {"neighbourDirections", [](ReconstructionOptions* o) { o->neighbourDirections = 0; },
      [](ReconstructionOptions* o) { o->neighbourDirections = ReconstructionOptions{}.neighbourDirections; }},
     {"objectTest", [](ReconstructionOptions* o) { o->objectTest = ObjectTest::kObjectId; },
@@ -229,8 +229,8 @@ const Enhancement kEnhancements[] = {
      [](ReconstructionOptions* o) { o->textureSplit = true; }},
     {"adaptiveBorders", [](ReconstructionOptions* o) { o->adaptiveBorders = false; },
      [](ReconstructionOptions* o) { o->adaptiveBorders = true; }},
-    {"displayWeightedContrast", [](ReconstructionOptions* o) { o->SetContrastMetric(ContrastMetric::kMitchell); },
-     [](ReconstructionOptions* o) { o->SetContrastMetric(ContrastMetric::kDisplayWeighted); }},
+    {"displayWeightedContrast", [](ReconstructionOptions* o) { o->contrastMetric = ContrastMetric::kMitchell; },
+     [](ReconstructionOptions* o) { o->contrastMetric = ContrastMetric::kDisplayWeighted; }},
     {"crossingFill", [](ReconstructionOptions* o) { o->crossingFillReach = 0; },
      [](ReconstructionOptions* o) { o->crossingFillReach = ReconstructionOptions{}.crossingFillReach; }},
     {"smoothRefinement", [](ReconstructionOptions* o) { o->smoothRefinement = SmoothRefinement::kAlways; },
@@ -273,7 +273,7 @@ std::string OptionsKey(const ReconstructionOptions& o) { return AllOptionsJson(o
 float DefaultThreshold(const std::string& method, int supersampling) {
   ReconstructionOptions o = MethodOptions(method);
   o.downsample = supersampling;
-  return o.ContrastThresholdFor(o.SupersampledRules(/*noisySamples=*/false));
+  return ResolveSettings(o, ProviderCapabilities{}).contrastThreshold;
 }
 
 /// The label of a method's point at its default settings ("dcm t=0.14").
@@ -326,7 +326,7 @@ std::vector<Config> SweepConfigs(const BenchFlags& f, const Subject& s) {
     std::sort(ts.begin(), ts.end());
     for (float t : ts) {
       Config c = base(m);
-      c.options.SetContrastThreshold(t);
+      c.options.contrastThreshold = t;
       c.label = std::string(m) + " t=" + Fmt("%g", t);
       c.sweeps = "threshold";
       add(c);
@@ -341,8 +341,7 @@ std::vector<Config> SweepConfigs(const BenchFlags& f, const Subject& s) {
   }
   for (int b : blocks) {
     Config c = base("dcm");
-    c.options.elementaryBlock = b;
-    c.options.noisyElementaryBlock = 0;  // the swept block, noisy or not
+    c.options.elementaryBlock = b;  // noisy samples or not
     c.options.minBlock = std::min(c.options.minBlock, b);
     c.label = "dcm block=" + std::to_string(b);
     c.sweeps = "block";
@@ -465,14 +464,14 @@ std::string PointToCsv(const Point& p) {
   s << CsvQuote(p.scene) << ',' << CsvQuote(p.input) << ',' << p.config.method << ',' << CsvQuote(p.config.label)
     << ',' << p.config.sweeps << ',';
   if (engine) {
-    s << CsvNum(o.ContrastThresholdFor(p.supersampledRules)) << ',' << o.elementaryBlock << ',' << o.minBlock << ',';
+    s << CsvNum(p.settings.contrastThreshold) << ',' << p.settings.elementaryBlock << ',' << o.minBlock << ',';
   } else {
     s << ",,,";
   }
   s << p.config.supersampling << ',';
   if (engine) {
-    s << ToString(o.ThinObjectsFor(p.supersampledRules)) << ',' << ToString(o.objectTest) << ',' << int(o.textureSplit) << ','
-      << int(o.adaptiveBorders) << ',' << ToString(p.smoothRefinement) << ',' << int(o.finestCentreProbe) << ','
+    s << ToString(p.settings.thinObjects) << ',' << ToString(o.objectTest) << ',' << int(o.textureSplit) << ','
+      << int(o.adaptiveBorders) << ',' << ToString(p.settings.smoothRefinement) << ',' << int(o.finestCentreProbe) << ','
       << int(o.lazyEvaluation) << ',';
   } else {
     s << ",,,,,,,";
@@ -703,8 +702,7 @@ int RunBench(const BenchFlags& f) {
         p->timeIllumS = rec.stats.timeProviderS;
         p->timeGuidesS = rec.stats.timeGuidesS;
         p->timeEngineS = rec.stats.timeEngineS;
-        p->supersampledRules = rec.stats.usedSupersampledRules;
-        p->smoothRefinement = UsedSmoothRefinement(o, prov->Capabilities());
+        p->settings = rec.stats.settings;
         ow = rec.width;
         oh = rec.height;
         *image = std::move(rec.image);
@@ -1056,4 +1054,4 @@ Registration reg(
 }  // namespace
 }  // namespace dcm::cli
 
-#endif  // __has_include("embree/embree_provider.h")
+#endif  // __has_include("dcm/embree/embree_provider.h")

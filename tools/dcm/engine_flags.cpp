@@ -40,10 +40,23 @@ class InGroup {
   std::string old_;
 };
 
+/// dcm's settings in one regime: at final resolution, under the supersampled
+/// rules (`supersampled`) or with noisy samples (`noisy`).
+ResolvedSettings DefaultsOf(const ReconstructionOptions& o, bool supersampled, bool noisy) {
+  ReconstructionOptions r = o;
+  r.downsample = supersampled ? 2 : 1;
+  ProviderCapabilities caps;
+  caps.variance = noisy;
+  return ResolveSettings(r, caps);
+}
+
 }  // namespace
 
 void AddEngineFlags(CLI::App* app, EngineFlags* f) {
   const ReconstructionOptions d, paper = ReconstructionOptions::Paper();
+  // The defaults of the options whose default depends on the regime.
+  const ResolvedSettings rd = DefaultsOf(d, false, false), rss = DefaultsOf(d, true, false),
+                         rnoisy = DefaultsOf(d, false, true), rp = DefaultsOf(paper, false, false);
   const std::string ss = "supersampled noiseless input, --downsample 2+: ";
   {
     InGroup g(app, kGroupIo);
@@ -60,28 +73,28 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
         ->check(CLI::IsMember({"dcm", "paper", "guo"}))
         ->capture_default_str();
     app->add_option("--threshold", f->threshold,
-                    "contrast threshold of the smooth/edge test (" + ss + G(d.contrastThresholdSupersampled) +
-                        "; paper|guo: " + G(paper.contrastThreshold) + ")")
+                    "contrast threshold of the smooth/edge test (" + ss + G(rss.contrastThreshold) +
+                        "; paper|guo: " + G(rp.contrastThreshold) + ")")
         ->transform(FiniteNumber(0))
-        ->default_str(G(d.contrastThreshold));
+        ->default_str(G(rd.contrastThreshold));
     app->add_option("--contrast", f->contrast,
-                    "mitchell | display | display-weighted (" + ss + std::string(ToString(d.contrastMetricSupersampled)) +
+                    "mitchell | display | display-weighted (" + ss + std::string(ToString(rss.contrastMetric)) +
                         "; docs/ENGINE.md)")
         ->check(EngineName<ContrastMetric>())
-        ->default_str(std::string(ToString(d.contrastMetric)));
+        ->default_str(std::string(ToString(rd.contrastMetric)));
     app->add_option("--block", f->block,
-                    "elementary block size (noisy samples: " + G(d.noisyElementaryBlock) +
-                        "; paper|guo: " + G(paper.elementaryBlock) + ")")
+                    "elementary block size (noisy samples: " + G(rnoisy.elementaryBlock) +
+                        "; paper|guo: " + G(rp.elementaryBlock) + ")")
         ->transform(PowerOfTwo(1, 256))
-        ->default_str(G(d.elementaryBlock));
+        ->default_str(G(rd.elementaryBlock));
     app->add_option("--min-block", f->minBlock, "finest block size, at most --block")
         ->transform(PowerOfTwo(1, 256))
         ->default_str(G(d.minBlock));
     app->add_option("--directions", f->directions,
                     "candidate directions of the least-discrepancy search, pi/N apart (" + ss +
-                        G(d.directionsSupersampled) + "; paper|guo: " + G(paper.directions) + ")")
+                        G(rss.directions) + "; paper|guo: " + G(rp.directions) + ")")
         ->transform(PowerOfTwo(4, 64))
-        ->default_str(G(d.directions));
+        ->default_str(G(rd.directions));
     app->add_flag("--full", f->full, "evaluate every pixel exactly (the baseline)");
     app->add_option("--target-psnr", f->targetPsnr,
                     "refine until the estimated display-referred PSNR against the full render reaches DB (its 95 % "
@@ -107,9 +120,9 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
     app->add_flag("--no-thin", f->noThin, "switch off the thin-object test (paper 3.1)");
     app->add_option("--thin-test", f->thinTest,
                     "off | none-matches | any-differs | end-differs (" + ss +
-                        std::string(ToString(d.thinObjectsSupersampled)) + ")")
+                        std::string(ToString(rss.thinObjects)) + ")")
         ->check(EngineName<ThinObjectTest>())
-        ->default_str(std::string(ToString(d.thinObjects)));
+        ->default_str(std::string(ToString(rd.thinObjects)));
     app->add_flag("--no-guide-first-order", f->noGuideFirstOrder,
                   "first-order test: evaluate the inner pixels at every crossing, also where the guides show the "
                   "surfaces meeting");
@@ -221,19 +234,17 @@ Status CheckDownsample(int width, int height, int n, const std::string& what) {
 }
 
 std::string SettingsSummary(const ReconstructionOptions& o, const ProviderCapabilities& caps) {
-  const bool rules = UsesSupersampledRules(o, caps);
+  const ResolvedSettings s = ResolveSettings(o, caps);
   char threshold[32];
-  std::snprintf(threshold, sizeof threshold, "%g", double(o.ContrastThresholdFor(rules)));
-  const std::string why = rules ? "supersampled rules: --downsample " + std::to_string(o.downsample)
+  std::snprintf(threshold, sizeof threshold, "%g", double(s.contrastThreshold));
+  const std::string why = s.supersampledRules ? "supersampled rules: --downsample " + std::to_string(o.downsample)
                           : o.downsample >= 2 ? "noisy samples: the supersampled rules are off"
                                               : "final resolution";
-  const SmoothRefinement used = UsedSmoothRefinement(o, caps);
-  std::string refine(ToString(used));
-  if (used != o.smoothRefinement) refine += " (the guides show every hard shadow)";
-  return std::string("contrast ") + std::string(ToString(o.ContrastMetricFor(rules))) + ", threshold " + threshold +
-         ", " + std::to_string(o.DirectionsFor(rules)) + " directions, thin-object test " + std::string(ToString(o.ThinObjectsFor(rules))) +
-         ", crossing fill " + std::to_string(o.CrossingFillReachFor(rules)) + " (" + why +
-         "); smooth blocks: " + refine;
+  std::string refine(ToString(s.smoothRefinement));
+  if (s.smoothRefinement != o.smoothRefinement) refine += " (the guides show every hard shadow)";
+  return std::string("contrast ") + std::string(ToString(s.contrastMetric)) + ", threshold " + threshold + ", " +
+         std::to_string(s.directions) + " directions, thin-object test " + std::string(ToString(s.thinObjects)) +
+         ", crossing fill " + std::to_string(s.crossingFillReach) + " (" + why + "); smooth blocks: " + refine;
 }
 
 bool QualityGoalOf(const EngineFlags& f, QualityGoal* goal) {
@@ -287,12 +298,13 @@ Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {
   if (f.method == "paper") *o = ReconstructionOptions::Paper();
   else if (f.method == "guo") *o = ReconstructionOptions::Guo();
   else *o = ReconstructionOptions{};
-  if (f.threshold) o->SetContrastThreshold(*f.threshold);
-  if (f.block) o->elementaryBlock = *f.block, o->noisyElementaryBlock = 0;  // with noisy samples too
+  // The flags set every regime's value: one flag, one meaning.
+  if (f.threshold) o->contrastThreshold = *f.threshold;
+  if (f.block) o->elementaryBlock = *f.block;
   if (f.minBlock) o->minBlock = *f.minBlock;
   // Both powers of two (checked at parse time); the finest block must fit.
-  if (o->minBlock > o->elementaryBlock) {
-    const std::string block = std::to_string(o->elementaryBlock), minBlock = std::to_string(o->minBlock);
+  if (o->minBlock > LargestElementaryBlock(*o)) {
+    const std::string block = std::to_string(LargestElementaryBlock(*o)), minBlock = std::to_string(o->minBlock);
     if (!f.minBlock)
       return Status::Error("--block " + block + ": below the finest block size " + minBlock +
                            "; give --min-block " + block + " or less too");
@@ -301,12 +313,12 @@ Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {
                            "; give --block " + minBlock + " or more too");
     return Status::Error("--min-block " + minBlock + " exceeds --block " + block);
   }
-  if (f.directions) o->SetDirections(*f.directions);
-  if (f.noThin) o->SetThinObjects(ThinObjectTest::kOff);
+  if (f.directions) o->directions = *f.directions;
+  if (f.noThin) o->thinObjects = ThinObjectTest::kOff;
   if (!f.thinTest.empty()) {
     ThinObjectTest t;
     DCM_RETURN_IF_ERROR(Parse(f.thinTest, &t));
-    o->SetThinObjects(t);
+    o->thinObjects = t;
   }
   if (f.neighbourDirections) o->neighbourDirections = *f.neighbourDirections;
   if (f.fallbackShadingChanges) o->fallbackShadingChanges = *f.fallbackShadingChanges;
@@ -316,7 +328,7 @@ Status ToOptions(const EngineFlags& f, ReconstructionOptions* o) {
   if (!f.contrast.empty()) {
     ContrastMetric m;
     DCM_RETURN_IF_ERROR(Parse(f.contrast, &m));
-    o->SetContrastMetric(m);
+    o->contrastMetric = m;
   }
   if (f.noLazy) o->lazyEvaluation = false;
   if (f.noFallback) o->fallback = false;

@@ -93,7 +93,7 @@ int RunPerFrame(const std::string& cmd, const Flags& flags, const TileFlags& til
 /// the noisy and the noiseless block: whether the samples are noisy is known
 /// only once the provider is).
 inline int TileAlignment(const ReconstructionOptions& o) {
-  return std::max(1, o.LargestElementaryBlock() / std::max(1, o.downsample));
+  return std::max(1, LargestElementaryBlock(o) / std::max(1, o.downsample));
 }
 
 /// The attributes of a part (tile, region, fingerprint, settings, the counts

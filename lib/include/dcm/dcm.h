@@ -40,8 +40,13 @@
 extern "C" {
 #endif
 
-/** Version of this C interface; raised on incompatible changes. */
-#define DCM_C_API_VERSION 3
+/** Version of this C interface; raised on incompatible changes. Version 4:
+ *  the options whose default depends on the regime (final resolution, the
+ *  supersampled rules, noisy samples) are one option each, unset by default;
+ *  their twins "noisy_elementary_block", "contrast_threshold_supersampled",
+ *  "contrast_metric_supersampled", "directions_supersampled" and
+ *  "thin_objects_supersampled" are gone (a value set serves every regime). */
+#define DCM_C_API_VERSION 4
 
 /** A reconstructor: options, guides, the sample callback and the last result. */
 typedef struct DCMReconstructorImpl* DCMReconstructor;
@@ -145,22 +150,20 @@ DCM_API DCMError dcmGetError(DCMReconstructor r, const char** message);
  *   "method"             "dcm" (default), "paper" (Scheel et al. 2001) or "guo"
  *                        (Guo 1998): resets EVERY option to that preset, so set
  *                        it first;
- *   "object_test"        "none" | "id" | "id+shader";
+ *   "object_test"        "none" | "id" | "id+shader" | "id|shader";
  *   "thin_objects"       "off" | "none-matches" | "any-differs" | "end-differs";
- *   "thin_objects_supersampled"  the same, used instead under the
- *                        supersampled rules: downsample >= 2 and samples that
- *                        are not noisy (default "none-matches");
  *   "contrast_metric"    "mitchell" | "display" | "display-weighted";
- *   "contrast_metric_supersampled"  the same, used instead under the
- *                        supersampled rules (default "display-weighted");
  *   "smooth_refinement"  "always" | "centre-probe" | "never".
+ *  "thin_objects" and "contrast_metric" depend on the regime when unset
+ *  (the default; "default" unsets them): under the supersampled rules
+ *  (downsample >= 2 and samples that are not noisy) "none-matches" and
+ *  "display-weighted", otherwise "end-differs" and "mitchell".
  *  An unknown name or value records DCM_ERROR_INVALID_ARGUMENT. */
 DCM_API void dcmSetString(DCMReconstructor r, const char* name, const char* value);
 
-/** Sets an integer option: "elementary_block", "noisy_elementary_block" (the
- *  elementary block with noisy samples, default 8; 0: elementary_block),
- *  "min_block", "directions", "directions_supersampled" (used instead
- *  under the supersampled rules, default 16), "fallback_max_changes",
+/** Sets an integer option: "elementary_block" (unset by default: 16, 8 with
+ *  noisy samples), "min_block", "directions" (unset by default: 8, 16 under
+ *  the supersampled rules), "fallback_max_changes",
  *  "fallback_shading_changes" (a finest block over fallback_max_changes
  *  falls back only when more than this many of its changes are no surface
  *  change, default 2; -1: every such block), "simple_surface_changes"
@@ -174,12 +177,14 @@ DCM_API void dcmSetString(DCMReconstructor r, const char* name, const char* valu
  *  pixels, where they agree; default 2, 0: off), "downsample",
  *  "threads" (0: all cores),
  *  "tile_size", "batch_size" (pixels per callback call). Bool options accept
- *  0/1 here too. Ranges are checked by dcmExecute(). */
+ *  0/1 here too. 0 unsets "elementary_block" and "directions" (dcm's default
+ *  for the regime), and dcmGetInt() reads them as 0 while unset. Ranges are
+ *  checked by dcmExecute(). */
 DCM_API void dcmSetInt(DCMReconstructor r, const char* name, int value);
 
-/** Sets a float option: "contrast_threshold" (default 0.14),
- *  "contrast_threshold_supersampled" (used instead under the supersampled
- *  rules, default 0.15), "noise_significance" (with a
+/** Sets a float option: "contrast_threshold" (unset by default: 0.14, 0.15
+ *  under the supersampled rules; a negative value unsets it, and
+ *  dcmGetFloat() reads -1 while unset), "noise_significance" (with a
  *  provider that reports variance), "probe_lc_share" (a finest edge block
  *  whose border changes only at surface changes is probed only where L_c
  *  exceeds this share of L at some border pixel, default 0.5),

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -39,7 +40,7 @@ enum class SmoothRefinement {
   kAlways,       ///< paper 2.1 as written: split it and classify the children again
   /// evaluate its centre; split only where the bilinear prediction misses
   /// it. None where the provider's guides show every hard shadow and the
-  /// samples are not noisy (UsedSmoothRefinement): a probe there finds only
+  /// samples are not noisy (ResolvedSettings::smoothRefinement): a probe there finds only
   /// what the guides already show (docs/TUNING.md).
   kCentreProbe,
   kNever,        ///< smooth blocks are final at the level where they are found
@@ -63,72 +64,34 @@ enum class ContrastMetric {
 /// the published methods. Which data chose each default, with the figures
 /// and the commands: docs/TUNING.md.
 struct ReconstructionOptions {
-  /// Size of level-0 blocks (a power of two; the paper's 8): the centre probe splits
-  /// smooth blocks only where needed, so flat regions cost fewer samples (docs/TUNING.md).
-  int elementaryBlock = 16;
-  /// Level-0 blocks for noisy samples: the noise discount hides more between coarse
-  /// corners, and the denoising fits want denser samples (docs/TUNING.md). 0: elementaryBlock.
-  int noisyElementaryBlock = 8;
-  int minBlock = 4;          ///< finest block size (a power of two <= elementaryBlock)
+  // A std::optional field has a regime-aware default: unset, it takes dcm's
+  // value for the regime (final resolution, the supersampled rules, noisy
+  // samples), which ResolveSettings applies (lib/src/settings.cpp; which data
+  // chose each value: docs/TUNING.md).
 
-  /// The elementary block used with noisy samples or without (never below
-  /// minBlock).
-  int ElementaryBlockFor(bool noisySamples) const {
-    const int b = noisySamples && noisyElementaryBlock > 0 ? noisyElementaryBlock : elementaryBlock;
-    return b < minBlock ? minBlock : b;
-  }
-  /// The larger of the two: a lattice of it is also a lattice of the other
-  /// (both powers of two), for tile alignment before the provider is known.
-  int LargestElementaryBlock() const {
-    return ElementaryBlockFor(false) > ElementaryBlockFor(true) ? ElementaryBlockFor(false) : ElementaryBlockFor(true);
-  }
-  /// Smooth/edge threshold of the contrast test at final resolution: the
-  /// largest tested that meets issue 3's target there (docs/TUNING.md).
-  float contrastThreshold = 0.14f;
-  /// The threshold under the supersampled rules (SupersampledRules), judged
-  /// after the box filter: the largest tested that meets issue 3's 4x target.
-  float contrastThresholdSupersampled = 0.15f;
-  /// The threshold in effect, with the supersampled rules or without.
-  float ContrastThresholdFor(bool supersampledRules) const {
-    return supersampledRules ? contrastThresholdSupersampled : contrastThreshold;
-  }
-  /// Sets the threshold of every supersampling (a command line's --threshold).
-  void SetContrastThreshold(float t) { contrastThreshold = contrastThresholdSupersampled = t; }
-  /// The metric at final resolution and with noisy samples (docs/TUNING.md).
-  ContrastMetric contrastMetric = ContrastMetric::kMitchell;
-  /// The metric under the supersampled rules: display-weighted, as the error is judged
-  /// on a display after the box filter (docs/TUNING.md).
-  ContrastMetric contrastMetricSupersampled = ContrastMetric::kDisplayWeighted;
-  /// The metric in effect, with the supersampled rules or without.
-  ContrastMetric ContrastMetricFor(bool supersampledRules) const {
-    return supersampledRules ? contrastMetricSupersampled : contrastMetric;
-  }
-  /// Sets the metric of every supersampling (a command line's --contrast).
-  void SetContrastMetric(ContrastMetric m) { contrastMetric = contrastMetricSupersampled = m; }
-  int directions = 8;        ///< candidate directions of the least-discrepancy search
-  /// The directions under the supersampled rules: 16, 11.25 degrees apart, as
-  /// an edge spans more working pixels per output pixel there (docs/TUNING.md).
-  int directionsSupersampled = 16;
-  /// The directions in effect, with the supersampled rules or without.
-  int DirectionsFor(bool supersampledRules) const { return supersampledRules ? directionsSupersampled : directions; }
-  /// Sets the directions of every supersampling (a command line's --directions).
-  void SetDirections(int k) { directions = directionsSupersampled = k; }
+  /// Size of level-0 blocks, a power of two (the paper's 8). Unset: coarser
+  /// without noise, where the centre probe splits smooth blocks only where
+  /// needed; finer with noisy samples, whose denoising fits want denser corners.
+  std::optional<int> elementaryBlock;
+  int minBlock = 4;  ///< finest block size (a power of two <= the elementary block)
+  /// Smooth/edge threshold of the contrast test. Unset: per regime, the
+  /// largest tested that meets issue 3's target there.
+  std::optional<float> contrastThreshold;
+  /// How the contrast is measured. Unset: Mitchell's; display-weighted under
+  /// the supersampled rules, as the error is judged on a display after the box filter.
+  std::optional<ContrastMetric> contrastMetric;
+  /// Candidate directions of the least-discrepancy search. Unset: the paper's
+  /// 8; more under the supersampled rules, where an edge spans more working
+  /// pixels per output pixel.
+  std::optional<int> directions;
 
   /// dcm: a surface is one material of one object, as Cryptomatte's object
   /// IDs name them (docs/TUNING.md); IDs of primitives want kObjectAndShader.
   ObjectTest objectTest = ObjectTest::kObjectOrShader;
-  /// The thin-object test at final resolution, where a one-ended pixel errs
-  /// in a whole output pixel (docs/TUNING.md).
-  ThinObjectTest thinObjects = ThinObjectTest::kEndDiffers;
-  /// The thin-object test under the supersampled rules: a one-ended pixel errs in
-  /// 1/downsample^2 of an output pixel only (docs/TUNING.md).
-  ThinObjectTest thinObjectsSupersampled = ThinObjectTest::kNoneMatches;
-  /// The thin-object test in effect, with the supersampled rules or without.
-  ThinObjectTest ThinObjectsFor(bool supersampledRules) const {
-    return supersampledRules ? thinObjectsSupersampled : thinObjects;
-  }
-  /// Sets the test with the supersampled rules and without (--thin-test).
-  void SetThinObjects(ThinObjectTest t) { thinObjects = thinObjectsSupersampled = t; }
+  /// The thin-object test. Unset: end-differs at final resolution, where a
+  /// one-ended pixel errs in a whole output pixel; none-matches under the
+  /// supersampled rules, where it errs in 1/downsample^2 of one.
+  std::optional<ThinObjectTest> thinObjects;
   /// A thin-object pixel first tries this many other directions each side (over K/2:
   /// all), taking one whose ends on its surface agree (docs/ENGINE.md, docs/TUNING.md).
   int neighbourDirections = 8;  ///< every direction of 8 and of 16
@@ -138,7 +101,7 @@ struct ReconstructionOptions {
   bool textureSplit = true;
 
   /// With normal guides: neighbours whose normals differ by more degrees (per output
-  /// pixel: WorkCreaseAngle) are a surface change; 0: unused (docs/TUNING.md).
+  /// pixel: divided by downsample between work pixels) are a surface change; 0: unused.
   float creaseAngle = 30.f;
 
   /// What happens to a smooth block above the finest level (docs/TUNING.md).
@@ -146,11 +109,9 @@ struct ReconstructionOptions {
   /// Edge-block borders: evaluate surface changes and bisect gaps whose ends differ; fill
   /// the rest from the same surface (docs/TUNING.md). Off: every border pixel (the paper).
   bool adaptiveBorders = true;
-  /// Supersampled rules: a side's surface-change pixel takes its surface's exact pixels
-  /// within this reach on the two neighbouring lattice lines where they agree (docs/TUNING.md).
+  /// Under the supersampled rules only: a side's surface-change pixel takes its surface's exact
+  /// pixels within this reach on the two neighbouring lattice lines where they agree (docs/TUNING.md).
   int crossingFillReach = 2;
-  /// The crossing fill's reach in effect (0: off).
-  int CrossingFillReachFor(bool supersampledRules) const { return supersampledRules ? crossingFillReach : 0; }
 
   bool zeroOrderTest = true;   ///< simple/complex: exactly two changes along the border
   /// A block of at most twice the finest size whose border changes 3 to this many times,
@@ -194,16 +155,10 @@ struct ReconstructionOptions {
   bool denoiseSamples = true;
 
   int downsample = 1;   ///< the working image is `downsample`x the output per axis
-  /// Whether the supersampled rules (the *Supersampled fields, crossingFillReach) apply:
-  /// supersampled input whose samples are not noisy (docs/TUNING.md).
-  bool SupersampledRules(bool noisySamples) const { return downsample >= 2 && !noisySamples; }
-  /// The crease angle between work pixels, creaseAngle / downsample: one threshold of
-  /// curvature per output pixel at every supersampling (docs/TUNING.md).
-  float WorkCreaseAngle() const { return downsample > 1 ? creaseAngle / float(downsample) : creaseAngle; }
   bool fullEvaluation = false;  ///< baseline: evaluate every pixel exactly
 
   int threads = 0;      ///< 0: all cores
-  int tileSize = 64;    ///< pixels per side of a unit of parallel work (multiple of elementaryBlock)
+  int tileSize = 64;    ///< pixels per side of a unit of parallel work (multiple of the elementary block)
   int batchSize = 4096; ///< pixels per Evaluate() call
 
   /// Progress in [0,1] with the name of the stage; called from the calling thread.

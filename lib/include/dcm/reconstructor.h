@@ -85,8 +85,9 @@ struct StageTimes {
 };
 
 /// The values the stages of one reconstruction use, resolved once from the
-/// options and the provider's capabilities (the rules that pick a regime:
-/// noisy samples, supersampled rules, texture split, guides).
+/// options and the provider's capabilities (ResolveSettings): the rules that
+/// pick a regime (noisy samples, supersampled rules, texture split, guides)
+/// and dcm's default of each option the user left unset for it.
 struct ResolvedSettings {
   /// Samples carry their variance and the tests weigh it: a provider that
   /// reports variance, noiseSignificance > 0.
@@ -94,20 +95,24 @@ struct ResolvedSettings {
   /// Interpolate (L_i, L_c) and re-apply tau (paper 3.3): asked for, the
   /// provider gives tau and the split radiance, and not the full baseline.
   bool split = false;
-  /// ReconstructionOptions::ElementaryBlockFor the samples.
+  /// The level-0 block: the option's, or the regime's default (finer with
+  /// noisy samples); never below minBlock.
   int elementaryBlock = 16;
-  /// ReconstructionOptions::SupersampledRules: supersampled, not noisy.
+  /// The supersampled rules apply: downsample >= 2 and samples that are not
+  /// noisy (with noise, the noise regime's hold at any supersampling).
   bool supersampledRules = false;
-  ContrastMetric contrastMetric = ContrastMetric::kMitchell;  ///< ContrastMetricFor the rules
-  float contrastThreshold = 0.f;                               ///< ContrastThresholdFor the rules
+  ContrastMetric contrastMetric = ContrastMetric::kMitchell;  ///< the option's, or the regime's default
+  float contrastThreshold = 0.f;                               ///< the option's, or the regime's default
   /// The contrast test's significance: noiseSignificance with noisy
   /// samples, 0 (the paper's test) without.
   float contrastSignificance = 0.f;
-  int directions = 8;                                       ///< DirectionsFor the rules
-  ThinObjectTest thinObjects = ThinObjectTest::kOff;        ///< ThinObjectsFor the rules
-  int crossingFillReach = 0;                                ///< CrossingFillReachFor the rules (0: off)
+  int directions = 8;                                 ///< the option's, or the regime's default
+  ThinObjectTest thinObjects = ThinObjectTest::kOff;  ///< the option's, or the regime's default
+  int crossingFillReach = 0;                          ///< crossingFillReach under the supersampled rules, else 0 (off)
   /// The smooth blocks' refinement: kCentreProbe becomes kNever where the
-  /// guides show every hard shadow and the samples are not noisy.
+  /// guides show every hard shadow (ProviderCapabilities::hardShadowsGuided)
+  /// and the samples are not noisy. Noisy samples keep the probes: they are
+  /// also samples the denoising fits use (docs/NOISE.md).
   SmoothRefinement smoothRefinement = SmoothRefinement::kAlways;
   /// Guides the engine asks for: object IDs (an object test and a provider
   /// that has them), shader IDs (with them, for the tests that read both),
@@ -115,7 +120,7 @@ struct ResolvedSettings {
   bool objectIds = false, shaderIds = false, normals = false;
   /// The surface test's rule: the options' with object IDs, kNone without.
   ObjectTest objectTest = ObjectTest::kNone;
-  /// The crease angle between work pixels (WorkCreaseAngle), 0 without normals.
+  /// The crease angle between work pixels (creaseAngle / downsample), 0 without normals.
   float creaseAngle = 0.f;
   /// Noisy samples are replaced by their local fits before interpolation.
   bool denoise = false;
@@ -142,7 +147,7 @@ struct ReconstructionStats {
   StageTimes stageTimes;     ///< timeEngineS per stage
   ResolvedSettings settings;  ///< what the stages used
   bool usedSplit = false, usedObjectId = false, usedShaderId = false, usedNormals = false;
-  bool usedSupersampledRules = false;  ///< ReconstructionOptions::SupersampledRules
+  bool usedSupersampledRules = false;  ///< ResolvedSettings::supersampledRules
   double exactFraction() const { return totalPixels ? double(exactPixels) / double(totalPixels) : 0.0; }
 };
 
@@ -161,18 +166,14 @@ struct Reconstruction {
   std::shared_ptr<InterpolationRecord> interpolation;
 };
 
-/// Whether a reconstruction with `options` of a provider with `caps` uses the
-/// supersampled rules (ReconstructionOptions::SupersampledRules: supersampled
-/// input whose samples are not noisy).
-bool UsesSupersampledRules(const ReconstructionOptions& options, const ProviderCapabilities& caps);
+/// The settings a reconstruction with `options` of a provider with `caps`
+/// uses (its ReconstructionStats::settings), known before it runs.
+ResolvedSettings ResolveSettings(const ReconstructionOptions& options, const ProviderCapabilities& caps);
 
-/// The refinement of smooth blocks a reconstruction with `options` of a
-/// provider with `caps` uses: kCentreProbe becomes kNever where the guides
-/// show every hard shadow (ProviderCapabilities::hardShadowsGuided) and the
-/// samples are not noisy. Noisy samples keep the probes: they are also
-/// samples the denoising fits use (docs/NOISE.md: the tracer's parquet at
-/// 16 spp lost 4.5 dB without them).
-SmoothRefinement UsedSmoothRefinement(const ReconstructionOptions& options, const ProviderCapabilities& caps);
+/// The largest elementary block a reconstruction with valid `options` uses,
+/// noisy samples or not: a lattice of it is a lattice of each (powers of
+/// two), for tile alignment before the provider is known.
+int LargestElementaryBlock(const ReconstructionOptions& options);
 
 /// Reconstructs the provider's image with DCM. On error `out` is unspecified.
 /// With a provider that answers Status::Pending, returns that status and

@@ -29,7 +29,7 @@ struct ProviderCapabilities {
   /// point or directional light, or the guides mark where such a light's
   /// visibility changes (a shadow guide folded into the IDs). Then a smooth
   /// block of samples that are not noisy needs no centre probe
-  /// (SmoothRefinement::kCentreProbe, UsedSmoothRefinement): what the probe
+  /// (SmoothRefinement::kCentreProbe, ResolvedSettings::smoothRefinement): what the probe
   /// finds between a block's corners is a shadow smaller than the block,
   /// and the guides show those.
   bool hardShadowsGuided = false;

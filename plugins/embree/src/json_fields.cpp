@@ -1,4 +1,4 @@
-#include "embree/json_fields.h"
+#include "json_fields.h"
 
 #include <cmath>
 #include <limits>

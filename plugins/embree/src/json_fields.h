@@ -11,7 +11,7 @@
 
 #include "dcm/color.h"
 #include "dcm/status.h"
-#include "embree/vec3.h"
+#include "dcm/embree/vec3.h"
 
 namespace dcm::embree {
 

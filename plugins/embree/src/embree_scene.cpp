@@ -1,4 +1,4 @@
-#include "embree/embree_scene.h"
+#include "dcm/embree/embree_scene.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <utility>
 #include <string>
 
-#include "embree/mesh_loader.h"
+#include "dcm/embree/mesh_loader.h"
 
 namespace dcm::embree {
 namespace {

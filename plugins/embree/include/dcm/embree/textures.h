@@ -8,8 +8,8 @@
 
 #include "dcm/color.h"
 #include "dcm/status.h"
-#include "embree/scene.h"
-#include "embree/vec3.h"
+#include "dcm/embree/scene.h"
+#include "dcm/embree/vec3.h"
 
 
 namespace dcm::embree {

@@ -1,4 +1,4 @@
-#include "embree/camera.h"
+#include "dcm/embree/camera.h"
 
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "embree/integrator.h"
+#include "dcm/embree/integrator.h"
 
 #include <algorithm>
 #include <cmath>

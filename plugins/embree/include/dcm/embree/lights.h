@@ -2,8 +2,8 @@
 #pragma once
 
 #include "dcm/color.h"
-#include "embree/scene.h"
-#include "embree/vec3.h"
+#include "dcm/embree/scene.h"
+#include "dcm/embree/vec3.h"
 
 namespace dcm::embree {
 

@@ -1,4 +1,4 @@
-#include "embree/mesh_loader.h"
+#include "dcm/embree/mesh_loader.h"
 
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>

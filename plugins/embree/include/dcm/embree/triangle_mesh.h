@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "embree/scene.h"
-#include "embree/vec3.h"
+#include "dcm/embree/scene.h"
+#include "dcm/embree/vec3.h"
 
 namespace dcm::embree {
 

@@ -4,9 +4,9 @@
 #include <cmath>
 
 #include "dcm/color.h"
-#include "embree/scene.h"
-#include "embree/textures.h"
-#include "embree/vec3.h"
+#include "dcm/embree/scene.h"
+#include "dcm/embree/textures.h"
+#include "dcm/embree/vec3.h"
 
 namespace dcm::embree {
 

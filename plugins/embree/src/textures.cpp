@@ -1,4 +1,4 @@
-#include "embree/textures.h"
+#include "dcm/embree/textures.h"
 
 #include <OpenImageIO/imageio.h>
 #include <OpenImageIO/texture.h>
@@ -8,7 +8,7 @@
 #include <filesystem>
 
 #include "dcm/memory_budget.h"
-#include "embree/sampling.h"
+#include "dcm/embree/sampling.h"
 
 namespace dcm::embree {
 namespace {

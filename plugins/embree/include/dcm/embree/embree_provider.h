@@ -9,11 +9,11 @@
 #include <vector>
 
 #include "dcm/sample_provider.h"
-#include "embree/camera.h"
-#include "embree/embree_scene.h"
-#include "embree/integrator.h"
-#include "embree/scene.h"
-#include "embree/textures.h"
+#include "dcm/embree/camera.h"
+#include "dcm/embree/embree_scene.h"
+#include "dcm/embree/integrator.h"
+#include "dcm/embree/scene.h"
+#include "dcm/embree/textures.h"
 
 namespace dcm::embree {
 

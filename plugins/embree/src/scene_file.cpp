@@ -1,4 +1,4 @@
-#include "embree/scene_file.h"
+#include "dcm/embree/scene_file.h"
 
 #include <limits>
 
@@ -7,7 +7,7 @@
 #include <map>
 #include <sstream>
 
-#include "embree/json_fields.h"
+#include "json_fields.h"
 
 namespace dcm::embree {
 namespace {

@@ -6,7 +6,7 @@
 #include <string_view>
 
 #include "dcm/status.h"
-#include "embree/scene.h"
+#include "dcm/embree/scene.h"
 
 namespace dcm::embree {
 

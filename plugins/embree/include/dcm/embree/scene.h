@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "dcm/color.h"
-#include "embree/vec3.h"
+#include "dcm/embree/vec3.h"
 
 namespace dcm::embree {
 

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "dcm/status.h"
-#include "embree/triangle_mesh.h"
+#include "dcm/embree/triangle_mesh.h"
 
 namespace dcm::embree {
 

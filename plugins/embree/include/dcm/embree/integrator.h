@@ -8,12 +8,12 @@
 #include <vector>
 
 #include "dcm/color.h"
-#include "embree/camera.h"
-#include "embree/embree_scene.h"
-#include "embree/lights.h"
-#include "embree/materials.h"
-#include "embree/sampling.h"
-#include "embree/scene.h"
+#include "dcm/embree/camera.h"
+#include "dcm/embree/embree_scene.h"
+#include "dcm/embree/lights.h"
+#include "dcm/embree/materials.h"
+#include "dcm/embree/sampling.h"
+#include "dcm/embree/scene.h"
 
 namespace dcm::embree {
 

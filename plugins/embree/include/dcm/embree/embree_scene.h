@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "dcm/status.h"
-#include "embree/scene.h"
-#include "embree/triangle_mesh.h"
-#include "embree/vec3.h"
+#include "dcm/embree/scene.h"
+#include "dcm/embree/triangle_mesh.h"
+#include "dcm/embree/vec3.h"
 
 namespace dcm::embree {
 

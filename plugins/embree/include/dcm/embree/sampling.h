@@ -5,7 +5,7 @@
 
 #include <cstdint>
 
-#include "embree/vec3.h"
+#include "dcm/embree/vec3.h"
 
 namespace dcm::embree {
 

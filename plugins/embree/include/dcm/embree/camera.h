@@ -1,8 +1,8 @@
 // The pinhole camera of the internal ray tracer.
 #pragma once
 
-#include "embree/scene.h"
-#include "embree/vec3.h"
+#include "dcm/embree/scene.h"
+#include "dcm/embree/vec3.h"
 
 namespace dcm::embree {
 

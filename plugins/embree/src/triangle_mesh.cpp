@@ -1,4 +1,4 @@
-#include "embree/triangle_mesh.h"
+#include "dcm/embree/triangle_mesh.h"
 
 #include <cmath>
 

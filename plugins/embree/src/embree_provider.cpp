@@ -1,6 +1,6 @@
-#include "embree/embree_provider.h"
+#include "dcm/embree/embree_provider.h"
 
-#include "embree/scene_file.h"
+#include "dcm/embree/scene_file.h"
 
 #include <tbb/parallel_for.h>
 
