@@ -124,6 +124,7 @@ class SampleStore {
   std::vector<SampleReason> reason_;
   std::vector<uint8_t> finite_, filled_, crease_, tauZero_;
   CellRegions regions_;
+  AdjacentChanges changes_;
   GuideImage guides_;
   SurfaceTest surfaces_;
   tbb::enumerable_thread_specific<std::vector<uint64_t>> requests_;
