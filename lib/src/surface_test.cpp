@@ -22,18 +22,41 @@ void SampleStore::SetGuides(GuideImage guides, ObjectTest test, float creaseAngl
       guides_.shaderId.size() == guides_.objectId.size()) {
     // A surface is an (object, shader) pair: one label per pair, numbered in
     // the order of first appearance (deterministic), instead of the object ID.
-    // Neighbours mostly repeat the last pair: look up only the changes.
-    std::unordered_map<uint64_t, uint32_t> labels;
-    uint64_t lastPair = 0;
-    uint32_t lastLabel = 0;
-    for (size_t i = 0; i < guides_.objectId.size(); ++i) {
-      const uint64_t pair = (uint64_t(guides_.objectId[i]) << 32) | guides_.shaderId[i];
-      if (i == 0 || pair != lastPair) {
-        lastPair = pair;
-        lastLabel = labels.try_emplace(pair, uint32_t(labels.size())).first->second;
+    // In parallel over fixed chunks of pixels: each chunk numbers its own pairs
+    // in its order of first appearance, the chunks' lists taken in order
+    // number them as one scan of the frame would, and each chunk then maps
+    // its numbers to those. Neighbours mostly repeat the last pair: look up
+    // only the changes.
+    constexpr size_t kChunk = size_t(1) << 15;
+    const size_t pixels = guides_.objectId.size(), chunks = (pixels + kChunk - 1) / kChunk;
+    std::vector<std::vector<uint64_t>> firsts(chunks);  // each chunk's pairs, in order
+    tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+      const size_t begin = c * kChunk, end = std::min(pixels, begin + kChunk);
+      std::unordered_map<uint64_t, uint32_t> local;
+      uint64_t lastPair = 0;
+      uint32_t lastLabel = 0;
+      for (size_t i = begin; i < end; ++i) {
+        const uint64_t pair = (uint64_t(guides_.objectId[i]) << 32) | guides_.shaderId[i];
+        if (i == begin || pair != lastPair) {
+          lastPair = pair;
+          const auto [it, added] = local.try_emplace(pair, uint32_t(local.size()));
+          if (added) firsts[c].push_back(pair);
+          lastLabel = it->second;
+        }
+        guides_.objectId[i] = lastLabel;
       }
-      guides_.objectId[i] = lastLabel;
+    });
+    std::unordered_map<uint64_t, uint32_t> labels;
+    std::vector<std::vector<uint32_t>> global(chunks);  // per chunk: its numbers to the frame's
+    for (size_t c = 0; c < chunks; ++c) {
+      global[c].reserve(firsts[c].size());
+      for (uint64_t pair : firsts[c]) global[c].push_back(labels.try_emplace(pair, uint32_t(labels.size())).first->second);
     }
+    tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+      const size_t begin = c * kChunk, end = std::min(pixels, begin + kChunk);
+      const uint32_t* map = global[c].data();
+      for (size_t i = begin; i < end; ++i) guides_.objectId[i] = map[guides_.objectId[i]];
+    });
   }
   const uint32_t* obj = (test != ObjectTest::kNone && !guides_.objectId.empty()) ? guides_.objectId.data() : nullptr;
   const uint32_t* shader = (obj && test == ObjectTest::kObjectAndShader && !guides_.shaderId.empty())
