@@ -91,7 +91,9 @@ void SampleStore::SetGuides(GuideImage guides, ObjectTest test, float creaseAngl
   if (split_ && tau_.size() == size_t(width_) * size_t(height_)) {
     tauZero_.resize(tau_.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, tau_.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t i = r.begin(); i < r.end(); ++i) tauZero_[i] = TauZero(tau_[i]) ? 1 : 0;
+      const RGB* tau = tau_.data();
+      uint8_t* zero = tauZero_.data();
+      for (size_t i = r.begin(); i < r.end(); ++i) zero[i] = uint8_t(TauZero(tau[i]));
     });
   }
   regions_ = CellRegions{};
