@@ -16,15 +16,27 @@ namespace dcm::detail {
 SampleStore::SampleStore(int width, int height, bool split, bool variance)
     : width_(width), height_(height), split_(split) {
   const size_t n = size_t(width) * size_t(height);
-  if (split_) {
-    a_.assign(n, RGB{});
-    b_.assign(n, RGB{});
-  }
   out_.assign(n, RGB{});
   reason_.assign(n, SampleReason::kInterpolated);
-  finite_.assign(n, 1);
-  filled_.assign(n, 0);
-  if (variance) var_.assign(n, {0.f, 0.f});
+  // The store's own arrays are allocated uninitialised and filled in
+  // parallel (PixelArray); the outputs' (out_, reason_) are std::vectors.
+  if (split_) {
+    a_.resize(n);
+    b_.resize(n);
+  }
+  finite_.resize(n);
+  filled_.resize(n);
+  if (variance) var_.resize(n);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, size_t(1) << 16), [&](const tbb::blocked_range<size_t>& r) {
+    const size_t begin = r.begin(), count = r.size();
+    if (split_) {
+      std::fill_n(a_.data() + begin, count, RGB{});
+      std::fill_n(b_.data() + begin, count, RGB{});
+    }
+    std::fill_n(finite_.data() + begin, count, uint8_t(1));
+    std::fill_n(filled_.data() + begin, count, uint8_t(0));
+    if (variance) std::fill_n(var_.data() + begin, count, std::array<float, 2>{0.f, 0.f});
+  });
 }
 
 std::array<float, 2> SampleStore::LuminanceVariances(RGB varL, RGB tau) {
