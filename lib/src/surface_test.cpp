@@ -158,11 +158,11 @@ bool AnyBit(const uint64_t* row, int lo, int hi) {
 }  // namespace
 
 bool SurfaceTest::ChangeIn(int x0, int y0, int x1, int y1) const {
-  if (changes_) {
-    const size_t words = size_t(changes_->words);
+  if (changesRight_) {
+    const size_t words = size_t(changesWords_);
     for (int y = y0; y <= y1; ++y) {
-      if (x1 > x0 && AnyBit(changes_->right.data() + size_t(y) * words, x0, x1 - 1)) return true;
-      if (y < y1 && AnyBit(changes_->below.data() + size_t(y) * words, x0, x1)) return true;
+      if (x1 > x0 && AnyBit(changesRight_ + size_t(y) * words, x0, x1 - 1)) return true;
+      if (y < y1 && AnyBit(changesBelow_ + size_t(y) * words, x0, x1)) return true;
     }
     return false;
   }

@@ -52,7 +52,8 @@ class SurfaceTest {
       : objectId_(objectId), shaderId_(shaderId), crease_(crease), tauZero_(tauZero), width_(width) {
     if (regions && !regions->labels.empty())
       regionLabels_ = regions->labels.data(), regionSize_ = regions->size, regionCellsX_ = regions->cellsX;
-    if (changes && !changes->right.empty()) changes_ = changes;
+    if (changes && !changes->right.empty())
+      changesRight_ = changes->right.data(), changesBelow_ = changes->below.data(), changesWords_ = changes->words;
   }
   bool enabled() const { return objectId_ != nullptr || crease_ != nullptr || tauZero_ != nullptr; }
   /// Without IDs everything is one surface; with object IDs only, equal IDs;
@@ -92,7 +93,10 @@ class SurfaceTest {
   const uint32_t* regionLabels_ = nullptr;  ///< CellRegions::labels (its buffer outlives moves)
   int regionSize_ = 0, regionCellsX_ = 0;
   int width_ = 0;
-  const AdjacentChanges* changes_ = nullptr;
+  /// AdjacentChanges' rows (their buffers outlive moves), or null.
+  const uint64_t* changesRight_ = nullptr;
+  const uint64_t* changesBelow_ = nullptr;
+  int changesWords_ = 0;
 };
 
 inline bool SurfaceTest::SameRegion(int64_t i, int64_t j) const {
