@@ -3,6 +3,10 @@
 // neighbours agree.
 #include "checkerboard_fill.h"
 
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+
 #include "engine.h"
 #include "oriented_interpolation.h"
 
@@ -61,9 +65,18 @@ void Engine::RequestOrDefer(int x, int y, SampleReason reason) {
 }
 
 Status Engine::ResolveDeferred(bool write) {
+  // The deferred pixels in frame order: found in parallel over fixed chunks,
+  // joined in chunk order.
+  constexpr size_t kChunk = size_t(1) << 16;
+  std::vector<std::vector<int64_t>> found((deferred_.size() + kChunk - 1) / kChunk);
+  tbb::parallel_for(size_t(0), found.size(), [&](size_t c) {
+    const SampleReason* reason = deferred_.data();
+    std::vector<int64_t>& out = found[c];
+    for (size_t i = c * kChunk, end = std::min(deferred_.size(), i + kChunk); i < end; ++i)
+      if (reason[i] != SampleReason::kInterpolated) out.push_back(int64_t(i));
+  });
   std::vector<int64_t> deferred;
-  for (size_t i = 0; i < deferred_.size(); ++i)
-    if (deferred_[i] != SampleReason::kInterpolated) deferred.push_back(int64_t(i));
+  for (const std::vector<int64_t>& f : found) deferred.insert(deferred.end(), f.begin(), f.end());
   std::vector<uint8_t> filled(deferred.size(), 0);
   // The decisions read the exact samples of the first colour only (requests
   // take effect at the flush), so they do not depend on the order.

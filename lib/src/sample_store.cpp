@@ -16,15 +16,27 @@ namespace dcm::detail {
 SampleStore::SampleStore(int width, int height, bool split, bool variance)
     : width_(width), height_(height), split_(split) {
   const size_t n = size_t(width) * size_t(height);
-  if (split_) {
-    a_.assign(n, RGB{});
-    b_.assign(n, RGB{});
-  }
   out_.assign(n, RGB{});
   reason_.assign(n, SampleReason::kInterpolated);
-  finite_.assign(n, 1);
-  filled_.assign(n, 0);
-  if (variance) var_.assign(n, {0.f, 0.f});
+  // The store's own arrays are allocated uninitialised and filled in
+  // parallel (PixelArray); the outputs' (out_, reason_) are std::vectors.
+  if (split_) {
+    a_.resize(n);
+    b_.resize(n);
+  }
+  finite_.resize(n);
+  filled_.resize(n);
+  if (variance) var_.resize(n);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, size_t(1) << 16), [&](const tbb::blocked_range<size_t>& r) {
+    const size_t begin = r.begin(), count = r.size();
+    if (split_) {
+      std::fill_n(a_.data() + begin, count, RGB{});
+      std::fill_n(b_.data() + begin, count, RGB{});
+    }
+    std::fill_n(finite_.data() + begin, count, uint8_t(1));
+    std::fill_n(filled_.data() + begin, count, uint8_t(0));
+    if (variance) std::fill_n(var_.data() + begin, count, std::array<float, 2>{0.f, 0.f});
+  });
 }
 
 std::array<float, 2> SampleStore::LuminanceVariances(RGB varL, RGB tau) {
@@ -124,30 +136,45 @@ Status SampleStore::Flush(SampleProvider& provider, const SampleRequest& what, i
     if (!s.ok()) return s;
   }
 
-  for (size_t k = 0; k < pixels.size(); ++k) {
-    const int64_t i = Index(pixels[k].x, pixels[k].y);
-    ExactSample& s = samples[k];
-    if (ClampSample(&s)) ++stats->clampedSamples;
-    reason_[i] = reasons[k];
-    ++stats->byReason[size_t(reasons[k])];
-    out_[i] = s.L;
-    if (split_) {
-      a_[i] = s.Li;
-      b_[i] = s.Lc;
+  // The pixels are distinct: their samples are stored in parallel, and the
+  // counts (integers) summed per range add up to the same whatever the split.
+  struct Counts {
+    int64_t clamped = 0, nonFinite = 0;
+    std::array<int64_t, kSampleReasonCount> byReason{};
+  };
+  tbb::enumerable_thread_specific<Counts> counts;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+    Counts& n = counts.local();
+    for (size_t k = r.begin(); k != r.end(); ++k) {
+      const int64_t i = Index(pixels[k].x, pixels[k].y);
+      ExactSample& s = samples[k];
+      if (ClampSample(&s)) ++n.clamped;
+      reason_[i] = reasons[k];
+      ++n.byReason[size_t(reasons[k])];
+      out_[i] = s.L;
+      if (split_) {
+        a_[i] = s.Li;
+        b_[i] = s.Lc;
+      }
+      // Where tau is exactly zero (a surface without diffuse texture: the sky,
+      // chrome, an emitter, a black texel) L = L_c and L_i means nothing: it is
+      // set to 0, and the sample interpolates L_c for pixels whose tau is zero
+      // too (the surface test keeps tau = 0 and tau != 0 apart).
+      const bool tauZero = split_ && TauZero(tau_[i]);
+      if (tauZero) a_[i] = RGB{};
+      const bool finite =
+          dcm::IsFinite(s.L) && (!split_ || ((tauZero || dcm::IsFinite(s.Li)) && dcm::IsFinite(s.Lc)));
+      if (!finite) ++n.nonFinite;
+      // Where tau is denormal, L_i = L_t / tau is not recoverable: the sample
+      // keeps its own exact L but never serves to interpolate others.
+      finite_[i] = (finite && (!split_ || tauZero || TauRecoverable(tau_[i]))) ? 1 : 0;
+      if (!var_.empty()) var_[i] = LuminanceVariances(s.variance, split_ ? tau_[i] : RGB::Gray(1.f));
     }
-    // Where tau is exactly zero (a surface without diffuse texture: the sky,
-    // chrome, an emitter, a black texel) L = L_c and L_i means nothing: it is
-    // set to 0, and the sample interpolates L_c for pixels whose tau is zero
-    // too (the surface test keeps tau = 0 and tau != 0 apart).
-    const bool tauZero = split_ && TauZero(tau_[i]);
-    if (tauZero) a_[i] = RGB{};
-    const bool finite =
-        dcm::IsFinite(s.L) && (!split_ || ((tauZero || dcm::IsFinite(s.Li)) && dcm::IsFinite(s.Lc)));
-    if (!finite) ++stats->nonFiniteSamples;
-    // Where tau is denormal, L_i = L_t / tau is not recoverable: the sample
-    // keeps its own exact L but never serves to interpolate others.
-    finite_[i] = (finite && (!split_ || tauZero || TauRecoverable(tau_[i]))) ? 1 : 0;
-    if (!var_.empty()) var_[i] = LuminanceVariances(s.variance, split_ ? tau_[i] : RGB::Gray(1.f));
+  });
+  for (const Counts& n : counts) {
+    stats->clampedSamples += n.clamped;
+    stats->nonFiniteSamples += n.nonFinite;
+    for (size_t r = 0; r < n.byReason.size(); ++r) stats->byReason[r] += n.byReason[r];
   }
   return Status::Ok();
 }

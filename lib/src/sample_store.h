@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <memory>
+#include <utility>
 #include <vector>
 
 #include "dcm/options.h"
@@ -37,6 +39,28 @@ inline Value Lerp(const Value& p, const Value& q, float t) {
   return {p.a * (1 - t) + q.a * t, p.b * (1 - t) + q.b * t,
           (1 - t) * (1 - t) * p.varA + t * t * q.varA, (1 - t) * (1 - t) * p.varB + t * t * q.varB};
 }
+
+/// Allocates without initialising the elements (default construction does
+/// nothing): SampleStore fills its own per-pixel arrays in parallel, so that
+/// their pages are first touched, and zeroed, by every worker instead of one.
+template <typename T>
+struct UninitialisedAllocator : std::allocator<T> {
+  template <typename U>
+  struct rebind {
+    using other = UninitialisedAllocator<U>;
+  };
+  UninitialisedAllocator() = default;
+  template <typename U>
+  UninitialisedAllocator(const UninitialisedAllocator<U>&) noexcept {}
+  template <typename U>
+  void construct(U*) noexcept {}
+  template <typename U, typename... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+template <typename T>
+using PixelArray = std::vector<T, UninitialisedAllocator<T>>;
 
 class SampleStore {
  public:
@@ -118,12 +142,14 @@ class SampleStore {
   void Write(int64_t i, const Value& v);
   int width_, height_;
   bool split_;
-  std::vector<RGB> a_, b_;  // (L_i, L_c) with the split only
+  PixelArray<RGB> a_, b_;  // (L_i, L_c) with the split only
   std::vector<RGB> out_, tau_;
-  std::vector<std::array<float, 2>> var_;  // (varA, varB) with variance only
+  PixelArray<std::array<float, 2>> var_;  // (varA, varB) with variance only
   std::vector<SampleReason> reason_;
-  std::vector<uint8_t> finite_, filled_, crease_, tauZero_;
+  PixelArray<uint8_t> finite_, filled_;
+  std::vector<uint8_t> crease_, tauZero_;
   CellRegions regions_;
+  AdjacentChanges changes_;
   GuideImage guides_;
   SurfaceTest surfaces_;
   tbb::enumerable_thread_specific<std::vector<uint64_t>> requests_;

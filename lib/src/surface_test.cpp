@@ -22,18 +22,41 @@ void SampleStore::SetGuides(GuideImage guides, ObjectTest test, float creaseAngl
       guides_.shaderId.size() == guides_.objectId.size()) {
     // A surface is an (object, shader) pair: one label per pair, numbered in
     // the order of first appearance (deterministic), instead of the object ID.
-    // Neighbours mostly repeat the last pair: look up only the changes.
-    std::unordered_map<uint64_t, uint32_t> labels;
-    uint64_t lastPair = 0;
-    uint32_t lastLabel = 0;
-    for (size_t i = 0; i < guides_.objectId.size(); ++i) {
-      const uint64_t pair = (uint64_t(guides_.objectId[i]) << 32) | guides_.shaderId[i];
-      if (i == 0 || pair != lastPair) {
-        lastPair = pair;
-        lastLabel = labels.try_emplace(pair, uint32_t(labels.size())).first->second;
+    // In parallel over fixed chunks of pixels: each chunk numbers its own pairs
+    // in its order of first appearance, the chunks' lists taken in order
+    // number them as one scan of the frame would, and each chunk then maps
+    // its numbers to those. Neighbours mostly repeat the last pair: look up
+    // only the changes.
+    constexpr size_t kChunk = size_t(1) << 15;
+    const size_t pixels = guides_.objectId.size(), chunks = (pixels + kChunk - 1) / kChunk;
+    std::vector<std::vector<uint64_t>> firsts(chunks);  // each chunk's pairs, in order
+    tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+      const size_t begin = c * kChunk, end = std::min(pixels, begin + kChunk);
+      std::unordered_map<uint64_t, uint32_t> local;
+      uint64_t lastPair = 0;
+      uint32_t lastLabel = 0;
+      for (size_t i = begin; i < end; ++i) {
+        const uint64_t pair = (uint64_t(guides_.objectId[i]) << 32) | guides_.shaderId[i];
+        if (i == begin || pair != lastPair) {
+          lastPair = pair;
+          const auto [it, added] = local.try_emplace(pair, uint32_t(local.size()));
+          if (added) firsts[c].push_back(pair);
+          lastLabel = it->second;
+        }
+        guides_.objectId[i] = lastLabel;
       }
-      guides_.objectId[i] = lastLabel;
+    });
+    std::unordered_map<uint64_t, uint32_t> labels;
+    std::vector<std::vector<uint32_t>> global(chunks);  // per chunk: its numbers to the frame's
+    for (size_t c = 0; c < chunks; ++c) {
+      global[c].reserve(firsts[c].size());
+      for (uint64_t pair : firsts[c]) global[c].push_back(labels.try_emplace(pair, uint32_t(labels.size())).first->second);
     }
+    tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+      const size_t begin = c * kChunk, end = std::min(pixels, begin + kChunk);
+      const uint32_t* map = global[c].data();
+      for (size_t i = begin; i < end; ++i) guides_.objectId[i] = map[guides_.objectId[i]];
+    });
   }
   const uint32_t* obj = (test != ObjectTest::kNone && !guides_.objectId.empty()) ? guides_.objectId.data() : nullptr;
   const uint32_t* shader = (obj && test == ObjectTest::kObjectAndShader && !guides_.shaderId.empty())
@@ -68,7 +91,9 @@ void SampleStore::SetGuides(GuideImage guides, ObjectTest test, float creaseAngl
   if (split_ && tau_.size() == size_t(width_) * size_t(height_)) {
     tauZero_.resize(tau_.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, tau_.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t i = r.begin(); i < r.end(); ++i) tauZero_[i] = TauZero(tau_[i]) ? 1 : 0;
+      const RGB* tau = tau_.data();
+      uint8_t* zero = tauZero_.data();
+      for (size_t i = r.begin(); i < r.end(); ++i) zero[i] = uint8_t(TauZero(tau[i]));
     });
   }
   regions_ = CellRegions{};
@@ -110,35 +135,91 @@ void SampleStore::SetGuides(GuideImage guides, ObjectTest test, float creaseAngl
   }
   surfaces_ = SurfaceTest(obj, shader, crease_.empty() ? nullptr : crease_.data(), width_,
                           tauZero_.empty() ? nullptr : tauZero_.data(), regions_.labels.empty() ? nullptr : &regions_);
+  changes_ = AdjacentChanges{};
+  if (surfaces_.enabled()) {
+    changes_ = surfaces_.BuildChanges(width_, height_);
+    surfaces_ = SurfaceTest(obj, shader, crease_.empty() ? nullptr : crease_.data(), width_,
+                            tauZero_.empty() ? nullptr : tauZero_.data(), regions_.labels.empty() ? nullptr : &regions_,
+                            &changes_);
+  }
 }
 
-bool SurfaceTest::ChangeInCell(int x0, int y0, int x1, int y1) const {
-  // The cell's labels, row-major from its origin (ox, oy), stride e + 1.
-  const uint32_t* cell = nullptr;
-  int ox = 0, oy = 0, stride = 0;
-  if (regionLabels_) {
-    const int e = regionSize_, cx = x0 / e, cy = y0 / e;
-    cell = regionLabels_ + size_t(cy * regionCellsX_ + cx) * size_t((e + 1) * (e + 1));
-    ox = cx * e, oy = cy * e, stride = e + 1;
-  }
-  // Same() and no crease between i and j; `li`, `lj` index the cell's labels.
-  auto same = [&](int64_t i, int64_t j, int li, int lj, uint8_t creaseBit) {
-    if (tauZero_ && tauZero_[i] != tauZero_[j]) return false;
-    const bool surface = (!objectId_ || objectId_[i] == objectId_[j]) ? (!cell || cell[li] == cell[lj])
-                                                                       : (shaderId_ && shaderId_[i] == shaderId_[j]);
-    return surface && !(crease_ && (crease_[std::min(i, j)] & creaseBit));
-  };
-  for (int y = y0; y <= y1; ++y) {
-    const int64_t row = int64_t(y) * width_;
-    const int lrow = (y - oy) * stride - ox;
-    for (int x = x0; x <= x1; ++x) {
-      const int64_t i = row + x;
-      const int li = lrow + x;
-      if (x < x1 && !same(i, i + 1, li, li + 1, 1)) return true;
-      if (y < y1 && !same(i, i + width_, li, li + stride, 2)) return true;
+namespace {
+/// Some bit of [lo, hi] (lo <= hi) is set in the row of 64-bit words.
+bool AnyBit(const uint64_t* row, int lo, int hi) {
+  const int w0 = lo >> 6, w1 = hi >> 6;
+  const uint64_t first = ~uint64_t(0) << (lo & 63), last = ~uint64_t(0) >> (63 - (hi & 63));
+  if (w0 == w1) return (row[w0] & first & last) != 0;
+  if (row[w0] & first) return true;
+  for (int w = w0 + 1; w < w1; ++w)
+    if (row[w]) return true;
+  return (row[w1] & last) != 0;
+}
+}  // namespace
+
+bool SurfaceTest::ChangeIn(int x0, int y0, int x1, int y1) const {
+  if (changesRight_) {
+    const size_t words = size_t(changesWords_);
+    for (int y = y0; y <= y1; ++y) {
+      if (x1 > x0 && AnyBit(changesRight_ + size_t(y) * words, x0, x1 - 1)) return true;
+      if (y < y1 && AnyBit(changesBelow_ + size_t(y) * words, x0, x1)) return true;
     }
+    return false;
   }
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x) {
+      const int64_t i = int64_t(y) * width_ + x;
+      if (x < x1 && !SameAdjacent(i, i + 1)) return true;
+      if (y < y1 && !SameAdjacent(i, i + width_)) return true;
+    }
   return false;
+}
+
+AdjacentChanges SurfaceTest::BuildChanges(int width, int height) const {
+  AdjacentChanges c;
+  c.words = (width + 63) / 64;
+  c.right.assign(size_t(c.words) * size_t(height), 0);
+  c.below.assign(size_t(c.words) * size_t(height), 0);
+  tbb::parallel_for(0, height, [&](int y) {
+    // SameAdjacent of 4-neighbours is: the same tau = 0 class, the same
+    // object or (with shader IDs) the same shader, and no crease between
+    // them; the cell regions join every such pair (AdjacentChanges). Each
+    // condition over the row in its own loop, which the compiler vectorises.
+    thread_local std::vector<uint8_t> differs;
+    differs.resize(size_t(width + 7) / 8 * 8);
+    const int64_t row = int64_t(y) * width;
+    auto pass = [&](int64_t offset, int count, uint8_t creaseBit, uint64_t* out) {
+      uint8_t* d = differs.data();
+      std::fill(differs.begin(), differs.end(), uint8_t(0));
+      if (tauZero_) {
+        const uint8_t* t = tauZero_ + row;
+        for (int x = 0; x < count; ++x) d[x] |= uint8_t(t[x] != t[x + offset]);
+      }
+      if (objectId_) {
+        const uint32_t* o = objectId_ + row;
+        if (shaderId_) {
+          const uint32_t* s = shaderId_ + row;
+          for (int x = 0; x < count; ++x) d[x] |= uint8_t((o[x] != o[x + offset]) & (s[x] != s[x + offset]));
+        } else {
+          for (int x = 0; x < count; ++x) d[x] |= uint8_t(o[x] != o[x + offset]);
+        }
+      }
+      if (crease_) {
+        const uint8_t* k = crease_ + row;
+        for (int x = 0; x < count; ++x) d[x] |= uint8_t((k[x] & creaseBit) != 0);
+      }
+      // Eight flags (bytes of 0 or 1) at a time: the multiplication gathers
+      // the low bit of byte j into bit 56 + j.
+      for (int x = 0; x < count; x += 8) {
+        uint64_t eight = 0;
+        for (int j = 0; j < 8; ++j) eight |= uint64_t(d[x + j]) << (8 * j);
+        out[x >> 6] |= ((eight * 0x0102040810204080ull) >> 56) << (x & 63);
+      }
+    };
+    pass(1, width - 1, 1, c.right.data() + size_t(y) * size_t(c.words));
+    if (y + 1 < height) pass(width, width, 2, c.below.data() + size_t(y) * size_t(c.words));
+  });
+  return c;
 }
 
 Status Engine::LoadGuides() {
@@ -179,15 +260,7 @@ Status Engine::LoadGuides() {
 
 bool Engine::HasSurfaceChange(const Block& b) const {
   const SurfaceTest& s = store_.surfaces();
-  if (!s.enabled()) return false;
-  if (s.HoldsInOneCell(b.x0, b.y0, b.x1, b.y1)) return s.ChangeInCell(b.x0, b.y0, b.x1, b.y1);
-  for (int y = b.y0; y <= b.y1; ++y)
-    for (int x = b.x0; x <= b.x1; ++x) {
-      const int64_t i = store_.Index(x, y);
-      if (x < b.x1 && !s.SameAdjacent(i, i + 1)) return true;
-      if (y < b.y1 && !s.SameAdjacent(i, i + store_.width())) return true;
-    }
-  return false;
+  return s.enabled() && s.ChangeIn(b.x0, b.y0, b.x1, b.y1);
 }
 
 }  // namespace dcm::detail

@@ -22,6 +22,16 @@ struct CellRegions {
   std::vector<uint32_t> labels;
 };
 
+/// Per row of the frame, bit x set where SameAdjacent fails between (x, y)
+/// and its right neighbour (`right`), or its neighbour below (`below`).
+/// SameAdjacent of 4-neighbours depends on no cell: two of them on one object
+/// and tau = 0 class with no crease between them are joined in every cell
+/// that holds both (CellRegions).
+struct AdjacentChanges {
+  int words = 0;  ///< 64-bit words per row
+  std::vector<uint64_t> right, below;
+};
+
 /// Which pairs of pixels lie on the same surface (paper 2.2 and 3.2).
 class SurfaceTest {
  public:
@@ -34,11 +44,16 @@ class SurfaceTest {
   /// `regions`: the regions of each cell (from normal guides; may be null):
   /// two pixels of one object that share a cell are one surface only when a
   /// path inside the cell joins them without crossing a crease.
+  /// `changes`: AdjacentChanges built by BuildChanges for these guides (may
+  /// be null: ChangeIn then tests each pair).
   SurfaceTest(const uint32_t* objectId, const uint32_t* shaderId, const uint8_t* crease = nullptr, int width = 0,
-              const uint8_t* tauZero = nullptr, const CellRegions* regions = nullptr)
+              const uint8_t* tauZero = nullptr, const CellRegions* regions = nullptr,
+              const AdjacentChanges* changes = nullptr)
       : objectId_(objectId), shaderId_(shaderId), crease_(crease), tauZero_(tauZero), width_(width) {
     if (regions && !regions->labels.empty())
       regionLabels_ = regions->labels.data(), regionSize_ = regions->size, regionCellsX_ = regions->cellsX;
+    if (changes && !changes->right.empty())
+      changesRight_ = changes->right.data(), changesBelow_ = changes->below.data(), changesWords_ = changes->words;
   }
   bool enabled() const { return objectId_ != nullptr || crease_ != nullptr || tauZero_ != nullptr; }
   /// Without IDs everything is one surface; with object IDs only, equal IDs;
@@ -60,17 +75,13 @@ class SurfaceTest {
     return true;  // not neighbours (the wrap of a degenerate block's loop)
   }
 
-  /// The pixels [x0, x1] x [y0, y1] lie in one cell of the regions (always
-  /// so without regions): ChangeInCell applies.
-  bool HoldsInOneCell(int x0, int y0, int x1, int y1) const {
-    if (!regionLabels_) return true;
-    const int e = regionSize_;
-    return x1 <= x0 / e * e + e && y1 <= y0 / e * e + e;
-  }
   /// Whether SameAdjacent fails for some pair of 4-neighbours inside
-  /// [x0, x1] x [y0, y1], which HoldsInOneCell: the same answer as testing
-  /// each pair, with the cell's labels found once.
-  bool ChangeInCell(int x0, int y0, int x1, int y1) const;
+  /// [x0, x1] x [y0, y1]: a few words per row with AdjacentChanges, each pair
+  /// tested without.
+  bool ChangeIn(int x0, int y0, int x1, int y1) const;
+  /// The AdjacentChanges of a width x height frame under this test (in
+  /// parallel over rows).
+  AdjacentChanges BuildChanges(int width, int height) const;
 
  private:
   bool SameRegion(int64_t i, int64_t j) const;
@@ -82,6 +93,10 @@ class SurfaceTest {
   const uint32_t* regionLabels_ = nullptr;  ///< CellRegions::labels (its buffer outlives moves)
   int regionSize_ = 0, regionCellsX_ = 0;
   int width_ = 0;
+  /// AdjacentChanges' rows (their buffers outlive moves), or null.
+  const uint64_t* changesRight_ = nullptr;
+  const uint64_t* changesBelow_ = nullptr;
+  int changesWords_ = 0;
 };
 
 inline bool SurfaceTest::SameRegion(int64_t i, int64_t j) const {

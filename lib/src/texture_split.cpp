@@ -19,7 +19,13 @@ void RequestNonFiniteTau(const std::vector<RGB>& tau, SampleStore& store) {
   // In parallel: the requests are sorted before they are evaluated.
   tbb::parallel_for(0, store.height(), [&](int y) {
     const RGB* row = tau.data() + store.Index(0, y);
-    for (int x = 0; x < store.width(); ++x)
+    const int width = store.width();
+    // Nearly every row is finite throughout: one pass without branches
+    // tells, and only the others look for their pixels.
+    unsigned finite = 1;
+    for (int x = 0; x < width; ++x) finite &= unsigned(IsFinite(row[x]));
+    if (finite) return;
+    for (int x = 0; x < width; ++x)
       if (!IsFinite(row[x])) store.Request(x, y, SampleReason::kFallback);
   });
 }

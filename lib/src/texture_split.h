@@ -14,7 +14,8 @@ namespace dcm::detail {
 /// tau is exactly zero in all three channels (L = L_c): a surface without
 /// diffuse texture (the sky, chrome, an emitter, a black texel), where L_i
 /// means nothing.
-inline bool TauZero(RGB tau) { return tau.r == 0.f && tau.g == 0.f && tau.b == 0.f; }
+/// (`&`: without branches, as IsFinite.)
+inline bool TauZero(RGB tau) { return (tau.r == 0.f) & (tau.g == 0.f) & (tau.b == 0.f); }
 
 /// L_i = L_t / tau is recoverable: tau is finite and neither zero nor
 /// denormal in every channel.

@@ -1,9 +1,11 @@
 // The tables that share the oriented-element geometry between blocks of one
 // shape (BorderPairs for the direction search, OrientedElements for the
-// interpolation) give, to the bit, what the per-pixel geometry gives.
+// interpolation) give, to the bit, what the per-pixel geometry gives; the
+// surface test's bit masks (AdjacentChanges) what each pair gives.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <algorithm>
 #include <cstring>
 #include <limits>
 #include <random>
@@ -155,6 +157,59 @@ TEST(GeometryTables, OrientedElementsMatchThePerPixelInterpolant) {
             }
           }
       }
+}
+
+// Guides with every kind of surface change: objects, shaders, tau = 0 pixels
+// and creases (whose cell regions then join pixels); the masks answer as each
+// pair's SameAdjacent does, for every test and random rectangles, cells
+// crossed or not.
+TEST(GeometryTables, SurfaceChangeMasksMatchThePairwiseTest) {
+  const int W = 83, H = 61;  // rows of more than one word, not a multiple of 64
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> coin(0, 9);
+  for (ObjectTest test : {ObjectTest::kObjectId, ObjectTest::kObjectOrShader, ObjectTest::kObjectAndShader}) {
+    for (bool normals : {false, true}) {
+      GuideImage g;
+      const size_t n = size_t(W) * size_t(H);
+      g.objectId.resize(n);
+      g.shaderId.resize(n);
+      g.texture.resize(n);
+      g.normal.resize(n);
+      for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+          const size_t i = size_t(y) * size_t(W) + size_t(x);
+          // Blobs rather than noise, so that many blocks have no change.
+          g.objectId[i] = uint32_t((x / 13 + y / 17) % 3) + (coin(rng) == 0 ? 5u : 0u);
+          g.shaderId[i] = uint32_t((x / 7) % 2);
+          g.texture[i] = (x > 40 && y > 30 && x < 50) ? RGB{} : RGB::Gray(0.5f);
+          g.normal[i] = (x + 2 * y) / 37 % 2 ? Vec3f{0.f, 0.f, 1.f} : Vec3f{1.f, 0.f, 0.f};
+        }
+      if (!normals) g.normal.clear();
+      SampleStore store(W, H, /*split=*/true);
+      store.SetGuides(g, test, normals ? 30.f : 0.f, 8);
+      const SurfaceTest& s = store.surfaces();
+      auto pairwise = [&](int x0, int y0, int x1, int y1) {
+        for (int y = y0; y <= y1; ++y)
+          for (int x = x0; x <= x1; ++x) {
+            const int64_t i = store.Index(x, y);
+            if (x < x1 && !s.SameAdjacent(i, i + 1)) return true;
+            if (y < y1 && !s.SameAdjacent(i, i + W)) return true;
+          }
+        return false;
+      };
+      std::uniform_int_distribution<int> px(0, W - 1), py(0, H - 1), len(0, 12);
+      int changes = 0, none = 0;
+      for (int r = 0; r < 4000; ++r) {
+        const int x0 = px(rng), y0 = py(rng);
+        const int x1 = std::min(W - 1, x0 + len(rng)), y1 = std::min(H - 1, y0 + len(rng));
+        const bool want = pairwise(x0, y0, x1, y1);
+        ASSERT_EQ(s.ChangeIn(x0, y0, x1, y1), want) << x0 << "," << y0 << "-" << x1 << "," << y1;
+        (want ? changes : none) += 1;
+      }
+      EXPECT_GT(changes, 100);  // both answers are exercised
+      EXPECT_GT(none, 100);
+    }
+  }
 }
 
 }  // namespace
