@@ -14,6 +14,7 @@
 #include <optional>
 #include <set>
 
+#include "dcm/noise_estimate.h"
 #include "exr_channels.h"
 
 namespace dcm::aov {
@@ -680,23 +681,7 @@ bool SameSurface(const Data& d, size_t i, size_t j) {
 /// Per pixel, the mean of `v` over the (2r+1)^2 window of pixels on the same
 /// surface (equal object and shader IDs where the inputs carry them).
 std::vector<RGB> SurfaceWindowMean(const std::vector<RGB>& v, const Data& d, int r) {
-  const int W = d.width(), H = d.height();
-  std::vector<RGB> out(v.size());
-  for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x) {
-      const size_t i = size_t(y) * size_t(W) + size_t(x);
-      double sum[3] = {};
-      int count = 0;
-      for (int ny = std::max(0, y - r); ny <= std::min(H - 1, y + r); ++ny)
-        for (int nx = std::max(0, x - r); nx <= std::min(W - 1, x + r); ++nx) {
-          const size_t j = size_t(ny) * size_t(W) + size_t(nx);
-          if (!SameSurface(d, i, j) || !IsFinite(v[j])) continue;
-          for (int c = 0; c < 3; ++c) sum[c] += v[j][c];
-          ++count;
-        }
-      if (count) out[i] = RGB(float(sum[0] / count), float(sum[1] / count), float(sum[2] / count));
-    }
-  return out;
+  return dcm::SurfaceWindowMean(v, d.width(), d.height(), d.objectId, d.shaderId, r);
 }
 
 /// The variance estimate of AovOptions::estimateVariance, in L units.
@@ -905,8 +890,7 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
       DCM_RETURN_IF_ERROR(ev2.Report(roles2, {kL, kLi, kLc}, nullptr, &d->warnings));
       std::vector<RGB> diff2(n);
       for (size_t i = 0; i < n; ++i) {
-        const RGB diff = d->L[i] - b.L[i];
-        diff2[i] = diff * diff * 0.25f;
+        diff2[i] = HalvesVariance(d->L[i], b.L[i], 1, 1);
         d->L[i] = (d->L[i] + b.L[i]) * 0.5f;
         if (split) {
           d->Li[i] = (d->Li[i] + b.Li[i]) * 0.5f;
