@@ -39,7 +39,7 @@ def exact(dcm, blender, src, tmp):
     for schedule in ("preview", "levels"):
         out, stats, smap = (os.path.join(tmp, schedule + e) for e in (".exr", ".json", ".png"))
         code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--sample-map", smap, "--schedule", schedule,
-                                 "--blender", blender, "--max-rounds", "8", "--no-variance"])
+                                 "--blender", blender, "--max-rounds", "8", "--variance", "off"])
         assert code == 0, se
         img, spec = bs.read_exr(out)
         assert spec.channelnames == ("ViewLayer.Combined.R", "ViewLayer.Combined.G", "ViewLayer.Combined.B",
@@ -82,25 +82,29 @@ def exact_mask(smap, h, w):
 
 def variance(dcm, blender, src, tmp):
     """By default the exact pixels are two renders of half the samples with the
-    file's seed and the next, and the engine weighs their variance."""
+    file's seed and the next; the engine weighs their variance where the
+    preview's halves say their noise matters (always with --variance on)."""
     blend = bs.make_scene(blender, src, tmp)  # 16 spp, seed 0
     half_a = bs.render_full(blender, src, blend, tmp, 8, 0)
     half_b = bs.render_full(blender, src, blend, tmp, 8, 1)
     h, w = half_a.shape[:2]
     runs = {}
-    for name, flags in (("default", []), ("raw", ["--no-denoise-samples"])):
+    for name, flags in (("auto", []), ("on", ["--variance", "on"]), ("raw", ["--variance", "on", "--no-denoise-samples"])):
         out, stats, smap = (os.path.join(tmp, name + e) for e in (".exr", ".json", ".png"))
         code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--sample-map", smap, "--blender", blender,
                                  "--max-rounds", "8"] + flags)
         assert code == 0, se
         j = json.load(open(stats))
         b = j["blender"]
-        assert b["variance"] == "halves" and b["seeds"] == [0, 1], b
+        assert b["seeds"] == [0, 1], b
+        # auto: the variance goes to the engine when the noise costs less than 42 dB.
+        used = name != "auto" or b["noise_psnr"] < 42
+        assert b["variance"] == ("halves" if used else "halves, not used"), b
         # The variance reached the engine: it runs its noise regime.
-        assert j["settings"]["noisy"], j["settings"]
+        assert j["settings"]["noisy"] == used, j["settings"]
         runs[name] = (bs.read_exr(out)[0], exact_mask(smap, h, w), j)
-    # The default denoises exact samples with their neighbours on the same surface.
-    assert runs["default"][2]["denoised_samples"] > 0, runs["default"][2]
+    # The engine denoises exact samples with their neighbours on the same surface.
+    assert runs["on"][2]["denoised_samples"] > 0, runs["on"][2]
     assert runs["raw"][2]["denoised_samples"] == 0, runs["raw"][2]
     # Without the denoising an exact pixel is the mean of the two seeds' renders
     # (relative 1e-5: the order of float additions in Cycles' film, far below the
@@ -111,8 +115,9 @@ def variance(dcm, blender, src, tmp):
     assert (err <= 1e-5 * np.maximum(np.abs(mean[is_exact][:, :3]), 1) + 1e-7).all(), err.max()
     differ = (np.abs(half_a - half_b)[is_exact][:, :3] > 1e-4).any(axis=1).mean()
     assert differ > 0.5, differ
-    print("%.1f %% exact; %.0f %% of them differ between the seeds; %d denoised by default"
-          % (100 * is_exact.mean(), 100 * differ, runs["default"][2]["denoised_samples"]))
+    print("%.1f %% exact; %.0f %% of them differ between the seeds; %d denoised; auto: noise %.1f dB, %s"
+          % (100 * is_exact.mean(), 100 * differ, runs["on"][2]["denoised_samples"],
+             runs["auto"][2]["blender"]["noise_psnr"], runs["auto"][2]["blender"]["variance"]))
     assert no_blender_left(blend)
 
 

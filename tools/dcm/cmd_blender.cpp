@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
@@ -61,7 +62,10 @@ struct BlenderFlags {
   int previewSamples = 0;  ///< 0: samples / 16, at least 4
   RoundFlags rounds;       ///< --schedule, --max-rounds
   int renderThreads = 0;
-  bool variance = true;    ///< exact pixels as two halves with two seeds, their variance to the engine
+  /// Exact pixels as two halves with two seeds; their variance to the engine:
+  /// auto where the preview's halves say the noise matters (kNoisyPsnr), on, off
+  /// (one render per pixel).
+  std::string variance = "auto";
   PipeFlags pipe;  ///< --provider-timeout, --provider-startup-timeout; engine; EXR format
 };
 
@@ -213,9 +217,13 @@ class TimedProvider final : public SampleProvider {
 /// (equal object and shader IDs) within one noisy elementary block
 /// (dcm::SurfaceWindowMean): a lattice corner then pools the corners around
 /// it, and a pixel on an edge its neighbours along the edge.
+/// `use` false: the samples go to the engine without variance.
 class PooledVarianceProvider final : public SampleProvider {
  public:
-  PooledVarianceProvider(SampleProvider& p, int radius) : p_(p), caps_(p.Capabilities()), radius_(radius) {}
+  PooledVarianceProvider(SampleProvider& p, int radius, bool use)
+      : p_(p), caps_(p.Capabilities()), radius_(radius) {
+    caps_.variance = caps_.variance && use;
+  }
   ProviderCapabilities Capabilities() const override { return caps_; }
   Status Guides(const Bounds2i& region, const GuideRequest& what, GuideImage* out) override {
     return p_.Guides(region, what, out);
@@ -296,7 +304,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   if (frame >= 0) command += " --frame " + std::to_string(frame);
   if (!f.viewLayer.empty()) command += " --view-layer " + ShellQuote(f.viewLayer);
   if (f.renderThreads > 0) command += " --threads " + std::to_string(f.renderThreads);
-  if (f.variance && !options.fullEvaluation) command += " --variance-halves";
+  if (f.variance != "off" && !options.fullEvaluation) command += " --variance-halves";
   // Blender prints to stdout before any script runs: the protocol goes to fd 3,
   // Blender's own output to stderr with -v, else nowhere (the child's notes and
   // errors still reach stderr).
@@ -314,7 +322,13 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   const auto& keys = provider->handshakeKeys();
   const double guidesRenderS = keys.count("guides_seconds") ? std::atof(keys.at("guides_seconds").c_str()) : 0.0;
   const std::string layer = keys.count("view_layer") ? PercentDecoded(keys.at("view_layer")) : "ViewLayer";
-  const ProviderCapabilities caps = provider->Capabilities();
+  // The exact pixels' variance goes to the engine where their noise matters.
+  const double noisePsnr =
+      keys.count("noise_psnr") ? std::atof(keys.at("noise_psnr").c_str()) : std::numeric_limits<double>::quiet_NaN();
+  const bool useVariance = provider->Capabilities().variance &&
+                           (f.variance == "on" || (f.variance == "auto" && noisePsnr < kNoisyPsnr));
+  PooledVarianceProvider pooled(*provider, options.ElementaryBlockFor(true), useVariance);
+  const ProviderCapabilities caps = pooled.Capabilities();
   RoundSchedule schedule = RoundSchedule::kLevels;
   if (Status st = ScheduleFor(f.rounds, provider->roundCost(), provider->hasPreview(), &schedule); !st.ok())
     return Fail("'" + f.scene + "': " + st.message());
@@ -327,6 +341,15 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     std::cerr << "blender: " << caps.width << "x" << caps.height << ", view layer '" << layer << "', round latency "
               << provider->roundCost().latencyS << " s, " << provider->roundCost().perSampleS
               << " s per pixel: schedule " << ToString(schedule) << "\n"
+              << "exact pixels: "
+              << (provider->Capabilities().variance
+                      ? std::string("two halves of the samples, seeds ") + keys.at("seeds") +
+                            (std::isnan(noisePsnr) ? std::string()
+                                                   : "; their noise costs about " + std::to_string(noisePsnr) +
+                                                         " dB PSNR (from the preview's halves)") +
+                            (useVariance ? ": the engine weighs their variance" : ": taken as noise-free")
+                      : std::string("one render each, taken as noise-free"))
+              << "\n"
               << "engine settings: " << SettingsSummary(options, caps) << "\n";
   }
   if (Status st = CheckDownsample(caps.width, caps.height, options.downsample, "the Blender image"); !st.ok())
@@ -334,7 +357,6 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
 
   toolkit::Progress progress(!f.pipe.engine.quiet);
   options.progress = [&](float v, std::string_view stage) { progress.Update(v, stage); };
-  PooledVarianceProvider pooled(*provider, options.ElementaryBlockFor(true));
   TimedProvider timed(pooled);
   Reconstruction rec;
   PreviewScheduleStats sched;
@@ -419,7 +441,8 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       }
     }
     b["seeds"] = seeds;
-    b["variance"] = caps.variance ? "halves" : "none";
+    b["variance"] = useVariance ? "halves" : provider->Capabilities().variance ? "halves, not used" : "none";
+    if (!std::isnan(noisePsnr)) b["noise_psnr"] = noisePsnr;
     j["blender"] = b;
     if (Status w = toolkit::WriteJson(stats, j); !w.ok()) return Fail(w.message());
   }
@@ -487,9 +510,12 @@ Registration reg("blender", "Render a .blend with Cycles at the pixels DCM asks 
                    app->add_option("--preview-samples", f->previewSamples,
                                    "samples of the guides and preview render (0: a sixteenth of --samples, at least 4)")
                        ->transform(Integer(0, 1 << 24));
-                   app->add_flag("!--no-variance", f->variance,
-                                 "render each exact pixel in one render at full samples (no variance: the engine "
-                                 "takes it as noise-free); by default two halves with two seeds give its variance");
+                   app->add_option("--variance", f->variance,
+                                   "exact pixels as two renders of half the samples with two seeds, whose difference "
+                                   "gives the engine their variance: auto (where the preview's halves say their "
+                                   "noise costs less than 42 dB PSNR), on, or off (one render each, no variance)")
+                       ->check(CLI::IsMember({"auto", "on", "off"}))
+                       ->capture_default_str();
                    app->add_option("--render-threads", f->renderThreads, "Cycles threads (0: Blender's choice)")
                        ->transform(Integer(0, kMaxThreads));
                    app->option_defaults()->group(kGroupGeneral);

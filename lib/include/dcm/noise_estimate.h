@@ -11,6 +11,15 @@
 
 namespace dcm {
 
+/// Samples whose noise alone costs less than this PSNR (dB, display-referred,
+/// against the noise-free image) are noisy enough for the engine's noise
+/// regime: noise within 2 dB of the 40-dB targets of docs/QUALITY.md decides
+/// what a reconstruction from them can reach; below it, weighing the noise
+/// pays, above it the regime's denser lattice costs more than it brings
+/// (docs/NOISE.md). Used by the AOV provider's noise detection and dcm
+/// blender's choice to give the engine its pixels' variance.
+inline constexpr double kNoisyPsnr = 42;
+
 /// The variance of the weighted mean (nA a + nB b) / (nA + nB) of two
 /// independent estimates of one pixel made with nA and nB samples, from that
 /// pixel alone: (a - b)^2 nA nB / (nA + nB)^2 ((a - b)^2 / 4 for equal halves).

@@ -77,6 +77,16 @@ def _write_png(path, grey):
                 + chunk(b"IDAT", zlib.compress(rows.tobytes(), 1)) + chunk(b"IEND", b""))
 
 
+def _noise_psnr(var, L):
+    """The display-referred PSNR that noise of variance `var` [h, w, 3] costs on
+    the image L: its sd times the slope of the sRGB encoding at L (at 1 above 1),
+    the measure of dcm's AOV noise detection (NoisePsnrFromData)."""
+    x = np.clip(L, 0.0031308, 1.0)
+    slope = np.where(L <= 0.0031308, 12.92, 1.055 / 2.4 * np.power(x, 1 / 2.4 - 1))
+    mse = float(np.mean(var * slope ** 2))
+    return 99.0 if not mse > 0 else -10 * np.log10(mse)
+
+
 def _log(msg):
     print("dcm-blender: " + msg, file=os.sys.stderr, flush=True)
 
@@ -91,6 +101,7 @@ class Session:
         self._guides = None   # planes of the guides/preview render
         self._mask_image = None
         self._round = 0
+        self.noise_psnr = None  # of the exact pixels' samples, from the preview's halves
         self.render_seconds = []
 
     # ------------------------------------------------------------- setup --
@@ -372,19 +383,34 @@ class Session:
         return np.stack([planes[name + "." + c] for c in comps], axis=-1)
 
     def guides(self):
-        """The guides and the preview: one unmasked render at the preview's samples."""
+        """The guides and the preview: one unmasked render at the preview's samples;
+        with halves two, one per seed, whose difference gives noise_psnr."""
         if self._guides is None:
             self._write_mask(np.ones((self.height * self.args.mask_scale,
                                       self.width * self.args.mask_scale), np.float32))
-            pl = self._render(self.preview_samples, "guides")
+            ps = self.preview_samples
+            counts = [ps - ps // 2, ps // 2] if self.halves and ps >= 2 else [ps]
+            pls = [self._render(n, "guides", seed) for n, seed in zip(counts, self.seeds)]
+            if len(pls) == 2:  # one entry: round_cost() reads the guides render's time
+                self.render_seconds[-2:] = [("guides", self.render_seconds[-2][1] + self.render_seconds[-1][1])]
+                self.scene.cycles.seed = self.seeds[0]
+
+            def mean(name, comps="RGB"):
+                return sum(n * self._rgb(p, name, comps) for n, p in zip(counts, pls)) / float(ps)
+            pl = pls[0]
             g = {}
             g["object_id"] = pl["CryptoObject00.r"].view(np.uint32).copy()
             g["shader_id"] = pl["CryptoMaterial00.r"].view(np.uint32).copy()
-            g["texture"] = self._rgb(pl, "DiffCol")
+            g["texture"] = mean("DiffCol")
             g["normal"] = self._rgb(pl, "Normal", "XYZ")
-            g["L"] = self._rgb(pl, "Combined")
-            g["Li"] = self._rgb(pl, "DiffDir") + self._rgb(pl, "DiffInd")
+            g["L"] = mean("Combined")
+            g["Li"] = mean("DiffDir") + mean("DiffInd")
             g["Lc"] = g["L"] - g["Li"] * g["texture"]
+            if len(pls) == 2:
+                # The preview's variance (dcm::HalvesVariance), at the exact pixels' samples.
+                a, b = self._rgb(pls[0], "Combined"), self._rgb(pls[1], "Combined")
+                var = (a - b) ** 2 * (counts[0] * counts[1] / float(ps) ** 2) * (ps / float(self.samples))
+                self.noise_psnr = _noise_psnr(var, g["L"])
             self._guides = g
         return self._guides
 
