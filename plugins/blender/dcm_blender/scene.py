@@ -79,10 +79,12 @@ def _write_png(path, grey):
 
 def _noise_psnr(var, L):
     """The display-referred PSNR that noise of variance `var` [h, w, 3] costs on
-    the image L: its sd times the slope of the sRGB encoding at L (at 1 above 1),
+    the image L: its relative sd times dcm::SrgbRelativeSlope(L) (the slope of
+    the sRGB encoding times L; above 1, where the display clips, the slope at 1),
     the measure of dcm's AOV noise detection (NoisePsnrFromData)."""
     x = np.clip(L, 0.0031308, 1.0)
     slope = np.where(L <= 0.0031308, 12.92, 1.055 / 2.4 * np.power(x, 1 / 2.4 - 1))
+    slope = np.where(L > 1, 1.055 / 2.4 / np.maximum(L, 1), slope)  # SrgbRelativeSlope(L) / L
     mse = float(np.mean(var * slope ** 2))
     return 99.0 if not mse > 0 else -10 * np.log10(mse)
 
