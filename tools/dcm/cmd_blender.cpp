@@ -17,9 +17,9 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cmath>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -338,15 +338,16 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     options.batchSize = caps.width * caps.height;
   }
   if (f.pipe.engine.verbose) {
+    char noise[96] = "";
+    if (!std::isnan(noisePsnr))
+      std::snprintf(noise, sizeof noise, "; their noise costs about %.1f dB PSNR (from the preview's halves)", noisePsnr);
     std::cerr << "blender: " << caps.width << "x" << caps.height << ", view layer '" << layer << "', round latency "
               << provider->roundCost().latencyS << " s, " << provider->roundCost().perSampleS
               << " s per pixel: schedule " << ToString(schedule) << "\n"
               << "exact pixels: "
               << (provider->Capabilities().variance
-                      ? std::string("two halves of the samples, seeds ") + keys.at("seeds") +
-                            (std::isnan(noisePsnr) ? std::string()
-                                                   : "; their noise costs about " + std::to_string(noisePsnr) +
-                                                         " dB PSNR (from the preview's halves)") +
+                      ? std::string("two halves of the samples, seeds ") +
+                            (keys.count("seeds") ? keys.at("seeds") : std::string("?")) + noise +
                             (useVariance ? ": the engine weighs their variance" : ": taken as noise-free")
                       : std::string("one render each, taken as noise-free"))
               << "\n"

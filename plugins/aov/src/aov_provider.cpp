@@ -719,8 +719,9 @@ std::vector<RGB> EstimateVarianceFromData(const Data& d) {
 /// The display-referred PSNR that the samples' noise alone would cost
 /// (AovOptions::detectNoise): the noise's relative variance is the median over
 /// pixels of the squared residual against the same-surface 4-neighbours (as
-/// EstimateVarianceFromData, in L_i: the split's, texture divided out) relative to the squared
-/// value, over 0.455 (the median of a chi-square of one degree of freedom:
+/// EstimateVarianceFromData, in L_i: the split's, the texture divided out)
+/// relative to the squared value, over 0.455 (the median of a chi-square of
+/// one degree of freedom:
 /// a renderer's noise is nearly the same in R, G and B); applied to L through
 /// the slope of the sRGB encoding. The median, where the estimate of the
 /// variance takes the mean: real detail the guides do not explain (hard shadow

@@ -78,14 +78,20 @@ def _write_png(path, grey):
 
 
 def _noise_psnr(var, L):
-    """The display-referred PSNR that noise of variance `var` [h, w, 3] costs on
-    the image L: its relative sd times dcm::SrgbRelativeSlope(L) (the slope of
-    the sRGB encoding times L; above 1, where the display clips, the slope at 1),
-    the measure of dcm's AOV noise detection (NoisePsnrFromData)."""
+    """The display-referred PSNR that noise of variance `var` [h, w, 3] (one pixel's
+    halves each, one degree of freedom) costs on the image L, as dcm's AOV noise
+    detection measures it (NoisePsnrFromData): the median over the pixels that are
+    not black of the variance relative to the squared value, over 0.455 (the median
+    of a chi-square of one degree of freedom), as a relative sd through
+    dcm::SrgbRelativeSlope (the slope of the sRGB encoding times L, at 1 above 1).
+    The median: a noisy value near 0 would make the slope, and a mean, explode."""
+    lit = L.sum(axis=-1) > 3e-3
+    if not lit.any():
+        return 99.0
+    rho2 = float(np.median(var.sum(axis=-1)[lit] / (L ** 2).sum(axis=-1)[lit])) / 0.455
     x = np.clip(L, 0.0031308, 1.0)
-    slope = np.where(L <= 0.0031308, 12.92, 1.055 / 2.4 * np.power(x, 1 / 2.4 - 1))
-    slope = np.where(L > 1, 1.055 / 2.4 / np.maximum(L, 1), slope)  # SrgbRelativeSlope(L) / L
-    mse = float(np.mean(var * slope ** 2))
+    rel = np.where(L <= 0.0031308, 12.92 * np.maximum(L, 0), 1.055 / 2.4 * np.power(x, 1 / 2.4))
+    mse = rho2 * float(np.mean(rel ** 2))
     return 99.0 if not mse > 0 else -10 * np.log10(mse)
 
 
