@@ -20,11 +20,12 @@ cd "$out"
 # The scene (examples/blender/make_and_render.py), saved after a 1-spp render.
 [ -f room.blend ] || blender -b --factory-startup --python "$here/examples/blender/make_and_render.py" -- \
     --out room_1spp.exr --view "$view" --res "$res" --samples 1 --save-blend room.blend >/dev/null
-render() {  # render SAMPLES OUT [NOISE_THRESHOLD]: the file at SAMPLES (adaptive sampling at the threshold)
+render() {  # render SAMPLES OUT [NOISE_THRESHOLD [SEED_OFFSET]]: the file at SAMPLES (adaptive sampling at the threshold)
   blender -b room.blend --python-expr "
 import bpy
 sc = bpy.context.scene
 sc.cycles.samples = $1
+sc.cycles.seed += ${4:-0}
 sc.cycles.use_adaptive_sampling = $([ -n "${3:-}" ] && echo True || echo False)
 sc.cycles.adaptive_threshold = ${3:-0.01}
 im = sc.render.image_settings
@@ -53,7 +54,9 @@ for t in ${ADAPTIVE:-}; do
   t1=$(now); render "$spp" "adaptive_$t.exr" "$t"; t2=$(now)
   adaptive_s+=("$t:$(echo "$t2 - $t1" | bc -l)")
 done
-[ -f ref.exr ] || render "$ref_spp" ref.exr
+# The reference with a seed of its own: with the file's, its first samples
+# would be the full render's and dcm's, and their errors against it smaller.
+[ -f ref.exr ] || render "$ref_spp" ref.exr "" 1000
 /usr/bin/python3 - "$full_s" "${DCM_VARIANTS:- }" "${adaptive_s[*]:-}" "${dcm_s[@]}" <<'PY'
 import json, sys
 import numpy as np

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Noisy Cycles renders (issue #8, docs/NOISE.md): dcm reconstructs from a
-# 64-spp render with the noise estimated from the data, or from two 64-spp
+# 64-spp render with the noise detected and estimated from the data, or from two 64-spp
 # renders of other seeds, and is compared against a converged render.
 #
 #   examples/blender/noise.sh [VIEW]            view a, b or c (default a)
@@ -52,7 +52,8 @@ echo "| input and method | exact % | PSNR dB | relMSE | SSIM |"
 echo "|---|---|---|---|---|"
 run "one render: the render itself" "$a" --full
 run "one render: paper (noise taken at face value)" "$a" --method paper
-run "one render: dcm, noise ignored (no variance)" "$a" "$guide"
+run "one render: dcm, noise ignored (no variance)" "$a" "$guide" --no-detect-noise
+run "one render: dcm, defaults (noise detected from the data)" "$a" "$guide"
 run "one render: dcm --estimate-variance" "$a" "$guide" --estimate-variance
 run "two renders: their mean" "$a" --second-render "$b" --full
 run "two renders: dcm --second-render" "$a" "$guide" --second-render "$b"

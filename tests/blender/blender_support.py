@@ -27,10 +27,12 @@ def read_exr(path, layer="ViewLayer.Combined."):
     return px[:, :, [names.index(layer + c) for c in "RGB"]], spec
 
 
-def render_full(blender, src, blend, tmp):
-    out = os.path.join(tmp, "full.exr")
-    subprocess.run([blender, "-b", blend, "--python", os.path.join(src, "tests/blender/render_full.py"), "--", out],
-                   check=True, stdout=subprocess.DEVNULL)
+def render_full(blender, src, blend, tmp, samples=None, seed=None):
+    """The file rendered in full (at `samples` with `seed` when given): RGBA [h, w, 4]."""
+    out = os.path.join(tmp, "full.exr" if samples is None else "full_%d_%d.exr" % (samples, seed))
+    extra = [] if samples is None else [str(samples), str(seed)]
+    subprocess.run([blender, "-b", blend, "--python", os.path.join(src, "tests/blender/render_full.py"), "--", out]
+                   + extra, check=True, stdout=subprocess.DEVNULL)
     return read_exr(out)[0]
 
 

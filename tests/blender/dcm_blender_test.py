@@ -1,9 +1,11 @@
-"""`dcm blender` on the tiny test scene: the exact pixels equal a full Cycles
-render of the same file, the .blend is unchanged, and bad input ends with a
-message naming the file and the step, exit 1, no output and no Blender left;
-a signal to dcm (SIGTERM, SIGKILL) leaves no output, no Blender and no scratch folder.
+"""`dcm blender` on the tiny test scene: with --variance off the exact pixels
+equal a full Cycles render of the same file; by default they are the mean of
+two renders at half the samples with two seeds, and the engine gets their
+variance; the .blend is unchanged, and bad input ends with a message naming
+the file and the step, exit 1, no output and no Blender left; a signal to dcm
+(SIGTERM, SIGKILL) leaves no output, no Blender and no scratch folder.
 
-    /usr/bin/python3 dcm_blender_test.py DCM BLENDER SOURCE_DIR exact|errors
+    /usr/bin/python3 dcm_blender_test.py DCM BLENDER SOURCE_DIR exact|variance|errors
 Exit 77 (skipped) when Blender is missing."""
 import hashlib
 import json
@@ -40,7 +42,7 @@ def exact(dcm, blender, src, tmp):
     for schedule in ("preview", "levels"):
         out, stats, smap = (os.path.join(tmp, schedule + e) for e in (".exr", ".json", ".png"))
         code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--sample-map", smap, "--schedule", schedule,
-                                 "--blender", blender, "--max-rounds", "8"])
+                                 "--blender", blender, "--max-rounds", "8", "--variance", "off"])
         assert code == 0, se
         img, spec = bs.read_exr(out)
         assert spec.channelnames == ("ViewLayer.Combined.R", "ViewLayer.Combined.G", "ViewLayer.Combined.B",
@@ -49,6 +51,7 @@ def exact(dcm, blender, src, tmp):
         j = json.load(open(stats))
         b = j["blender"]
         assert b["preview_stand_ins"] == 0, b
+        assert b["variance"] == "none" and len(b["seeds"]) == 1 and not j["settings"]["noisy"], (b, j["settings"])
         # The sample map's image part: dark grey (40, 40, 40) where interpolated.
         import OpenImageIO as oiio
         m = oiio.ImageInput.open(smap)
@@ -68,6 +71,56 @@ def exact(dcm, blender, src, tmp):
         print("%s: %.1f %% exact in %d render calls, %.1f %% bit-identical to the full render; %.2f s" % (
             schedule, 100 * j["exact_fraction"], rounds, 100 * (err == 0).all(axis=1).mean(), b["wall_s"]))
     assert hashlib.sha256(open(blend, "rb").read()).hexdigest() == digest, "the .blend changed"
+    assert no_blender_left(blend)
+
+
+def exact_mask(smap, h, w):
+    """Where the sample map says exact: its image part is dark grey (40, 40, 40) where interpolated."""
+    import OpenImageIO as oiio
+    m = oiio.ImageInput.open(smap)
+    sm = m.read_image("uint8")[:h, :w, :3]
+    m.close()
+    return (sm != 40).any(axis=2)
+
+
+def variance(dcm, blender, src, tmp):
+    """By default the exact pixels are two renders of half the samples with the
+    file's seed and the next; the engine weighs their variance where the
+    preview's halves say their noise matters (always with --variance on)."""
+    blend = bs.make_scene(blender, src, tmp)  # 16 spp, seed 0
+    half_a = bs.render_full(blender, src, blend, tmp, 8, 0)
+    half_b = bs.render_full(blender, src, blend, tmp, 8, 1)
+    h, w = half_a.shape[:2]
+    runs = {}
+    for name, flags in (("auto", []), ("on", ["--variance", "on"]), ("raw", ["--variance", "on", "--no-denoise-samples"])):
+        out, stats, smap = (os.path.join(tmp, name + e) for e in (".exr", ".json", ".png"))
+        code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--sample-map", smap, "--blender", blender,
+                                 "--max-rounds", "8"] + flags)
+        assert code == 0, se
+        j = json.load(open(stats))
+        b = j["blender"]
+        assert b["seeds"] == [0, 1], b
+        # auto: the variance goes to the engine when the noise costs less than 42 dB.
+        used = name != "auto" or b["noise_psnr"] < 42
+        assert b["variance"] == ("halves" if used else "halves, not used"), b
+        # The variance reached the engine: it runs its noise regime.
+        assert j["settings"]["noisy"] == used, j["settings"]
+        runs[name] = (bs.read_exr(out)[0], exact_mask(smap, h, w), j)
+    # The engine denoises exact samples with their neighbours on the same surface.
+    assert runs["on"][2]["denoised_samples"] > 0, runs["on"][2]
+    assert runs["raw"][2]["denoised_samples"] == 0, runs["raw"][2]
+    # Without the denoising an exact pixel is the mean of the two seeds' renders
+    # (relative 1e-5: the order of float additions in Cycles' film, far below the
+    # 8-spp noise), which differ: two seeds, each seen by Cycles' persistent session.
+    img, is_exact = runs["raw"][0], runs["raw"][1]
+    mean = (half_a + half_b) / 2
+    err = np.abs(img - mean)[is_exact][:, :3]
+    assert (err <= 1e-5 * np.maximum(np.abs(mean[is_exact][:, :3]), 1) + 1e-7).all(), err.max()
+    differ = (np.abs(half_a - half_b)[is_exact][:, :3] > 1e-4).any(axis=1).mean()
+    assert differ > 0.5, differ
+    print("%.1f %% exact; %.0f %% of them differ between the seeds; %d denoised; auto: noise %.1f dB, %s"
+          % (100 * is_exact.mean(), 100 * differ, runs["on"][2]["denoised_samples"],
+             runs["auto"][2]["blender"]["noise_psnr"], runs["auto"][2]["blender"]["variance"]))
     assert no_blender_left(blend)
 
 
@@ -151,7 +204,7 @@ def main():
     os.environ["TMPDIR"] = os.path.join(tmp, "tmpdir")
     os.mkdir(os.environ["TMPDIR"])
     try:
-        {"exact": exact, "errors": errors}[what](dcm, blender, src, tmp)
+        {"exact": exact, "variance": variance, "errors": errors}[what](dcm, blender, src, tmp)
         print("ok")
         return 0
     finally:

@@ -40,6 +40,7 @@ struct AovFlags {
   std::vector<std::string> samples;
   std::vector<std::string> secondRender;
   bool estimateVariance = false;
+  bool detectNoise = true;
   float highlightLevel = aov::AovOptions{}.highlightLevel;
 };
 
@@ -83,6 +84,9 @@ inline void AddAovFlags(CLI::App* app, AovFlags* f, bool samplesHelpForPlan) {
       ->allow_extra_args(false);
   app->add_flag("--estimate-variance", f->estimateVariance,
                 "noisy renders without a variance channel: estimate the noise from the data (docs/NOISE.md)");
+  app->add_flag("!--no-detect-noise", f->detectNoise,
+                "take samples without a variance channel as noise-free; by default dcm estimates their noise "
+                "when the data show it (docs/NOISE.md)");
   app->option_defaults()->group(kGroupGeneral);
 }
 
@@ -130,6 +134,7 @@ inline Status ToAovOptions(const AovFlags& f, bool sparse, bool split, aov::AovO
   o->split = split;
   o->secondRender = f.secondRender;
   o->estimateVariance = f.estimateVariance;
+  o->detectNoise = f.detectNoise;
   o->highlightLevel = f.highlightLevel;
   return Status::Ok();
 }

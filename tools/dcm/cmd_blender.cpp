@@ -1,9 +1,10 @@
 // dcm blender: a user's .blend rendered by Cycles only at the pixels DCM asks
 // for. Blender starts once as a dcm-pipe child (plugins/blender/child_main.py)
 // that renders the guides and a few-samples preview in one render call, then
-// each round of exact pixels in one masked render call at full samples; dcm
-// plans the rounds on the preview (RoundSchedule::kPreview) and writes a
-// multilayer EXR with Blender's names. Nothing is written on failure, and no
+// each round of exact pixels in masked render calls at full samples (two
+// halves with two seeds, so that dcm knows the pixels' variance); dcm plans the
+// rounds on the preview (RoundSchedule::kPreview) and writes a multilayer EXR
+// with Blender's names. Nothing is written on failure, and no
 // Blender is left running.
 //
 //   dcm blender SCENE.blend -o OUT.exr [--stats S.json] [--samples N] [--frames A-B]
@@ -14,15 +15,18 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -34,6 +38,7 @@
 #include "common/progress.h"
 #include "common/sample_map.h"
 #include "common/stats_json.h"
+#include "dcm/noise_estimate.h"
 #include "dcm/pipe/pipe_provider.h"
 #include "dcm/pipe/scratch_folder.h"
 #include "dcm/reconstructor.h"
@@ -58,6 +63,10 @@ struct BlenderFlags {
   int previewSamples = 0;  ///< 0: samples / 16, at least 4
   RoundFlags rounds;       ///< --schedule, --max-rounds
   int renderThreads = 0;
+  /// Exact pixels as two halves with two seeds; their variance to the engine:
+  /// auto where the preview's halves say the noise matters (kNoisyPsnr), on, off
+  /// (one render per pixel).
+  std::string variance = "auto";
   PipeFlags pipe;  ///< --provider-timeout, --provider-startup-timeout; engine; EXR format
 };
 
@@ -180,6 +189,52 @@ class TimedProvider final : public SampleProvider {
   SampleProvider& p_;
 };
 
+/// Pools the variance the child reports per exact pixel (from that pixel's two
+/// halves alone: one degree of freedom per channel, often near 0 or several
+/// times the truth) over the exact pixels known so far on the same surface
+/// (equal object and shader IDs) within one noisy elementary block
+/// (dcm::SurfaceWindowMean): a lattice corner then pools the corners around
+/// it, and a pixel on an edge its neighbours along the edge.
+/// `use` false: the samples go to the engine without variance.
+class PooledVarianceProvider final : public SampleProvider {
+ public:
+  PooledVarianceProvider(SampleProvider& p, int radius, bool use)
+      : p_(p), caps_(p.Capabilities()), radius_(radius) {
+    caps_.variance = caps_.variance && use;
+  }
+  ProviderCapabilities Capabilities() const override { return caps_; }
+  Status Guides(const Bounds2i& region, const GuideRequest& what, GuideImage* out) override {
+    return p_.Guides(region, what, out);
+  }
+  Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what, std::span<ExactSample> out) override {
+    DCM_RETURN_IF_ERROR(p_.Evaluate(pixels, what, out));
+    if (!what.variance || pixels.empty()) return Status::Ok();
+    const size_t n = size_t(caps_.width) * size_t(caps_.height);
+    if (raw_.empty()) {
+      // The surfaces, once: the IDs the engine reads too.
+      GuideImage g;
+      DCM_RETURN_IF_ERROR(p_.Guides(Bounds2i{{0, 0}, {caps_.width, caps_.height}},
+                                    {caps_.objectId, caps_.shaderId, false, false}, &g));
+      objectId_ = std::move(g.objectId);
+      shaderId_ = std::move(g.shaderId);
+      raw_.assign(n, RGB::Gray(std::numeric_limits<float>::quiet_NaN()));
+    }
+    for (size_t i = 0; i < pixels.size(); ++i)
+      raw_[size_t(pixels[i].y) * size_t(caps_.width) + size_t(pixels[i].x)] = out[i].variance;
+    const std::vector<RGB> pooled =
+        SurfaceWindowMean(raw_, caps_.width, caps_.height, objectId_, shaderId_, radius_, pixels);
+    for (size_t i = 0; i < pixels.size(); ++i) out[i].variance = pooled[i];
+    return Status::Ok();
+  }
+
+ private:
+  SampleProvider& p_;
+  ProviderCapabilities caps_;
+  int radius_;
+  std::vector<RGB> raw_;  ///< the child's per-pixel variance; NaN: not rendered
+  std::vector<uint32_t> objectId_, shaderId_;
+};
+
 /// Renders one frame (`frame` < 0: the file's current frame) to `output`.
 int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const std::string& stats,
              const std::string& sampleMap) {
@@ -229,6 +284,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   if (frame >= 0) command += " --frame " + std::to_string(frame);
   if (!f.viewLayer.empty()) command += " --view-layer " + ShellQuote(f.viewLayer);
   if (f.renderThreads > 0) command += " --threads " + std::to_string(f.renderThreads);
+  if (f.variance != "off" && !options.fullEvaluation) command += " --variance-halves";
   // Blender prints to stdout before any script runs: the protocol goes to fd 3,
   // Blender's own output to stderr with -v, else nowhere (the child's notes and
   // errors still reach stderr).
@@ -246,7 +302,13 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   const auto& keys = provider->handshakeKeys();
   const double guidesRenderS = keys.count("guides_seconds") ? std::atof(keys.at("guides_seconds").c_str()) : 0.0;
   const std::string layer = keys.count("view_layer") ? PercentDecoded(keys.at("view_layer")) : "ViewLayer";
-  const ProviderCapabilities caps = provider->Capabilities();
+  // The exact pixels' variance goes to the engine where their noise matters.
+  const double noisePsnr =
+      keys.count("noise_psnr") ? std::atof(keys.at("noise_psnr").c_str()) : std::numeric_limits<double>::quiet_NaN();
+  const bool useVariance = provider->Capabilities().variance &&
+                           (f.variance == "on" || (f.variance == "auto" && noisePsnr < kNoisyPsnr));
+  PooledVarianceProvider pooled(*provider, options.ElementaryBlockFor(true), useVariance);
+  const ProviderCapabilities caps = pooled.Capabilities();
   RoundSchedule schedule = RoundSchedule::kLevels;
   if (Status st = ScheduleFor(f.rounds, provider->roundCost(), provider->hasPreview(), &schedule); !st.ok())
     return Fail("'" + f.scene + "': " + st.message());
@@ -256,9 +318,19 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     options.batchSize = caps.width * caps.height;
   }
   if (f.pipe.engine.verbose) {
+    char noise[96] = "";
+    if (!std::isnan(noisePsnr))
+      std::snprintf(noise, sizeof noise, "; their noise costs about %.1f dB PSNR (from the preview's halves)", noisePsnr);
     std::cerr << "blender: " << caps.width << "x" << caps.height << ", view layer '" << layer << "', round latency "
               << provider->roundCost().latencyS << " s, " << provider->roundCost().perSampleS
               << " s per pixel: schedule " << ToString(schedule) << "\n"
+              << "exact pixels: "
+              << (provider->Capabilities().variance
+                      ? std::string("two halves of the samples, seeds ") +
+                            (keys.count("seeds") ? keys.at("seeds") : std::string("?")) + noise +
+                            (useVariance ? ": the engine weighs their variance" : ": taken as noise-free")
+                      : std::string("one render each, taken as noise-free"))
+              << "\n"
               << "engine settings: " << SettingsSummary(options, caps) << "\n";
   }
   if (Status st = CheckDownsample(caps.width, caps.height, options.downsample, "the Blender image"); !st.ok())
@@ -266,7 +338,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
 
   toolkit::Progress progress(!f.pipe.engine.quiet);
   options.progress = [&](float v, std::string_view stage) { progress.Update(v, stage); };
-  TimedProvider timed(*provider);
+  TimedProvider timed(pooled);
   Reconstruction rec;
   PreviewScheduleStats sched;
   double previewS = 0;
@@ -339,6 +411,19 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     b["preview_stand_ins"] = sched.previewStandIns;
     b["round_latency_s"] = provider->roundCost().latencyS;
     b["sample_cost_s"] = provider->roundCost().perSampleS;
+    // The seeds of the exact pixels' renders: two when they carry their variance.
+    nlohmann::json seeds = nlohmann::json::array();
+    if (keys.count("seeds")) {
+      const std::string list = keys.at("seeds");
+      for (size_t start = 0; start < list.size();) {
+        const size_t end = std::min(list.find(',', start), list.size());
+        seeds.push_back(std::atoll(list.substr(start, end - start).c_str()));
+        start = end + 1;
+      }
+    }
+    b["seeds"] = seeds;
+    b["variance"] = useVariance ? "halves" : provider->Capabilities().variance ? "halves, not used" : "none";
+    if (!std::isnan(noisePsnr)) b["noise_psnr"] = noisePsnr;
     j["blender"] = b;
     if (Status w = toolkit::WriteJson(stats, j); !w.ok()) return Fail(w.message());
   }
@@ -406,6 +491,12 @@ Registration reg("blender", "Render a .blend with Cycles at the pixels DCM asks 
                    app->add_option("--preview-samples", f->previewSamples,
                                    "samples of the guides and preview render (0: a sixteenth of --samples, at least 4)")
                        ->transform(Integer(0, 1 << 24));
+                   app->add_option("--variance", f->variance,
+                                   "exact pixels as two renders of half the samples with two seeds, whose difference "
+                                   "gives the engine their variance: auto (where the preview's halves say their "
+                                   "noise costs less than 42 dB PSNR), on, or off (one render each, no variance)")
+                       ->check(CLI::IsMember({"auto", "on", "off"}))
+                       ->capture_default_str();
                    app->add_option("--render-threads", f->renderThreads, "Cycles threads (0: Blender's choice)")
                        ->transform(Integer(0, kMaxThreads));
                    app->option_defaults()->group(kGroupGeneral);

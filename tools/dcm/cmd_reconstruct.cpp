@@ -101,6 +101,7 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
     identity[key] = hashes;
   }
   identity["estimate_variance"] = f.aov.estimateVariance;
+  identity["detect_noise"] = f.aov.detectNoise;
   identity["preset"] = f.aov.preset;
   identity["map"] = f.aov.maps;
   identity["texture"] = f.aov.textures;

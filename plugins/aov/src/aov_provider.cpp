@@ -14,6 +14,7 @@
 #include <optional>
 #include <set>
 
+#include "dcm/noise_estimate.h"
 #include "exr_channels.h"
 
 namespace dcm::aov {
@@ -683,23 +684,7 @@ bool SameSurface(const Data& d, size_t i, size_t j) {
 /// Per pixel, the mean of `v` over the (2r+1)^2 window of pixels on the same
 /// surface (equal object and shader IDs where the inputs carry them).
 std::vector<RGB> SurfaceWindowMean(const std::vector<RGB>& v, const Data& d, int r) {
-  const int W = d.width(), H = d.height();
-  std::vector<RGB> out(v.size());
-  for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x) {
-      const size_t i = size_t(y) * size_t(W) + size_t(x);
-      double sum[3] = {};
-      int count = 0;
-      for (int ny = std::max(0, y - r); ny <= std::min(H - 1, y + r); ++ny)
-        for (int nx = std::max(0, x - r); nx <= std::min(W - 1, x + r); ++nx) {
-          const size_t j = size_t(ny) * size_t(W) + size_t(nx);
-          if (!SameSurface(d, i, j) || !IsFinite(v[j])) continue;
-          for (int c = 0; c < 3; ++c) sum[c] += v[j][c];
-          ++count;
-        }
-      if (count) out[i] = RGB(float(sum[0] / count), float(sum[1] / count), float(sum[2] / count));
-    }
-  return out;
+  return dcm::SurfaceWindowMean(v, d.width(), d.height(), d.objectId, d.shaderId, r);
 }
 
 /// The variance estimate of AovOptions::estimateVariance, in L units.
@@ -732,6 +717,57 @@ std::vector<RGB> EstimateVarianceFromData(const Data& d) {
   if (split)
     for (size_t i = 0; i < var.size(); ++i) var[i] = var[i] * d.tau[i] * d.tau[i];
   return var;
+}
+
+/// The display-referred PSNR that the samples' noise alone would cost
+/// (AovOptions::detectNoise): the noise's relative variance is the median over
+/// pixels of the squared residual against the same-surface 4-neighbours (as
+/// EstimateVarianceFromData, in L_i: the split's, the texture divided out)
+/// relative to the squared value, over 0.455 (the median of a chi-square of
+/// one degree of freedom:
+/// a renderer's noise is nearly the same in R, G and B); applied to L through
+/// the slope of the sRGB encoding. The median, where the estimate of the
+/// variance takes the mean: real detail the guides do not explain (hard shadow
+/// edges, aliased geometry) is large at few pixels, noise is at every pixel.
+/// +Inf when no pixel shows any.
+double NoisePsnrFromData(const Data& d) {
+  const int W = d.width(), H = d.height();
+  const std::vector<RGB>& v = d.Li;  // the caller's condition: the split, the texture divided out
+  std::vector<float> rel;
+  rel.reserve(v.size());
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const size_t i = size_t(y) * size_t(W) + size_t(x);
+      if (!IsFinite(v[i])) continue;
+      const float energy = v[i].r * v[i].r + v[i].g * v[i].g + v[i].b * v[i].b;
+      // Black pixels say nothing about a relative noise (and divide by 0).
+      if (!(v[i].r + v[i].g + v[i].b > 3e-3f)) continue;
+      RGB mean;
+      int count = 0;
+      for (auto [dx, dy] : {std::pair{-1, 0}, {1, 0}, {0, -1}, {0, 1}}) {
+        const int nx = x + dx, ny = y + dy;
+        if (nx < 0 || ny < 0 || nx >= W || ny >= H) continue;
+        const size_t j = size_t(ny) * size_t(W) + size_t(nx);
+        if (!SameSurface(d, i, j) || !IsFinite(v[j])) continue;
+        mean += v[j];
+        ++count;
+      }
+      if (count < 2) continue;
+      const RGB res = v[i] - mean * (1.f / float(count));
+      rel.push_back((res.r * res.r + res.g * res.g + res.b * res.b) / (1.f + 1.f / float(count)) / energy);
+    }
+  if (rel.empty()) return std::numeric_limits<double>::infinity();
+  std::nth_element(rel.begin(), rel.begin() + rel.size() / 2, rel.end());
+  const double rho2 = rel[rel.size() / 2] / 0.455;
+  double sum = 0;
+  size_t count = 0;
+  for (const RGB& L : d.L) {
+    if (!IsFinite(L)) continue;
+    for (int c = 0; c < 3; ++c) sum += rho2 * double(SrgbRelativeSlope(L[c])) * SrgbRelativeSlope(L[c]);
+    count += 3;
+  }
+  if (!(sum > 0)) return std::numeric_limits<double>::infinity();
+  return -10 * std::log10(sum / double(count));
 }
 
 /// Which sample roles `split`/non-split needs; message when they are absent.
@@ -908,8 +944,7 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
       DCM_RETURN_IF_ERROR(ev2.Report(roles2, {kL, kLi, kLc}, nullptr, &d->warnings));
       std::vector<RGB> diff2(n);
       for (size_t i = 0; i < n; ++i) {
-        const RGB diff = d->L[i] - b.L[i];
-        diff2[i] = diff * diff * 0.25f;
+        diff2[i] = HalvesVariance(d->L[i], b.L[i], 1, 1);
         d->L[i] = (d->L[i] + b.L[i]) * 0.5f;
         if (split) {
           d->Li[i] = (d->Li[i] + b.Li[i]) * 0.5f;
@@ -923,6 +958,22 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
       d->var = EstimateVarianceFromData(*d);
       d->notes.push_back("variance: estimated from the data (residual against the 4-neighbours, 5x5 window on "
                          "each surface)");
+    } else if (options.detectNoise && !hasVar && !split) {
+      // Without the split a texture at the pixel scale would look like noise at most pixels.
+      d->notes.push_back("samples: taken as noise-free (no texture split to tell noise from texture; "
+                         "--estimate-variance for a noisy render)");
+    } else if (options.detectNoise && !hasVar) {
+      const double psnr = NoisePsnrFromData(*d);
+      const std::string figure = OIIO::Strutil::fmt::format("{:.1f}", psnr);
+      if (psnr < kNoisyPsnr) {
+        d->var = EstimateVarianceFromData(*d);
+        d->notes.push_back("samples: noisy (their noise alone would cost about " + figure +
+                           " dB PSNR): variance estimated from the data, as --estimate-variance "
+                           "(--no-detect-noise: take them as noise-free)");
+      } else {
+        d->notes.push_back("samples: taken as noise-free (their noise, if any, would cost about " + figure +
+                           " dB PSNR, above " + OIIO::Strutil::fmt::format("{:.0f}", kNoisyPsnr) + " dB)");
+      }
     }
     d->dense = true;
   } else {

@@ -31,6 +31,8 @@ def parse_args(argv):
     ap.add_argument("--frame", type=int, default=None, help="frame to render (default: the file's current)")
     ap.add_argument("--view-layer", default="", help="view layer to render (default: the first that renders)")
     ap.add_argument("--threads", type=int, default=0, help="render threads (0: Blender's choice)")
+    ap.add_argument("--variance-halves", action="store_true",
+                    help="render exact pixels as two halves of the samples with two seeds; report their variance")
     ap.add_argument("--call-seconds", type=float, default=0.3,
                     help="fixed time of a render call in the running Blender (sets how many borders pay off)")
     ap.add_argument("--max-calls", type=int, default=64, help="render calls per round at most")
@@ -71,10 +73,14 @@ class Protocol:
         self.out.flush()
 
 
-def _records(what, L, Li, Lc):
+def _records(what, L, Li, Lc, var=None):
     parts = [L]
     if "split" in what:
         parts += [Li, Lc]
+    if "variance" in what:
+        if var is None:
+            raise ValueError("eval: variance asked for, and not announced")
+        parts.append(var)
     return np.concatenate(parts, axis=1).astype("<f4").tobytes()
 
 
@@ -100,8 +106,8 @@ def serve(proto, session):
             xs, ys = xy[:, 0].astype(np.int64), xy[:, 1].astype(np.int64)
             if n and (xs.min() < 0 or ys.min() < 0 or xs.max() >= session.width or ys.max() >= session.height):
                 raise ValueError("eval: a pixel outside the %dx%d image" % (session.width, session.height))
-            L, Li, Lc = session.evaluate(xs, ys) if n else (np.zeros((0, 3)),) * 3
-            proto.send("samples %d" % n, _records(t[2].split(","), L, Li, Lc))
+            L, Li, Lc, var = session.evaluate(xs, ys) if n else (np.zeros((0, 3)),) * 4
+            proto.send("samples %d" % n, _records(t[2].split(","), L, Li, Lc, var))
         elif t[0] == "preview" and len(t) == 6:
             x0, y0, x1, y1 = (int(v) for v in t[1:5])
             g = session.guides()
@@ -144,9 +150,11 @@ def main(argv):
         latency, per_sample = session.round_cost()
         # view_layer (percent-encoded: names have spaces) and guides_seconds are for `dcm blender`.
         proto.send("dcm-pipe 1 width=%d height=%d caps=%s name=blender-cycles round_latency=%.4g sample_cost=%.4g "
-                   "view_layer=%s guides_seconds=%.3f"
-                   % (session.width, session.height, CAPS, latency, per_sample,
-                      urllib.parse.quote(session.layer.name, safe=""), session.render_seconds[0][1]))
+                   "view_layer=%s guides_seconds=%.3f seeds=%s%s"
+                   % (session.width, session.height, CAPS + (",variance" if session.halves else ""), latency, per_sample,
+                      urllib.parse.quote(session.layer.name, safe=""), session.render_seconds[0][1],
+                      ",".join(str(s) for s in session.seeds),
+                      "" if session.noise_psnr is None else " noise_psnr=%.2f" % session.noise_psnr))
         serve(proto, session)
     except Exception as e:  # told to dcm, which stops with the message
         msg = " ".join(("%s: %s" % (type(e).__name__, e) if not isinstance(e, scene.SceneError)

@@ -11,6 +11,12 @@ the pixel's camera rays leave). With persistent data a mask changed in memory,
 or saved and reloaded under the same name, does not reach the next render; a
 new file per render does.
 
+With `--variance-halves` every exact pixel is rendered as two halves of its
+samples with different seeds (the file's and the next), which cost what one
+render costs but for a render call: the pixel is their mean, and (A - B)^2/4
+per pixel, the variance of that mean from this pixel alone, goes to dcm,
+which pools it over the exact pixels on the same surface (docs/NOISE.md).
+
 Every change to the scene (settings, nodes, materials) is recorded and undone
 by restore(), also after an error; the .blend on disk is never written."""
 import os
@@ -71,6 +77,24 @@ def _write_png(path, grey):
                 + chunk(b"IDAT", zlib.compress(rows.tobytes(), 1)) + chunk(b"IEND", b""))
 
 
+def _noise_psnr(var, L):
+    """The display-referred PSNR that noise of variance `var` [h, w, 3] (one pixel's
+    halves each, one degree of freedom) costs on the image L, as dcm's AOV noise
+    detection measures it (NoisePsnrFromData): the median over the pixels that are
+    not black of the variance relative to the squared value, over 0.455 (the median
+    of a chi-square of one degree of freedom), as a relative sd through
+    dcm::SrgbRelativeSlope (the slope of the sRGB encoding times L, at 1 above 1).
+    The median: a noisy value near 0 would make the slope, and a mean, explode."""
+    lit = L.sum(axis=-1) > 3e-3
+    if not lit.any():
+        return 99.0
+    rho2 = float(np.median(var.sum(axis=-1)[lit] / (L ** 2).sum(axis=-1)[lit])) / 0.455
+    x = np.clip(L, 0.0031308, 1.0)
+    rel = np.where(L <= 0.0031308, 12.92 * np.maximum(L, 0), 1.055 / 2.4 * np.power(x, 1 / 2.4))
+    mse = rho2 * float(np.mean(rel ** 2))
+    return 99.0 if not mse > 0 else -10 * np.log10(mse)
+
+
 def _log(msg):
     print("dcm-blender: " + msg, file=os.sys.stderr, flush=True)
 
@@ -85,6 +109,7 @@ class Session:
         self._guides = None   # planes of the guides/preview render
         self._mask_image = None
         self._round = 0
+        self.noise_psnr = None  # of the exact pixels' samples, from the preview's halves
         self.render_seconds = []
 
     # ------------------------------------------------------------- setup --
@@ -152,6 +177,10 @@ class Session:
             self.notes.append("denoising off (it would see a frame of black, unrendered pixels)")
             c.set(cy, "use_denoising", False)
         c.set(cy, "samples", self.samples)
+        # Two halves of the samples with two seeds: the second seed is the next one.
+        self.halves = a.variance_halves and self.samples >= 2
+        self.seeds = (cy.seed, (cy.seed + 1) % 2 ** 31) if self.halves else (cy.seed,)
+        c.restore_later(cy, ("seed",))
         if a.threads > 0:
             c.set(r, "threads_mode", "FIXED")
             c.set(r, "threads", a.threads)
@@ -328,12 +357,14 @@ class Session:
         return out
 
     # ----------------------------------------------------------- renders --
-    def _render(self, samples, label):
+    def _render(self, samples, label, seed=None):
         import time
         sc = self.scene
         self._round += 1
         path = sc.render.filepath
         sc.cycles.samples = samples
+        if seed is not None:
+            sc.cycles.seed = seed
         # A changed sample count alone does not reach a persistent Cycles session;
         # a change to the render settings (the same path) makes it look again.
         sc.render.filepath = path
@@ -360,19 +391,34 @@ class Session:
         return np.stack([planes[name + "." + c] for c in comps], axis=-1)
 
     def guides(self):
-        """The guides and the preview: one unmasked render at the preview's samples."""
+        """The guides and the preview: one unmasked render at the preview's samples;
+        with halves two, one per seed, whose difference gives noise_psnr."""
         if self._guides is None:
             self._write_mask(np.ones((self.height * self.args.mask_scale,
                                       self.width * self.args.mask_scale), np.float32))
-            pl = self._render(self.preview_samples, "guides")
+            ps = self.preview_samples
+            counts = [ps - ps // 2, ps // 2] if self.halves and ps >= 2 else [ps]
+            pls = [self._render(n, "guides", seed) for n, seed in zip(counts, self.seeds)]
+            if len(pls) == 2:  # one entry: round_cost() reads the guides render's time
+                self.render_seconds[-2:] = [("guides", self.render_seconds[-2][1] + self.render_seconds[-1][1])]
+                self.scene.cycles.seed = self.seeds[0]
+
+            def mean(name, comps="RGB"):
+                return sum(n * self._rgb(p, name, comps) for n, p in zip(counts, pls)) / float(ps)
+            pl = pls[0]
             g = {}
             g["object_id"] = pl["CryptoObject00.r"].view(np.uint32).copy()
             g["shader_id"] = pl["CryptoMaterial00.r"].view(np.uint32).copy()
-            g["texture"] = self._rgb(pl, "DiffCol")
+            g["texture"] = mean("DiffCol")
             g["normal"] = self._rgb(pl, "Normal", "XYZ")
-            g["L"] = self._rgb(pl, "Combined")
-            g["Li"] = self._rgb(pl, "DiffDir") + self._rgb(pl, "DiffInd")
+            g["L"] = mean("Combined")
+            g["Li"] = mean("DiffDir") + mean("DiffInd")
             g["Lc"] = g["L"] - g["Li"] * g["texture"]
+            if len(pls) == 2:
+                # The preview's variance (dcm::HalvesVariance), at the exact pixels' samples.
+                a, b = self._rgb(pls[0], "Combined"), self._rgb(pls[1], "Combined")
+                var = (a - b) ** 2 * (counts[0] * counts[1] / float(ps) ** 2) * (ps / float(self.samples))
+                self.noise_psnr = _noise_psnr(var, g["L"])
             self._guides = g
         return self._guides
 
@@ -403,11 +449,11 @@ class Session:
         if self.args.border_tile > 0:
             return self._runs(xs, ys, self.args.border_tile)
         masked = 0.14 * self.pixel_seconds()
-        best, best_cost = [None], self.args.call_seconds + self.width * self.height * masked
+        best, best_cost = [None], len(self.seeds) * self.args.call_seconds + self.width * self.height * masked
         for t in (16, 32, 64):
             rects = self._runs(xs, ys, t)
             area = sum((x1 - x0) * (y1 - y0) for x0, y0, x1, y1 in rects)
-            cost = len(rects) * self.args.call_seconds + area * masked
+            cost = len(rects) * len(self.seeds) * self.args.call_seconds + area * masked
             if len(rects) <= self.args.max_calls and cost < best_cost:
                 best, best_cost = rects, cost
         return best
@@ -425,37 +471,53 @@ class Session:
         r.border_min_y, r.border_max_y = 1 - y1 / self.height, 1 - y0 / self.height
 
     def evaluate(self, xs, ys):
-        """L, L_i, L_c [n, 3] of pixels (xs, ys) at full samples: one mask, and one
-        render call per rectangle of rectangles()."""
+        """L, L_i, L_c, var [n, 3] of pixels (xs, ys) at full samples: one mask, and one
+        render call per rectangle of rectangles(), two with halves (var: the variance
+        of L from the two halves at this pixel alone; None without halves)."""
         g = self.guides()
         if os.environ.get("DCM_BLENDER_TEST_FAULT") == "crash-on-eval":  # tests: Blender dies mid-round
             os.kill(os.getpid(), 9)
         texels = self.mask_of(xs, ys)
         self._write_mask(texels)
         reached = self.reached(texels)
-        L, Li = np.zeros((len(xs), 3), np.float32), np.zeros((len(xs), 3), np.float32)
+        # Samples per render: all of them, or two halves (the first takes the odd one).
+        counts = [self.samples] if not self.halves else [self.samples - self.samples // 2, self.samples // 2]
+        L = np.zeros((len(counts), len(xs), 3), np.float32)
+        Li = np.zeros((len(counts), len(xs), 3), np.float32)
         done = np.zeros(len(xs), bool)
         self._evals = getattr(self, "_evals", 0) + 1
         for rect in self.rectangles(xs, ys):
             self._set_border(rect)
-            pl = self._render(self.samples, "eval%d" % self._evals)
-            diffcol = self._rgb(pl, "DiffCol")
-            # The mask rendered must be the mask asked for: outside it no surface
-            # keeps its own shader (a stale mask would show diffuse colour there).
-            stray = (diffcol.max(axis=-1) > 0) & ~reached
-            if stray.any():
-                raise SceneError("%d pixels outside the mask were rendered: the mask of this round did not "
-                                 "reach Cycles" % int(stray.sum()))
             inside = np.ones(len(xs), bool) if rect is None else (
                 (xs >= rect[0]) & (xs < rect[2]) & (ys >= rect[1]) & (ys < rect[3]))
-            L[inside] = self._rgb(pl, "Combined")[ys[inside], xs[inside]]
-            Li[inside] = (self._rgb(pl, "DiffDir") + self._rgb(pl, "DiffInd"))[ys[inside], xs[inside]]
+            for h, (n, seed) in enumerate(zip(counts, self.seeds)):
+                pl = self._render(n, "eval%d" % self._evals, seed)
+                diffcol = self._rgb(pl, "DiffCol")
+                # The mask rendered must be the mask asked for: outside it no surface
+                # keeps its own shader (a stale mask would show diffuse colour there).
+                stray = (diffcol.max(axis=-1) > 0) & ~reached
+                if stray.any():
+                    raise SceneError("%d pixels outside the mask were rendered: the mask of this round did not "
+                                     "reach Cycles" % int(stray.sum()))
+                L[h, inside] = self._rgb(pl, "Combined")[ys[inside], xs[inside]]
+                Li[h, inside] = (self._rgb(pl, "DiffDir") + self._rgb(pl, "DiffInd"))[ys[inside], xs[inside]]
             done |= inside
         self._set_border(None)
+        self.scene.cycles.seed = self.seeds[0]
         if not done.all():
             raise SceneError("%d pixels fell outside every render border" % int((~done).sum()))
+        var = None
+        if self.halves:
+            # The mean weighted by samples; its variance (A - B)^2 nA nB / N^2 (dcm::HalvesVariance).
+            nA, nB = counts
+            N = float(self.samples)
+            var = ((L[0] - L[1]) ** 2 * (nA * nB / N ** 2)).astype(np.float32)
+            L = ((nA * L[0] + nB * L[1]) / N).astype(np.float32)
+            Li = ((nA * Li[0] + nB * Li[1]) / N).astype(np.float32)
+        else:
+            L, Li = L[0], Li[0]
         Lc = L - Li * g["texture"][ys, xs]
-        return L, Li, Lc
+        return L, Li, Lc, var
 
     def pixel_seconds(self):
         """What one pixel at full samples costs, from the guides render (its samples
@@ -470,7 +532,7 @@ class Session:
         seconds = self.render_seconds[0][1]
         full = seconds * self.samples / self.preview_samples
         pixels = self.width * self.height
-        return 0.1 + 0.14 * full, full / pixels
+        return 0.1 * len(self.seeds) + 0.14 * full, full / pixels
 
     def fingerprint(self):
         """What setup() may change, as text: restore() must bring it back."""
@@ -495,7 +557,7 @@ class Session:
                                                              "threads_mode", "threads")]
                                     + [r.image_settings.file_format, r.image_settings.color_depth,
                                        r.image_settings.exr_codec]))
-        lines.append("cycles %s" % [cy.samples, cy.use_adaptive_sampling, cy.use_denoising, sc.frame_current])
+        lines.append("cycles %s" % [cy.samples, cy.seed, cy.use_adaptive_sampling, cy.use_denoising, sc.frame_current])
         return "\n".join(lines)
 
     def restore(self):

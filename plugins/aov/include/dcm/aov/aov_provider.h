@@ -121,7 +121,17 @@ struct AovOptions {
   /// (an untextured pattern, hair, aliased geometry inside one object): that
   /// detail is taken for noise and smoothed over.
   bool estimateVariance = false;
+  /// Dense mode with the texture split (L_i, tau), and no variance channel,
+  /// second render or estimateVariance:
+  /// decide from the data whether the samples are noisy and, when they are,
+  /// estimate their variance as estimateVariance does. Noisy: the display-
+  /// referred PSNR their noise alone would cost, estimated from the median
+  /// relative residual against the same-surface 4-neighbours (robust to the
+  /// detail at few pixels that misleads a mean), is below dcm::kNoisyPsnr.
+  bool detectNoise = false;
 };
+
+
 
 /// The provider. Create with Open(); all data is loaded (and checked) there,
 /// so Guides() and Evaluate() only copy and are thread safe.
