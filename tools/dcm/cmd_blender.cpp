@@ -307,7 +307,10 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       keys.count("noise_psnr") ? std::atof(keys.at("noise_psnr").c_str()) : std::numeric_limits<double>::quiet_NaN();
   const bool useVariance = provider->Capabilities().variance &&
                            (f.variance == "on" || (f.variance == "auto" && noisePsnr < kNoisyPsnr));
-  PooledVarianceProvider pooled(*provider, options.ElementaryBlockFor(true), useVariance);
+  // The variance is pooled over the elementary block of the noisy regime.
+  ProviderCapabilities noisyCaps = provider->Capabilities();
+  noisyCaps.variance = true;
+  PooledVarianceProvider pooled(*provider, ResolveSettings(options, noisyCaps).elementaryBlock, useVariance);
   const ProviderCapabilities caps = pooled.Capabilities();
   RoundSchedule schedule = RoundSchedule::kLevels;
   if (Status st = ScheduleFor(f.rounds, provider->roundCost(), provider->hasPreview(), &schedule); !st.ok())
