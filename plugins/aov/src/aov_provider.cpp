@@ -681,6 +681,27 @@ bool SameSurface(const Data& d, size_t i, size_t j) {
          (d.shaderId.empty() || d.shaderId[i] == d.shaderId[j]);
 }
 
+/// The residual of pixel (x, y) of `v` against the mean of its finite
+/// 4-neighbours on the same surface, and how many there are; false with
+/// fewer than two.
+bool NeighbourResidual(const Data& d, const std::vector<RGB>& v, int x, int y, RGB* res, int* count) {
+  const int W = d.width(), H = d.height();
+  const size_t i = size_t(y) * size_t(W) + size_t(x);
+  RGB mean;
+  *count = 0;
+  for (auto [dx, dy] : {std::pair{-1, 0}, {1, 0}, {0, -1}, {0, 1}}) {
+    const int nx = x + dx, ny = y + dy;
+    if (nx < 0 || ny < 0 || nx >= W || ny >= H) continue;
+    const size_t j = size_t(ny) * size_t(W) + size_t(nx);
+    if (!SameSurface(d, i, j) || !IsFinite(v[j])) continue;
+    mean += v[j];
+    ++*count;
+  }
+  if (*count < 2) return false;
+  *res = v[i] - mean * (1.f / float(*count));
+  return true;
+}
+
 /// Per pixel, the mean of `v` over the (2r+1)^2 window of pixels on the same
 /// surface (equal object and shader IDs where the inputs carry them).
 std::vector<RGB> SurfaceWindowMean(const std::vector<RGB>& v, const Data& d, int r) {
@@ -698,19 +719,10 @@ std::vector<RGB> EstimateVarianceFromData(const Data& d) {
     for (int x = 0; x < W; ++x) {
       const size_t i = size_t(y) * size_t(W) + size_t(x);
       if (!IsFinite(v[i])) continue;
-      RGB mean;
+      RGB res;
       int count = 0;
-      for (auto [dx, dy] : {std::pair{-1, 0}, {1, 0}, {0, -1}, {0, 1}}) {
-        const int nx = x + dx, ny = y + dy;
-        if (nx < 0 || ny < 0 || nx >= W || ny >= H) continue;
-        const size_t j = size_t(ny) * size_t(W) + size_t(nx);
-        if (!SameSurface(d, i, j) || !IsFinite(v[j])) continue;
-        mean += v[j];
-        ++count;
-      }
-      if (count < 2) continue;
+      if (!NeighbourResidual(d, v, x, y, &res, &count)) continue;
       // r = v - mean of k neighbours has variance sigma^2 (1 + 1/k).
-      const RGB res = v[i] - mean * (1.f / float(count));
       r2[i] = res * res * (1.f / (1.f + 1.f / float(count)));
     }
   std::vector<RGB> var = SurfaceWindowMean(r2, d, 2);
@@ -742,18 +754,9 @@ double NoisePsnrFromData(const Data& d) {
       const float energy = v[i].r * v[i].r + v[i].g * v[i].g + v[i].b * v[i].b;
       // Black pixels say nothing about a relative noise (and divide by 0).
       if (!(v[i].r + v[i].g + v[i].b > 3e-3f)) continue;
-      RGB mean;
+      RGB res;
       int count = 0;
-      for (auto [dx, dy] : {std::pair{-1, 0}, {1, 0}, {0, -1}, {0, 1}}) {
-        const int nx = x + dx, ny = y + dy;
-        if (nx < 0 || ny < 0 || nx >= W || ny >= H) continue;
-        const size_t j = size_t(ny) * size_t(W) + size_t(nx);
-        if (!SameSurface(d, i, j) || !IsFinite(v[j])) continue;
-        mean += v[j];
-        ++count;
-      }
-      if (count < 2) continue;
-      const RGB res = v[i] - mean * (1.f / float(count));
+      if (!NeighbourResidual(d, v, x, y, &res, &count)) continue;
       rel.push_back((res.r * res.r + res.g * res.g + res.b * res.b) / (1.f + 1.f / float(count)) / energy);
     }
   if (rel.empty()) return std::numeric_limits<double>::infinity();
