@@ -53,6 +53,7 @@ adaptive_s=()
 for t in ${ADAPTIVE:-}; do
   t1=$(now); render "$spp" "adaptive_$t.exr" "$t"; t2=$(now)
   adaptive_s+=("$t:$(echo "$t2 - $t1" | bc -l)")
+  printf "adaptive %s: %.2f s\n" "$t" "$(echo "$t2 - $t1" | bc -l)" >> times.txt
 done
 # The reference with a seed of its own: with the file's, its first samples
 # would be the full render's and dcm's, and their errors against it smaller.

@@ -77,11 +77,35 @@ def main():
                 near_second[np.clip(rounds[1] // w + dy, 0, h - 1), np.clip(rounds[1] % w + dx, 0, w - 1)] = True
         assert not (second & first_only & ~near_second).any(), "round 2 rendered pixels of round 1"
         assert second.flat[rounds[1]][tau.reshape(-1, 3)[rounds[1]].max(1) > 0].all()
-
         prev = child.preview(0, 0, w, h)
         assert prev.shape == (w * h, 3) and np.isfinite(prev).all()
         assert child.quit() == 0, "the child did not exit cleanly (or the scene was not restored)"
         assert hashlib.sha256(open(blend, "rb").read()).hexdigest() == digest, "the .blend changed"
+
+        # A masked pixel stops after a few samples (adaptive sampling on its
+        # all-zero samples); a requested pixel takes every sample. At 64 spp:
+        # Cycles judges convergence every 16 samples.
+        keep64 = os.path.join(tmp, "renders64")
+        child = bs.Child(blender, src, blend, ["--keep-renders", keep64, "--border-tile", "8", "--samples", "64"])
+        child.guides()
+        child.eval(block % w, block // w)
+        assert child.quit() == 0
+        kept = np.load(glob.glob(os.path.join(keep64, "*_eval1.npz"))[0])
+        count = kept["Debug Sample Count.X"]
+        asked = np.zeros((h, w), bool)
+        asked.flat[block] = True
+        # Masked and stopping: inside the render border (count > 0), black, and 3 px
+        # or more from anything rendered. Rendered are the requested pixels, their
+        # neighbours that a Blackman-Harris pixel's rays reach, and the world,
+        # which is not masked; Cycles' convergence filter marks the neighbours of
+        # a pixel still sampling in x, then in y.
+        lit = kept["Combined.R"] != 0
+        far = (count > 0) & ~lit
+        for y, x in zip(*np.nonzero(lit)):
+            far[max(y - 2, 0):y + 3, max(x - 2, 0):x + 3] = False
+        assert (count[asked] == 1).all(), "requested pixels took fewer samples: %s" % count[asked]
+        assert far.any() and (count[far] <= 0.25).all(), \
+            "masked pixels took more than 16 of 64 samples: %s" % np.unique(count[far])
         print("ok")
         return 0
     finally:

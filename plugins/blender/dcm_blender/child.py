@@ -39,6 +39,9 @@ def parse_args(argv):
     ap.add_argument("--border-tile", type=int, default=0,
                     help="tests: render every round within borders over tiles of this size")
     ap.add_argument("--mask-scale", type=int, default=4, help="mask texels per pixel and side")
+    ap.add_argument("--masked-min-samples", type=int, default=0,
+                    help="samples after which a masked pixel may stop in a round of exact pixels "
+                         "(0: an eighth of the samples; the samples: never)")
     ap.add_argument("--workdir", default="",
                     help="scratch folder for masks and renders, made and removed by dcm (default: one of its own)")
     ap.add_argument("--verbose", action="store_true", help="the time of each render call on stderr")

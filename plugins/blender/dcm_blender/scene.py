@@ -166,6 +166,8 @@ class Session:
                      "use_pass_cryptomatte_material"):
             c.set(vl, attr, True)
         c.set(vl, "pass_cryptomatte_depth", 2)
+        if a.keep_renders:  # tests read how many samples each pixel took
+            c.set(vl.cycles, "pass_debug_sample_count", True)
 
         cy = sc.cycles
         self.samples = a.samples if a.samples > 0 else cy.samples
@@ -177,6 +179,8 @@ class Session:
             self.notes.append("denoising off (it would see a frame of black, unrendered pixels)")
             c.set(cy, "use_denoising", False)
         c.set(cy, "samples", self.samples)
+        # Rounds of exact pixels switch adaptive sampling on (masked_pixels_stop).
+        c.restore_later(cy, ("adaptive_threshold", "adaptive_min_samples"))
         # Two halves of the samples with two seeds: the second seed is the next one.
         self.halves = a.variance_halves and self.samples >= 2
         self.seeds = (cy.seed, (cy.seed + 1) % 2 ** 31) if self.halves else (cy.seed,)
@@ -442,13 +446,15 @@ class Session:
 
     def rectangles(self, xs, ys):
         """Where to render pixels (xs, ys): a list of (x0, y0, x1, y1), or [None] for
-        the whole frame. A masked pixel still costs Cycles a camera ray and a
-        shader per sample (about a seventh of a rendered one), a render call a
-        fixed time: of tiles of 16, 32 or 64 px that hold the pixels (each tile
-        row's runs one render border) and the whole frame, the cheapest."""
+        the whole frame. A masked pixel costs Cycles a camera ray and a shader per
+        sample (about a seventh of a rendered one) until it stops
+        (_masked_pixels_stop), a render call a fixed time: of tiles of 16, 32 or
+        64 px that hold the pixels (each tile row's runs one render border) and
+        the whole frame, the cheapest."""
         if self.args.border_tile > 0:
             return self._runs(xs, ys, self.args.border_tile)
-        masked = 0.14 * self.pixel_seconds()
+        n = self.samples // len(self.seeds)
+        masked = 0.14 * self.pixel_seconds() * self._masked_min_samples(n) / n
         best, best_cost = [None], len(self.seeds) * self.args.call_seconds + self.width * self.height * masked
         for t in (16, 32, 64):
             rects = self._runs(xs, ys, t)
@@ -457,6 +463,23 @@ class Session:
             if len(rects) <= self.args.max_calls and cost < best_cost:
                 best, best_cost = rects, cost
         return best
+
+    def _masked_min_samples(self, n):
+        """Samples after which a masked pixel of a render of n samples may stop."""
+        return max(4, min(n, self.args.masked_min_samples or n // 8))
+
+    def _masked_pixels_stop(self, n):
+        """Lets a masked pixel stop after a few of the n samples (n = 0: off). A
+        masked camera ray costs Cycles about a seventh of a rendered one per sample;
+        with adaptive sampling a pixel whose samples agree stops, and a masked
+        pixel's are all 0. The threshold is so low that a rendered pixel stops only
+        when its samples are all equal: the minimum, an eighth of them, makes that
+        unlikely where the pixel is not constant (docs/BLENDER.md, "Masked pixels")."""
+        cy = self.scene.cycles
+        cy.use_adaptive_sampling = n > 0
+        if n > 0:
+            cy.adaptive_threshold = 1e-8
+            cy.adaptive_min_samples = self._masked_min_samples(n)
 
     def _set_border(self, rect):
         r = self.scene.render
@@ -491,6 +514,7 @@ class Session:
             inside = np.ones(len(xs), bool) if rect is None else (
                 (xs >= rect[0]) & (xs < rect[2]) & (ys >= rect[1]) & (ys < rect[3]))
             for h, (n, seed) in enumerate(zip(counts, self.seeds)):
+                self._masked_pixels_stop(n)
                 pl = self._render(n, "eval%d" % self._evals, seed)
                 diffcol = self._rgb(pl, "DiffCol")
                 # The mask rendered must be the mask asked for: outside it no surface
@@ -503,6 +527,7 @@ class Session:
                 Li[h, inside] = (self._rgb(pl, "DiffDir") + self._rgb(pl, "DiffInd"))[ys[inside], xs[inside]]
             done |= inside
         self._set_border(None)
+        self._masked_pixels_stop(0)
         self.scene.cycles.seed = self.seeds[0]
         if not done.all():
             raise SceneError("%d pixels fell outside every render border" % int((~done).sum()))
