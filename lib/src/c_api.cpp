@@ -57,6 +57,7 @@ struct DCMReconstructorImpl {
   int previewWidth = 0, previewHeight = 0;
   std::vector<dcm::RGB> previewL, previewLi, previewLc;
   double targetPsnr = 0, budget = 0;  ///< "target_psnr", "budget" (0: none; dcm/quality_target.h)
+  bool targetRender = false;          ///< "target_render" (QualityGoal::targetRender)
 
   bool hasResult = false;
   dcm::Reconstruction result;
@@ -390,7 +391,8 @@ DCM_API void dcmSetFloat(DCMReconstructor r, const char* name, float value) {
 DCM_API void dcmSetBool(DCMReconstructor r, const char* name, int value) {
   if (!CheckArgs(r, name, "dcmSetBool")) return;
   Guard(r, "dcmSetBool", [&] {
-    if (bool* b = dcm::FindBoolOption(r->options, name)) *b = value != 0;
+    if (std::string_view(name) == "target_render") r->targetRender = value != 0;
+    else if (bool* b = dcm::FindBoolOption(r->options, name)) *b = value != 0;
     else SetError(r, DCM_ERROR_INVALID_ARGUMENT, UnknownOption("bool", name));
   });
 }
@@ -423,7 +425,8 @@ DCM_API int dcmGetBool(DCMReconstructor r, const char* name) {
   if (!CheckArgs(r, name, "dcmGetBool")) return 0;
   int result = 0;
   Guard(r, "dcmGetBool", [&] {
-    if (bool* b = dcm::FindBoolOption(r->options, name)) result = *b ? 1 : 0;
+    if (std::string_view(name) == "target_render") result = r->targetRender ? 1 : 0;
+    else if (bool* b = dcm::FindBoolOption(r->options, name)) result = *b ? 1 : 0;
     else SetError(r, DCM_ERROR_INVALID_ARGUMENT, UnknownOption("bool", name));
   });
   return result;
@@ -571,11 +574,12 @@ DCM_API DCMError dcmExecute(DCMReconstructor r) {
     r->schedule = {};
     r->quality.reset();
     dcm::Status st;
-    if (r->targetPsnr > 0 || r->budget > 0) {
+    if (r->targetPsnr > 0 || r->budget > 0 || r->targetRender) {
       // A quality goal runs the engine level by level (its runs share one sample cache).
       dcm::QualityGoal goal;
       goal.targetPsnr = r->targetPsnr;
       goal.budget = r->budget;
+      goal.targetRender = r->targetRender;
       dcm::QualityReport report;
       st = dcm::ReconstructToQuality(provider, options, goal, &r->result, &report);
       if (st.ok()) r->quality = std::move(report);
@@ -670,6 +674,10 @@ DCM_API double dcmGetStat(DCMReconstructor r, const char* name) {
     if (n == "estimated_psnr") return q.estimate.psnr;
     if (n == "estimated_psnr_low") return q.estimate.low;
     if (n == "estimated_psnr_high") return q.estimate.high;
+    if (n == "estimated_render_psnr") return q.renderEstimate.psnr;
+    if (n == "estimated_render_psnr_low") return q.renderEstimate.low;
+    if (n == "estimated_render_psnr_high") return q.renderEstimate.high;
+    if (n == "estimate_against_converged") return q.againstConverged ? 1.0 : 0.0;
     if (n == "validation_pixels") return double(q.validationPixels);
     if (n == "quality_runs") return double(q.runs);
     if (n == "target_reached") return q.targetReached ? 1.0 : 0.0;

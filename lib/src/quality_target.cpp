@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <mutex>
 #include <optional>
@@ -120,6 +121,8 @@ class CachingProvider : public SampleProvider {
       // Reserved before the (unlocked) evaluation: concurrent batches are
       // disjoint, so no pixel is counted twice.
       distinct_ += fresh;
+      if (marking_)
+        for (const Point2i& p : pixels) engine_[Index(p)] = 1;
     }
     std::vector<Point2i> ask(misses.size());
     for (size_t k = 0; k < misses.size(); ++k) ask[k] = pixels[misses[k]];
@@ -157,6 +160,17 @@ class CachingProvider : public SampleProvider {
     std::lock_guard<std::mutex> lock(mutex_);
     budgetHit_ = false;
   }
+  /// While on, every pixel asked is marked as the engine's (EngineAsked):
+  /// on during a run of the engine, off for the validation. Turning it on
+  /// clears the marks of the run before.
+  void MarkEngine(bool on) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (on) engine_.assign(index_.size(), 0);
+    marking_ = on;
+  }
+  /// The working pixel (row-major index) was asked by the current (or last)
+  /// run of the engine. Read between batches (the level callbacks).
+  bool EngineAsked(size_t i) const { return i < engine_.size() && engine_[i]; }
   /// The largest number of distinct pixels from now on (0: none).
   void SetLimit(int64_t limit) {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -176,6 +190,8 @@ class CachingProvider : public SampleProvider {
   std::vector<uint8_t> masks_;  ///< what each sample holds (Mask)
   int64_t distinct_ = 0;
   bool budgetHit_ = false;
+  bool marking_ = false;
+  std::vector<uint8_t> engine_;  ///< per working pixel: asked by the engine's run (MarkEngine)
   std::mutex guideMutex_;
   std::optional<GuideImage> guides_;
   GuideRequest guideRequest_;
@@ -186,6 +202,23 @@ struct Validation {
   std::vector<Point2i> pixels;  ///< output pixels
   std::vector<double> weights;  ///< output pixels each stands for
   std::vector<RGB> exact;       ///< box mean of the exact working samples
+  /// With samples that carry their variance: per output pixel, the variance
+  /// of each of its working samples divided by the box's pixel count squared
+  /// (its share in the variance of the box mean), from `first[k]` on.
+  std::vector<RGB> variance;
+  std::vector<size_t> first;
+
+  /// Adds pixel `k` of `from`.
+  void Append(const Validation& from, size_t k) {
+    pixels.push_back(from.pixels[k]);
+    weights.push_back(from.weights[k]);
+    exact.push_back(from.exact[k]);
+    if (from.variance.empty()) return;
+    if (first.empty()) first.push_back(0);
+    variance.insert(variance.end(), from.variance.begin() + std::ptrdiff_t(from.first[k]),
+                    from.variance.begin() + std::ptrdiff_t(from.first[k + 1]));
+    first.push_back(variance.size());
+  }
 };
 
 /// One output pixel drawn uniformly in each cell of a grid of about `count`
@@ -210,19 +243,107 @@ RGB Display(const QualityGoal& goal, RGB c) {
   return {SrgbEncode(c.r), SrgbEncode(c.g), SrgbEncode(c.b)};
 }
 
-/// The estimate of `image` (output resolution, `outW` wide) at the validation pixels.
-PsnrEstimate EstimateAt(const Validation& v, const QualityGoal& goal, const std::vector<RGB>& image, int outW) {
+/// Which working pixels (row-major index) the engine evaluated itself.
+using SampledFn = std::function<bool(size_t)>;
+
+/// The standard deviations of variances `var` (negative ones as 0).
+RGB StdDev(RGB var) {
+  return {std::sqrt(std::max(0.f, var.r)), std::sqrt(std::max(0.f, var.g)), std::sqrt(std::max(0.f, var.b))};
+}
+
+/// The display-space variance (mean over the display's channels) of a linear
+/// value x whose channels have variances `var`, by the first-order
+/// propagation through the display's Jacobian at x. The Jacobian's column of
+/// a channel is a central difference of half-width `step` (that channel's
+/// standard deviation of the box mean: a secant over the noise's own scale,
+/// so that the clipping and the curve at dark values are seen as the noise
+/// sees them). Channels are taken as uncorrelated; with a display that
+/// encodes each channel on its own (sRGB) their correlation does not enter.
+double DisplayVariance(const QualityGoal& goal, RGB x, RGB var, RGB step) {
+  double sum = 0;
+  for (int c = 0; c < 3; ++c) {
+    if (!(var[c] > 0) || !(step[c] > 0)) continue;
+    RGB up = x, down = x;
+    up[c] += step[c];
+    down[c] -= step[c];
+    const RGB du = Display(goal, up), dd = Display(goal, down);
+    for (int k = 0; k < 3; ++k) {
+      const double j = (double(du[k]) - double(dd[k])) / (2.0 * double(step[c]));
+      sum += j * j * double(var[c]);
+    }
+  }
+  return sum / 3.0;
+}
+
+/// The estimate of `image` (output resolution, `outW` wide) at the validation
+/// pixels.
+///
+/// Without variance: the mean squared display difference to the exact
+/// values, i.e. against the full render. With variance (v.variance filled),
+/// against the converged image: at a validation pixel whose working pixels
+/// split into those the engine evaluated itself (S, `sampled`) and those it
+/// interpolated (I), rec - x = sum over I of (rec_w - x_w) / n when the
+/// engine kept its samples, and the interpolated values do not depend on the
+/// noise of x_w (the engine never sees the validation's samples), so
+///   E[(rec - x)^2] = E[(rec - truth)^2] - V_S + V_I,
+/// V the display variance of the box mean's share of S or I. The estimate of
+/// the error against the converged image is then d - V_I + V_S. Where every
+/// working pixel is the engine's (all at 1x) rec is built from x itself: its
+/// error is V_S, the noise of the sample as if kept; where the engine
+/// denoised it the fit lowers that variance and d says nothing about how
+/// much (it is correlated with x), so V_S is the estimate, an upper one but
+/// for the fit's bias. In mixed boxes (supersampled) the interpolated pixels
+/// may use the box's own samples; that covariance is left out.
+PsnrEstimate EstimateAt(const Validation& v, const QualityGoal& goal, const std::vector<RGB>& image, int outW,
+                        const SampledFn& sampled, int workW, int s) {
+  const bool noise = !v.variance.empty();
   std::vector<double> d, w;
   d.reserve(v.pixels.size());
   w.reserve(v.pixels.size());
   for (size_t k = 0; k < v.pixels.size(); ++k) {
-    const RGB x = image[size_t(v.pixels[k].y) * size_t(outW) + size_t(v.pixels[k].x)], r = v.exact[k];
+    const RGB x = image[size_t(v.pixels[k].y) * size_t(outW) + size_t(v.pixels[k].x)], e = v.exact[k];
     // Left out where either is not finite, as the stats' PSNR does.
-    if (!IsFinite(x) || !IsFinite(r)) continue;
-    const RGB dx = Display(goal, x), dr = Display(goal, r);
+    if (!IsFinite(x) || !IsFinite(e)) continue;
+    const RGB dx = Display(goal, x), de = Display(goal, e);
     double sq = 0;
-    for (int c = 0; c < 3; ++c) sq += (double(dx[c]) - double(dr[c])) * (double(dx[c]) - double(dr[c]));
-    d.push_back(sq / 3.0);
+    for (int c = 0; c < 3; ++c) sq += (double(dx[c]) - double(de[c])) * (double(dx[c]) - double(de[c]));
+    sq /= 3.0;
+    if (noise) {
+      RGB varS, varI;
+      bool anyI = false;
+      const Point2i p = v.pixels[k];
+      size_t i = v.first[k];
+      for (int y = p.y * s; i < v.first[k + 1] && y < (p.y + 1) * s; ++y)
+        for (int xw = p.x * s; i < v.first[k + 1] && xw < (p.x + 1) * s; ++xw, ++i) {
+          if (sampled(size_t(y) * size_t(workW) + size_t(xw))) {
+            varS += v.variance[i];
+          } else {
+            varI += v.variance[i];
+            anyI = true;
+          }
+        }
+      if (!IsFinite(varS + varI)) continue;
+      const RGB step = StdDev(varS + varI);
+      const double vs = DisplayVariance(goal, e, varS, step);
+      sq = anyI ? sq - DisplayVariance(goal, e, varI, step) + vs : vs;
+    }
+    d.push_back(sq);
+    w.push_back(v.weights[k]);
+  }
+  return EstimatePsnr(d, w);
+}
+
+/// The full render's own estimate against the converged image: at each
+/// validation pixel, its exact value is the full render's, and its error is
+/// the display variance of the box mean. NaN without variance.
+PsnrEstimate RenderEstimate(const Validation& v, const QualityGoal& goal) {
+  if (v.variance.empty()) return {kNaN, kNaN, kNaN};
+  std::vector<double> d, w;
+  for (size_t k = 0; k < v.pixels.size(); ++k) {
+    RGB var;
+    for (size_t i = v.first[k]; i < v.first[k + 1]; ++i) var += v.variance[i];
+    if (!IsFinite(v.exact[k]) || !IsFinite(var)) continue;
+    d.push_back(DisplayVariance(goal, v.exact[k], var, StdDev(var)));
     w.push_back(v.weights[k]);
   }
   return EstimatePsnr(d, w);
@@ -245,10 +366,16 @@ Status EvaluateValidation(CachingProvider& cache, const ReconstructionOptions& o
   size_t k = 0;
   for (const Point2i& p : v->pixels) {
     RGB sum;
-    int n = 0;
+    const size_t from = k;
     for (int y = p.y * s; y < std::min(caps.height, (p.y + 1) * s); ++y)
-      for (int x = p.x * s; x < std::min(caps.width, (p.x + 1) * s); ++x, ++n) sum += samples[k++].L;
-    v->exact.push_back(sum * (1.f / float(n)));
+      for (int x = p.x * s; x < std::min(caps.width, (p.x + 1) * s); ++x) sum += samples[k++].L;
+    const float n = float(k - from);
+    v->exact.push_back(sum * (1.f / n));
+    if (what.variance) {
+      if (v->first.empty()) v->first.push_back(0);
+      for (size_t i = from; i < k; ++i) v->variance.push_back(samples[i].variance * (1.f / (n * n)));
+      v->first.push_back(v->variance.size());
+    }
   }
   return Status::Ok();
 }
@@ -268,7 +395,11 @@ Status QualityGoal::Validate() const {
     return Status::Error("--target-psnr: must be in (0, 99] dB, got " + Num(targetPsnr));
   if (!(budget >= 0) || budget > 1 || !std::isfinite(budget))
     return Status::Error("--budget: must be a share of the pixels in (0, 1], got " + Num(budget));
-  if (targetPsnr == 0 && budget == 0) return Status::Error("--target-psnr or --budget: neither is given");
+  if (targetRender && targetPsnr > 0)
+    return Status::Error("--target-psnr render: the target is the render's estimated PSNR, not also " + Num(targetPsnr) +
+                         " dB");
+  if (targetPsnr == 0 && !targetRender && budget == 0)
+    return Status::Error("--target-psnr or --budget: neither is given");
   if (!(validationFraction > 0) || validationFraction > 1)
     return Status::Error("validationFraction: must be in (0, 1]");
   if (minValidationPixels < 2) return Status::Error("minValidationPixels: must be at least 2");
@@ -313,13 +444,17 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   const int outW = (caps.width + s - 1) / s, outH = (caps.height + s - 1) / s;
   const int64_t limit = goal.budget > 0 ? std::max<int64_t>(1, int64_t(std::floor(goal.budget * double(total)))) : 0;
   CachingProvider cache(provider, limit);
+  if (goal.targetRender && !caps.variance)
+    return Status::Error("--target-psnr render: the samples carry no variance (" + caps.name +
+                         "), so the full render's own error is not known; give a target in dB");
+  const bool hasTarget = goal.targetPsnr > 0 || goal.targetRender;
 
   // The validation: a share of the output pixels, at most a quarter of the budget.
   const int64_t outPixels = int64_t(outW) * int64_t(outH);
   int64_t count = std::max<int64_t>(goal.minValidationPixels, int64_t(std::ceil(goal.validationFraction * double(outPixels))));
   // Without a target the estimate is only reported: a twentieth of the budget.
   if (limit > 0)
-    count = std::min(count, std::max<int64_t>(2, limit / (goal.targetPsnr > 0 ? 4 : 20) / (int64_t(s) * s)));
+    count = std::min(count, std::max<int64_t>(2, limit / (hasTarget ? 4 : 20) / (int64_t(s) * s)));
   count = std::min(count, outPixels);
   const bool split = caps.splitRadiance && options.textureSplit;
   const SampleRequest what{split, caps.variance};
@@ -342,9 +477,7 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
         ++report->validationPixels;
         mark = 1;
       }
-      into->pixels.push_back(p);
-      into->weights.push_back(more.weights[k]);
-      into->exact.push_back(more.exact[k]);
+      into->Append(more, k);
     }
     return Status::Ok();
   };
@@ -354,6 +487,24 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
     return st;
   }
   report->totalPixels = total;
+  report->againstConverged = caps.variance;
+  // The engine's own pixels of a finished run, and of the run under way (its levels).
+  const int workW = caps.width;
+  auto sampledBy = [](const Reconstruction& rec) -> SampledFn {
+    return [&rec](size_t i) {
+      return rec.sampleMap[i] != SampleReason::kInterpolated && rec.sampleMap[i] != SampleReason::kPreviewStandIn;
+    };
+  };
+  const SampledFn asked = [&cache](size_t i) { return cache.EngineAsked(i); };
+  // The target: given, or the full render's own PSNR against the converged image.
+  double target = goal.targetPsnr;
+  if (goal.targetRender) {
+    const PsnrEstimate render = RenderEstimate(v, goal);
+    target = std::min(99.0, render.psnr);
+    if (!(target > 0))
+      return Status::Error("--target-psnr render: the render's estimated PSNR is " + Num(render.psnr) + " dB");
+  }
+  report->targetPsnr = target;
 
   // What every run cost, refused ones included.
   ReconstructionStats spent;
@@ -368,13 +519,15 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
       o.onLevel = [&](int level, int w, int h, const std::vector<RGB>& work) {
         int ow = 0, oh = 0;
         const std::vector<RGB> image = BoxDownsample(work, w, h, s, &ow, &oh);
-        r.levels.push_back({level, EstimateAt(v, goal, image, ow)});
+        r.levels.push_back({level, EstimateAt(v, goal, image, ow, asked, workW, s)});
         options.onLevel(level, w, h, work);
       };
     }
     ++report->runs;
     cache.ClearBudgetHit();
+    cache.MarkEngine(true);
     const Status st = Reconstruct(cache, o, &r.rec, pending);
+    cache.MarkEngine(false);
     spent.timeGuidesS += r.rec.stats.timeGuidesS;
     spent.timeProviderS += r.rec.stats.timeProviderS;
     spent.timeEngineS += r.rec.stats.timeEngineS;
@@ -386,7 +539,7 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
       }
       return st;
     }
-    r.estimate = EstimateAt(v, goal, r.rec.image, r.rec.width);
+    r.estimate = EstimateAt(v, goal, r.rec.image, r.rec.width, sampledBy(r.rec), workW, s);
     *result = std::move(r);
     return Status::Ok();
   };
@@ -394,7 +547,7 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   const double threshold = double(ResolveSettings(options, caps).contrastThreshold);
   // Contrasts are at most 1 but for the display-weighted metric's brightest sets.
   const double t0 = limit > 0 ? std::min(kStartFactorBudget * threshold, 1.0) : kStartFactor * threshold;
-  auto meets = [&](const Run& r) { return goal.targetPsnr > 0 && r.estimate.low >= goal.targetPsnr; };
+  auto meets = [&](const Run& r) { return target > 0 && r.estimate.low >= target; };
 
   std::optional<Run> best, tried;
   std::vector<double> lows, spends;  // per run of the descent: the lower bound, the pixels spent
@@ -417,13 +570,13 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
     // The point estimate reaches the target but its bound does not: the
     // validation is too small for how the error is spread (a few pixels
     // carry most of it). More draws before more samples of the image.
-    while (goal.targetPsnr > 0 && !meets(*best) && best->estimate.psnr >= goal.targetPsnr && draws < kMaxSearchDraws) {
+    while (target > 0 && !meets(*best) && best->estimate.psnr >= target && draws < kMaxSearchDraws) {
       cache.ClearBudgetHit();
       if (Status st = drawMore(&v); !st.ok()) {
         if (cache.BudgetHit()) break;
         return st;
       }
-      best->estimate = EstimateAt(v, goal, best->rec.image, best->rec.width);
+      best->estimate = EstimateAt(v, goal, best->rec.image, best->rec.width, sampledBy(best->rec), workW, s);
     }
     const double low = best->estimate.low;
     if (meets(*best) || t < 0) break;
@@ -434,7 +587,7 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
     lows.push_back(low);
     spends.push_back(double(cache.Distinct()));
     const size_t n = lows.size();
-    if (goal.targetPsnr > 0 && n >= 3 && std::isfinite(lows[n - 3]) && lows[n - 1] - lows[n - 3] < kPlateauDb &&
+    if (target > 0 && n >= 3 && std::isfinite(lows[n - 3]) && lows[n - 1] - lows[n - 3] < kPlateauDb &&
         spends[n - 1] > kPlateauGrowth * spends[n - 3])
       break;
     if (t <= kMinThreshold) {
@@ -445,12 +598,12 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
     // Secants in log threshold: of the lower bound, the step that reaches the
     // target; of the log exact pixels, the step that fills the budget. The
     // smaller step of the two.
-    double toTarget = goal.targetPsnr > 0 ? kDefaultStep : 0, toBudget = limit > 0 ? kDefaultStep : 0;
+    double toTarget = target > 0 ? kDefaultStep : 0, toBudget = limit > 0 ? kDefaultStep : 0;
     const double used = double(cache.Distinct());
     if (lastT > 0) {
       const double dlogT = std::log(t) - std::log(lastT);
       if (toTarget > 0 && std::isfinite(low) && std::isfinite(lastLow) && low > lastLow)
-        toTarget = std::exp((goal.targetPsnr - low) * dlogT / (low - lastLow));
+        toTarget = std::exp((target - low) * dlogT / (low - lastLow));
       if (toBudget > 0 && used > lastUsed)
         toBudget = std::exp((std::log(double(limit)) - std::log(used)) * dlogT / (std::log(used) - std::log(lastUsed)));
     }
@@ -495,20 +648,23 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   // The search stopped where its validation pixels looked good enough: on
   // them the result errs high (the more runs, the more; 10 dB on the tracer's
   // room). A fresh draw, which chose nothing, estimates the result.
-  if (goal.targetPsnr > 0 && best->threshold >= 0) {
-    Validation fresh;
+  Validation fresh;
+  if (target > 0 && best->threshold >= 0) {
     cache.ClearBudgetHit();
     if (Status st = drawMore(&fresh); st.ok()) {
-      best->estimate = EstimateAt(fresh, goal, best->rec.image, best->rec.width);
+      best->estimate = EstimateAt(fresh, goal, best->rec.image, best->rec.width, sampledBy(best->rec), workW, s);
       report->confirmed = true;
     } else if (!cache.BudgetHit()) {
       return st;
     }
   }
+  // The render's own error does not depend on the search: every draw counts.
+  for (size_t k = 0; k < fresh.pixels.size(); ++k) v.Append(fresh, k);
+  report->renderEstimate = RenderEstimate(v, goal);
   report->estimate = best->estimate;
   report->levels = std::move(best->levels);
   report->threshold = best->threshold;
-  report->targetReached = goal.targetPsnr <= 0 || meets(*best);
+  report->targetReached = target <= 0 || meets(*best);
   report->exactPixels = cache.Distinct();
   *out = std::move(best->rec);
   // The cost of the whole search: every pixel evaluated, every run's time.

@@ -558,6 +558,7 @@ TEST(DcmReconstruct, TargetAndBudgetFlagsAreChecked) {
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
       {{"--target-psnr", "0"}, "--target-psnr"},
       {{"--target-psnr", "120"}, "--target-psnr"},
+      {{"--target-psnr", "rendered"}, "--target-psnr"},
       {{"--budget", "0"}, "--budget"},
       {{"--budget", "1.5"}, "--budget"},
       {{"--target-psnr", "40", "--threshold", "0.1"}, "--target-psnr: not with --threshold"},
@@ -572,6 +573,12 @@ TEST(DcmReconstruct, TargetAndBudgetFlagsAreChecked) {
     EXPECT_THAT(r.err, HasSubstr(message));
     EXPECT_FALSE(fs::exists(dir / "out.exr"));
   }
+  // --target-psnr render: the input carries no variance, so the render's own
+  // error is unknown; an error (exit 1) naming the flag, nothing written.
+  const auto r = RunDcm({"reconstruct", dir / "in.exr", "-o", dir / "out.exr", "--quiet", "--target-psnr", "render"}, dir);
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("--target-psnr render"));
+  EXPECT_FALSE(fs::exists(dir / "out.exr"));
 }
 
 // A farm's round trip: each tile plans and renders its own part (its window,

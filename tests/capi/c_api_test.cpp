@@ -322,6 +322,15 @@ TEST(CApi, TargetAndBudgetReportTheEstimateAndStayWithinTheBudget) {
   // Every pixel evaluated (validation included) is counted once, within the budget.
   EXPECT_EQ(double(scene.evaluated.load()), dcmGetStat(r, "exact_pixels"));
   EXPECT_LE(dcmGetStat(r, "exact_fraction"), 0.4);
+  // The callback reports no variance: the estimate is against the full render.
+  EXPECT_EQ(dcmGetStat(r, "estimate_against_converged"), 0.0);
+  EXPECT_TRUE(std::isnan(dcmGetStat(r, "estimated_render_psnr")));
+  // A target of the render's own PSNR needs variance, and not also a target in dB.
+  dcmSetBool(r, "target_render", 1);
+  EXPECT_EQ(dcmGetBool(r, "target_render"), 1);
+  EXPECT_NE(dcmExecute(r), DCM_ERROR_NONE);
+  EXPECT_NE(TakeError(r).find("--target-psnr render"), std::string::npos);
+  dcmSetBool(r, "target_render", 0);
   dcmSetFloat(r, "target_psnr", 120.f);
   EXPECT_NE(TakeError(r).find("target_psnr"), std::string::npos);
   dcmSetFloat(r, "budget", -0.5f);

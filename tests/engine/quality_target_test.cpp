@@ -8,6 +8,7 @@
 
 #include "dcm/downsample.h"
 #include "dcm/quality_target.h"
+#include "noisy_provider.h"
 #include "run_helpers.h"
 
 namespace dcm::testing {
@@ -139,6 +140,119 @@ TEST(QualityTarget, ProgressiveLevelsCarryAnEstimate) {
   // validation pixels, more exact samples).
   for (size_t k = 1; k < r.report.levels.size(); ++k)
     EXPECT_GE(r.report.levels[k].estimate.psnr, r.report.levels[k - 1].estimate.psnr - 0.5) << "level " << k;
+}
+
+/// A noisy run: the result's PSNR against the noise-free image and the noisy
+/// full render's, beside what the report estimates.
+struct NoisyOutcome {
+  QualityReport report;
+  double truePsnr = 0;        ///< the result against the converged (noise-free) image
+  double trueRenderPsnr = 0;  ///< the noisy full render against it
+};
+
+NoisyOutcome RunNoisy(NoiseModel noise, const ReconstructionOptions& o, QualityGoal goal, int n = 256) {
+  AnalyticProvider exact(n, n, FurnishedScene(n, n));
+  NoisyProvider noisy(exact, noise);
+  NoisyOutcome r;
+  Reconstruction rec;
+  const Status st = ReconstructToQuality(noisy, o, goal, &rec, &r.report);
+  EXPECT_TRUE(st.ok()) << st.message();
+  int w = 0, h = 0;
+  const std::vector<RGB> truth = BoxDownsample(exact.FullRender(), n, n, o.downsample, &w, &h);
+  r.truePsnr = DisplayPsnr(rec.image, truth);
+  r.trueRenderPsnr = DisplayPsnr(BoxDownsample(noisy.NoisyFullRender(), n, n, o.downsample, &w, &h), truth);
+  const PsnrEstimate &e = r.report.estimate, &m = r.report.renderEstimate;
+  std::printf("noise %.3f+%.3f seed %u: estimate %.2f [%.2f, %.2f] true %.2f; render %.2f [%.2f, %.2f] true %.2f; "
+              "target %.2f, exact %.2f %%\n",
+              noise.relative, noise.absolute, noise.seed, e.psnr, e.low, e.high, r.truePsnr, m.psnr, m.low, m.high,
+              r.trueRenderPsnr, r.report.targetPsnr, 100 * r.report.exactFraction());
+  return r;
+}
+
+bool Within(double truth, const PsnrEstimate& e) { return truth >= e.low && truth <= e.high; }
+
+TEST(QualityTarget, NoisyEstimateIsAgainstTheConvergedImage) {
+  // Gaussian noise of a known, reported variance; a budget only, so that no
+  // choice of the search depends on the validation pixels and each stated
+  // 90 % interval covers its truth with probability about 0.9. Of 10
+  // independent noise and validation seeds, at least 7 must cover it: with
+  // a coverage of 0.9 fewer happen with probability 1.3 % (binomial).
+  for (int downsample : {1, 2}) {
+    int estimateCovered = 0, renderCovered = 0;
+    for (uint32_t seed = 1; seed <= 10; ++seed) {
+      ReconstructionOptions o;
+      o.downsample = downsample;
+      QualityGoal goal;
+      goal.budget = 0.15;
+      goal.seed = 1000 + seed;
+      const NoisyOutcome r = RunNoisy({0.05f, 0.002f, seed}, o, goal);
+      EXPECT_TRUE(r.report.againstConverged);
+      estimateCovered += Within(r.truePsnr, r.report.estimate);
+      renderCovered += Within(r.trueRenderPsnr, r.report.renderEstimate);
+    }
+    EXPECT_GE(estimateCovered, 7) << "downsample " << downsample;
+    EXPECT_GE(renderCovered, 7) << "downsample " << downsample;
+  }
+}
+
+TEST(QualityTarget, WithoutVarianceTheEstimateIsAgainstTheFullRender) {
+  // The same noisy samples without their variance: the estimate keeps its
+  // meaning, the PSNR against the noisy full render, and reports no render
+  // estimate (the same 7 of 10 as above).
+  int covered = 0;
+  for (uint32_t seed = 1; seed <= 10; ++seed) {
+    const int n = 256;
+    AnalyticProvider exact(n, n, FurnishedScene(n, n));
+    NoisyProvider noisy(exact, {0.05f, 0.002f, seed, /*reportVariance=*/false});
+    QualityGoal goal;
+    goal.budget = 0.15;
+    goal.seed = 1000 + seed;
+    Reconstruction rec;
+    QualityReport report;
+    ASSERT_TRUE(ReconstructToQuality(noisy, ReconstructionOptions{}, goal, &rec, &report).ok());
+    EXPECT_FALSE(report.againstConverged);
+    EXPECT_TRUE(std::isnan(report.renderEstimate.psnr));
+    covered += Within(DisplayPsnr(rec.image, noisy.NoisyFullRender()), report.estimate);
+  }
+  EXPECT_GE(covered, 7);
+}
+
+TEST(QualityTarget, TargetRenderIsAtLeastAsCloseAsTheFullRender) {
+  // --target-psnr render: the target is the render's estimated PSNR against
+  // the converged image. The result reaches it within the 0.5 dB of
+  // the truth, at an exact fraction below the whole image.
+  for (float relative : {0.05f, 0.15f}) {
+    QualityGoal goal;
+    goal.targetRender = true;
+    const NoisyOutcome r = RunNoisy({relative, 0.002f, 7}, ReconstructionOptions{}, goal);
+    EXPECT_TRUE(r.report.targetReached);
+    // The target is the first draw's render estimate: within the render's
+    // interval of the truth, widened by 0.5 dB for that draw's own spread.
+    EXPECT_GE(r.report.targetPsnr, r.report.renderEstimate.low - 0.5);
+    EXPECT_LE(r.report.targetPsnr, r.report.renderEstimate.high + 0.5);
+    EXPECT_GE(r.truePsnr, r.trueRenderPsnr - 0.5);
+    EXPECT_LT(r.report.exactFraction(), 1.0);
+  }
+}
+
+TEST(QualityTarget, TargetRenderNeedsVarianceAndNoOtherTarget) {
+  AnalyticProvider plain(64, 64, FurnishedScene(64, 64));
+  Reconstruction rec;
+  QualityReport report;
+  QualityGoal goal;
+  goal.targetRender = true;
+  Status st = ReconstructToQuality(plain, ReconstructionOptions{}, goal, &rec, &report);
+  EXPECT_FALSE(st.ok());
+  EXPECT_NE(st.message().find("--target-psnr render"), std::string::npos) << st.message();
+  EXPECT_NE(st.message().find("variance"), std::string::npos) << st.message();
+  EXPECT_EQ(plain.TotalEvaluations(), 0);
+  goal.targetPsnr = 40;
+  st = goal.Validate();
+  EXPECT_FALSE(st.ok());
+  EXPECT_NE(st.message().find("--target-psnr render"), std::string::npos) << st.message();
+  goal.targetPsnr = 0;
+  goal.budget = 0.2;  // with a budget: whichever binds first
+  EXPECT_TRUE(goal.Validate().ok());
 }
 
 TEST(QualityTarget, BadGoalsNameTheFlag) {

@@ -150,10 +150,17 @@ void AddQualityJson(const QualityReport& r, double targetPsnr, double budget, nl
   (*j)["estimated_psnr_low"] = r.estimate.low;
   (*j)["estimated_psnr_high"] = r.estimate.high;
   (*j)["estimated_psnr_confidence"] = r.confidence;
+  if (r.againstConverged) {
+    // Noisy samples of known variance: the estimate is against the converged image.
+    (*j)["estimated_psnr_against"] = "converged";
+    (*j)["estimated_render_psnr"] = r.renderEstimate.psnr;
+    (*j)["estimated_render_psnr_low"] = r.renderEstimate.low;
+    (*j)["estimated_render_psnr_high"] = r.renderEstimate.high;
+  }
   nlohmann::json levels = nlohmann::json::array();
   for (const LevelEstimate& l : r.levels)
     levels.push_back({{"level", l.level}, {"psnr", l.estimate.psnr}, {"low", l.estimate.low}, {"high", l.estimate.high}});
-  (*j)["quality"] = {{"target_psnr", orNull(targetPsnr)},
+  (*j)["quality"] = {{"target_psnr", orNull(targetPsnr < 0 ? r.targetPsnr : targetPsnr)},
                      {"budget", orNull(budget)},
                      {"target_reached", r.targetReached},
                      {"confirmed", r.confirmed},
@@ -165,12 +172,14 @@ void AddQualityJson(const QualityReport& r, double targetPsnr, double budget, nl
                      {"runs", r.runs},
                      {"threshold", r.threshold < 0 ? nlohmann::json(nullptr) : nlohmann::json(r.threshold)},
                      {"levels", levels}};
+  if (targetPsnr < 0) (*j)["quality"]["target_render"] = true;
 }
 
 void AddQualityMetadata(const QualityReport& r, Metadata* m) {
   for (const auto& [name, v] : {std::pair<const char*, double>{"dcm:estimated_psnr", r.estimate.psnr},
                                 {"dcm:estimated_psnr_low", r.estimate.low},
-                                {"dcm:estimated_psnr_high", r.estimate.high}})
+                                {"dcm:estimated_psnr_high", r.estimate.high},
+                                {"dcm:estimated_render_psnr", r.renderEstimate.psnr}})
     if (std::isfinite(v)) m->floats.push_back({name, float(v)});
 }
 

@@ -40,11 +40,17 @@ nlohmann::json RunToJson(const Reconstruction& r, const std::string& method, con
 /// estimated_psnr_confidence) and quality {target_psnr, budget, target_reached,
 /// confirmed, budget_bound, exact_pixels, exact_fraction, validation_pixels,
 /// validation_exact_pixels, runs, threshold, levels [{level, psnr, low, high}]};
-/// a target or budget of 0 is null (not asked).
+/// a target or budget of 0 is null (not asked). A negative targetPsnr is
+/// --target-psnr render: target_psnr is then the render's estimate aimed at,
+/// and quality.target_render true. With samples of known variance
+/// (QualityReport::againstConverged) also estimated_psnr_against "converged"
+/// and estimated_render_psnr, _low, _high (the full render's own PSNR
+/// against the converged image).
 void AddQualityJson(const QualityReport& report, double targetPsnr, double budget, nlohmann::json* j);
 
-/// Adds dcm:estimated_psnr, dcm:estimated_psnr_low and dcm:estimated_psnr_high
-/// (finite values only) to EXR metadata.
+/// Adds dcm:estimated_psnr, dcm:estimated_psnr_low, dcm:estimated_psnr_high
+/// and, with samples of known variance, dcm:estimated_render_psnr (finite
+/// values only) to EXR metadata.
 void AddQualityMetadata(const QualityReport& report, Metadata* metadata);
 
 /// The warnings a run's samples deserve, one sentence each: NaN/Inf samples

@@ -13,12 +13,17 @@
 
 namespace dcm::cli {
 
+/// --target-psnr render: the full render's own estimated PSNR against the
+/// converged image (QualityGoal::targetRender), kept in EngineFlags::targetPsnr.
+inline constexpr double kTargetRender = -1;
+
 /// Flag values as parsed; turned into ReconstructionOptions by ToOptions().
 /// An empty optional: the flag was not given, the method's default applies.
 struct EngineFlags {
   std::string method = "dcm";  ///< dcm | paper | guo
   std::optional<float> threshold, noiseSignificance, creaseAngle, probeLcShare;
-  std::optional<double> targetPsnr, budget;  ///< --target-psnr, --budget (dcm/quality_target.h)
+  /// --target-psnr (kTargetRender: `render`), --budget (dcm/quality_target.h)
+  std::optional<double> targetPsnr, budget;
   std::optional<int> block, minBlock, directions, tile;
   std::optional<int> neighbourDirections, fallbackShadingChanges, crossingFill, simpleSurfaceChanges;
   int downsample = 1;

@@ -196,7 +196,10 @@ DCM_API void dcmSetInt(DCMReconstructor r, const char* name, int value);
  *  numbers here too. */
 DCM_API void dcmSetFloat(DCMReconstructor r, const char* name, float value);
 
-/** Sets a bool option: "surface_aware", "texture_split", "adaptive_borders",
+/** Sets a bool option: "target_render" (a quality goal: at least as close to
+ *  the converged image as the full render, whose PSNR against it is
+ *  estimated from the samples' variance; needs a provider that reports
+ *  variance, not with "target_psnr"; docs/QUALITY.md), "surface_aware", "texture_split", "adaptive_borders",
  *  "zero_order_test", "gradient_blocks_simple", "first_order_test",
  *  "first_order_from_guides",
  *  "lazy_evaluation", "fallback", "fallback_filled_borders",
@@ -300,8 +303,12 @@ DCM_API const uint8_t* dcmGetSampleMap(DCMReconstructor r, int* width, int* heig
  *  (since API version 3); with "target_psnr" or "budget" set also
  *  "estimated_psnr", "estimated_psnr_low", "estimated_psnr_high" (the 90 %
  *  interval), "validation_pixels", "quality_runs", "target_reached" and
- *  "budget_bound" (0/1), and "exact_pixels" counts every pixel evaluated
- *  over the runs.
+ *  "budget_bound" (0/1), "estimate_against_converged" (1: the provider
+ *  reports variance, and the estimate is against the converged image),
+ *  "estimated_render_psnr", "estimated_render_psnr_low",
+ *  "estimated_render_psnr_high" (the full render's own PSNR against the
+ *  converged image; NaN without variance), and "exact_pixels" counts every
+ *  pixel evaluated over the runs.
  *  0 and an error for an unknown name or before a result. */
 DCM_API double dcmGetStat(DCMReconstructor r, const char* name);
 

@@ -1,6 +1,8 @@
 // Quality asked for instead of a threshold: a PSNR to reach (--target-psnr)
 // or a share of exact pixels not to exceed (--budget), with an estimate of
-// the PSNR the result has against the full render and its uncertainty.
+// the PSNR the result has against the full render and its uncertainty. With
+// noisy samples of known variance, the estimate is against the converged
+// (noise-free) image, and the full render's own PSNR is estimated beside it.
 //
 // The estimate comes from validation pixels drawn at random (stratified,
 // seeded) and evaluated exactly; they count in the exact pixels. The knob is
@@ -22,9 +24,16 @@ namespace dcm {
 
 /// What to deliver: a target, a budget, or both (whichever binds first).
 struct QualityGoal {
-  /// dB of display-referred PSNR against the full render, checked against
+  /// dB of display-referred PSNR against the full render (against the
+  /// converged image when the samples carry their variance), checked against
   /// the estimate's lower bound; 0: no target.
   double targetPsnr = 0;
+  /// The target is the full render's own PSNR against the converged image,
+  /// as estimated at the first validation draw (at most 99 dB): a result at
+  /// least as close to the converged image as the noisy full render
+  /// (--target-psnr render). Needs samples that carry their variance; not
+  /// with targetPsnr.
+  bool targetRender = false;
   /// Largest share of working pixels evaluated exactly, validation pixels and
   /// every run's samples included; 0: no budget (1: the whole image).
   double budget = 0;
@@ -62,7 +71,19 @@ struct LevelEstimate {
 struct QualityReport {
   /// Of the result: with a target, from a last draw of validation pixels that
   /// took no part in the search (`confirmed`); else from the search's.
+  /// Against the converged image where `againstConverged`, else against the
+  /// full render (at the samples the provider gives).
   PsnrEstimate estimate;
+  /// The samples carry their variance: `estimate` is against the converged
+  /// image (the noise of the exact values taken out) and `renderEstimate` is
+  /// filled (docs/QUALITY.md, "Noise").
+  bool againstConverged = false;
+  /// The full render's own PSNR against the converged image, from the
+  /// variance of the samples at every validation pixel; NaN without variance.
+  PsnrEstimate renderEstimate;
+  /// The target the search aimed at: goal.targetPsnr, or with
+  /// goal.targetRender the render's estimate it was set to (0: none).
+  double targetPsnr = 0;
   /// The estimate comes from the last, independent draw (a target was given
   /// and the budget left room for it).
   bool confirmed = false;
@@ -101,7 +122,9 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
                             Reconstruction* out, QualityReport* report, std::vector<Point2i>* pending = nullptr);
 
 /// The estimate from per-pixel mean squared display errors `d` with weights
-/// `w` (the share of the image each stands for): exposed for tests.
+/// `w` (the share of the image each stands for): exposed for tests. A `d`
+/// may be negative (an unbiased estimate of an error from which a noise
+/// variance was subtracted); a mean at or below 0 gives +inf.
 PsnrEstimate EstimatePsnr(const std::vector<double>& d, const std::vector<double>& w);
 
 }  // namespace dcm
