@@ -11,7 +11,7 @@
 #  - glossy:  a large floor of procedural tiles under a clear coat, a monkey,
 #             a gold torus, a glass ball and a striped block; an area light
 #             and a dim environment.
-#  - spines:  a potted cactus with about a thousand thin spines and a tuft of
+#  - spines:  a potted cactus with about 400 thin spines and a tuft of
 #             grass blades; an area light and a small point light (hard,
 #             thin shadows).
 #  - mirror:  a mirror ball and a standing mirror in a room of checker,
