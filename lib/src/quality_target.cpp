@@ -24,10 +24,10 @@ constexpr double kZ = 1.6448536269514722;
 /// The first run's threshold is this many times the options' threshold; the
 /// runs go down from it, so that each one's samples are mostly reused by the
 /// next (a lower threshold refines a superset of the blocks). Not above the
-/// default: coarser runs miss small features (a highlight, a ball's shadow)
-/// that few validation pixels see, and the estimate then errs high by 5 to
-/// 8 dB (docs/QUALITY.md); the default threshold catches them on the scenes
-/// it was tuned on.
+/// default: a coarser run misses small features (a highlight, a ball's
+/// shadow) that no draw of a few percent sees reliably; from twice the
+/// default, the traced test scene stopped at 39.2 dB for a target of 40
+/// (docs/QUALITY.md).
 constexpr double kStartFactor = 1.0;
 /// With a budget, from higher still: a run the budget refuses leaves its
 /// samples spent, and the coarsest run's samples are the ones every later run
@@ -49,6 +49,8 @@ constexpr double kPlateauDb = 0.5, kPlateauGrowth = 1.25;
 constexpr double kDescentShare = 0.6;
 /// Bisections between the last run within the budget and the one beyond.
 constexpr int kBudgetBisections = 3;
+/// At most this many confirming draws (and runs after the first).
+constexpr int kMaxConfirmations = 3;
 
 /// Status message of an evaluation the budget refused (never shown: the
 /// caller recognises CachingProvider::BudgetHit()).
@@ -113,6 +115,11 @@ class CachingProvider : public SampleProvider {
         const int32_t i = index_[Index(pixels[k])];
         if (i < 0 || (masks_[size_t(i)] & need) != need) misses.push_back(k);
       }
+      // A pixel twice in one batch (importance draws are with replacement) is evaluated once.
+      std::sort(misses.begin(), misses.end(), [&](size_t a, size_t b) { return Index(pixels[a]) < Index(pixels[b]); });
+      misses.erase(std::unique(misses.begin(), misses.end(),
+                               [&](size_t a, size_t b) { return Index(pixels[a]) == Index(pixels[b]); }),
+                   misses.end());
       for (size_t k : misses) fresh += index_[Index(pixels[k])] < 0 ? 1 : 0;
       if (limit_ > 0 && distinct_ + fresh > limit_) {
         budgetHit_ = true;
@@ -207,6 +214,10 @@ struct Validation {
   /// (its share in the variance of the box mean), from `first[k]` on.
   std::vector<RGB> variance;
   std::vector<size_t> first;
+  /// The output pixel count times the number of draws: what the weights sum
+  /// to (exactly for stratified draws, on average for importance draws).
+  double total = 0;
+  bool importance = false;  ///< some draw followed an error proxy (EstimatePsnr's `total`)
 
   /// Adds pixel `k` of `from`.
   void Append(const Validation& from, size_t k) {
@@ -218,6 +229,12 @@ struct Validation {
     variance.insert(variance.end(), from.variance.begin() + std::ptrdiff_t(from.first[k]),
                     from.variance.begin() + std::ptrdiff_t(from.first[k + 1]));
     first.push_back(variance.size());
+  }
+  /// Adds every pixel of `from` (a whole draw).
+  void AppendAll(const Validation& from) {
+    for (size_t k = 0; k < from.pixels.size(); ++k) Append(from, k);
+    total += from.total;
+    importance = importance || from.importance;
   }
 };
 
@@ -238,9 +255,109 @@ std::vector<Point2i> DrawValidation(int outW, int outH, int64_t count, uint64_t 
   return out;
 }
 
+/// The display-referred encoding of a linear value (QualityGoal::display).
 RGB Display(const QualityGoal& goal, RGB c) {
   if (goal.display) return goal.display(c);
   return {SrgbEncode(c.r), SrgbEncode(c.g), SrgbEncode(c.b)};
+}
+
+/// Share of an importance draw that follows the error proxy; the rest is
+/// uniform over the image, so that every pixel can be drawn (a draw then
+/// estimates any run, not only the one whose proxy chose it) and no weight
+/// exceeds 1 / (1 - kProxyShare) times the uniform draw's. Chosen on the
+/// tuning set (docs/TUNING.md, Q) with kProxySpread, by simulated draws on
+/// the results and their references: 0.5 and 0.8 shares, spreads of 1/16,
+/// 1/4 and 1/2 elementary block.
+constexpr double kProxyShare = 0.8;
+/// The max filter that spreads the proxy: this share of the elementary block
+/// on each side.
+constexpr double kProxySpread = 0.25;
+
+/// Where a run's error is likely, per output pixel (any scale): the detail
+/// the run found, i.e. the squared display difference between the result and
+/// the bilinear interpolation of its elementary lattice, spread by a max
+/// filter (kProxySpread). The error that remains sits by what the engine has
+/// seen of an edge, a highlight or a thin object: the ends it did not follow,
+/// the crossings it filled. Noise-free, a box the engine evaluated entirely
+/// has no error (the result is its exact value): 0 there.
+std::vector<double> ErrorProxy(const Reconstruction& rec, const QualityGoal& goal, int s, bool noise) {
+  const int outW = rec.width, outH = rec.height;
+  const size_t N = size_t(outW) * size_t(outH);
+  const int L = std::max(1, rec.stats.settings.elementaryBlock / s);
+  auto pix = [&](int x, int y) {
+    return Display(goal, rec.image[size_t(std::min(y, outH - 1)) * size_t(outW) + size_t(std::min(x, outW - 1))]);
+  };
+  std::vector<double> detail(N, 0.0);
+  for (int y = 0; y < outH; ++y)
+    for (int x = 0; x < outW; ++x) {
+      const int x0 = x / L * L, y0 = y / L * L;
+      const float u = float(x - x0) / float(L), v = float(y - y0) / float(L);
+      const RGB lerp = pix(x0, y0) * ((1 - u) * (1 - v)) + pix(x0 + L, y0) * (u * (1 - v)) +
+                       pix(x0, y0 + L) * ((1 - u) * v) + pix(x0 + L, y0 + L) * (u * v);
+      const RGB r = pix(x, y);
+      double sq = 0;
+      for (int k = 0; k < 3; ++k) sq += (double(r[k]) - double(lerp[k])) * (double(r[k]) - double(lerp[k]));
+      if (std::isfinite(sq)) detail[size_t(y) * size_t(outW) + size_t(x)] = sq;
+    }
+  // The max filter, separable.
+  const int r = int(std::lround(kProxySpread * double(L)));
+  std::vector<double> rows(N, 0.0);
+  for (int y = 0; y < outH; ++y)
+    for (int x = 0; x < outW; ++x) {
+      double m = 0;
+      for (int k = std::max(0, x - r); k <= std::min(outW - 1, x + r); ++k)
+        m = std::max(m, detail[size_t(y) * size_t(outW) + size_t(k)]);
+      rows[size_t(y) * size_t(outW) + size_t(x)] = m;
+    }
+  std::vector<double> proxy(N, 0.0);
+  for (int y = 0; y < outH; ++y)
+    for (int x = 0; x < outW; ++x) {
+      double m = 0;
+      for (int k = std::max(0, y - r); k <= std::min(outH - 1, y + r); ++k)
+        m = std::max(m, rows[size_t(k) * size_t(outW) + size_t(x)]);
+      proxy[size_t(y) * size_t(outW) + size_t(x)] = m;
+    }
+  if (noise) return proxy;
+  for (int y = 0; y < outH; ++y)
+    for (int x = 0; x < outW; ++x) {
+      bool all = true;
+      for (int wy = y * s; all && wy < std::min(rec.workHeight, (y + 1) * s); ++wy)
+        for (int wx = x * s; all && wx < std::min(rec.workWidth, (x + 1) * s); ++wx) {
+          const SampleReason why = rec.sampleMap[size_t(wy) * size_t(rec.workWidth) + size_t(wx)];
+          all = why != SampleReason::kInterpolated && why != SampleReason::kPreviewStandIn;
+        }
+      if (all) proxy[size_t(y) * size_t(outW) + size_t(x)] = 0;
+    }
+  return proxy;
+}
+
+/// `count` output pixels drawn independently with probability q = a mixture
+/// of the uniform (1 - kProxyShare) and of `proxy` (kProxyShare); each with
+/// the weight 1 / (count q), the share of the image it stands for (their sum
+/// is the pixel count on average): the Hansen-Hurwitz estimate of the mean
+/// error, unbiased whatever the proxy.
+std::vector<Point2i> DrawImportance(const std::vector<double>& proxy, int outW, int64_t count, uint64_t seed,
+                                    std::vector<double>* weights) {
+  const size_t N = proxy.size();
+  double total = 0;
+  for (double p : proxy) total += p;
+  const double share = total > 0 ? kProxyShare : 0.0;
+  std::vector<double> cdf(N);
+  double acc = 0;
+  for (size_t i = 0; i < N; ++i) {
+    acc += (1.0 - share) / double(N) + (total > 0 ? share * proxy[i] / total : 0.0);
+    cdf[i] = acc;
+  }
+  SplitMix64 rng{seed};
+  std::vector<Point2i> out;
+  for (int64_t k = 0; k < count; ++k) {
+    const double u = double(rng.Next() >> 11) * 0x1.0p-53 * acc;
+    const size_t i = std::min(N - 1, size_t(std::upper_bound(cdf.begin(), cdf.end(), u) - cdf.begin()));
+    const double q = (1.0 - share) / double(N) + (total > 0 ? share * proxy[i] / total : 0.0);
+    out.push_back({int(i % size_t(outW)), int(i / size_t(outW))});
+    weights->push_back(1.0 / (double(count) * q));
+  }
+  return out;
 }
 
 /// Which working pixels (row-major index) the engine evaluated itself.
@@ -330,7 +447,7 @@ PsnrEstimate EstimateAt(const Validation& v, const QualityGoal& goal, const std:
     d.push_back(sq);
     w.push_back(v.weights[k]);
   }
-  return EstimatePsnr(d, w);
+  return EstimatePsnr(d, w, v.importance ? v.total : 0);
 }
 
 /// The full render's own estimate against the converged image: at each
@@ -346,7 +463,7 @@ PsnrEstimate RenderEstimate(const Validation& v, const QualityGoal& goal) {
     d.push_back(DisplayVariance(goal, v.exact[k], var, StdDev(var)));
     w.push_back(v.weights[k]);
   }
-  return EstimatePsnr(d, w);
+  return EstimatePsnr(d, w, v.importance ? v.total : 0);
 }
 
 /// Evaluates the working pixels of the validation's output pixels through
@@ -406,11 +523,25 @@ Status QualityGoal::Validate() const {
   return Status::Ok();
 }
 
-PsnrEstimate EstimatePsnr(const std::vector<double>& d, const std::vector<double>& w) {
+PsnrEstimate EstimatePsnr(const std::vector<double>& d, const std::vector<double>& w, double total) {
   PsnrEstimate e;
   const size_t n = std::min(d.size(), w.size());
   double W = 0, sum = 0;
   for (size_t i = 0; i < n; ++i) W += w[i], sum += w[i] * d[i];
+  if (total > 0 && n >= 2) {
+    // Hansen-Hurwitz: each pixel an independent estimate y = n w d / total
+    // of the mean; dividing by the realized sum of weights instead (Hajek)
+    // is biased where the draw follows the error: there the weights are small
+    // exactly where d is large.
+    const double m = sum / total;
+    double var = 0;
+    for (size_t i = 0; i < n; ++i) {
+      const double y = double(n) * w[i] * d[i] / total;
+      var += (y - m) * (y - m);
+    }
+    const double se = std::sqrt(var / (double(n) * double(n - 1)));
+    return {PsnrOf(m), PsnrOf(m + kZ * se), PsnrOf(std::max(0.0, m - kZ * se))};
+  }
   if (n == 0 || !(W > 0)) {
     e.psnr = e.low = e.high = kNaN;
     return e;
@@ -461,15 +592,20 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   Validation v;
   std::vector<uint8_t> drawn(size_t(outPixels), 0);  // output pixels validated, for the cost
   int draws = 0;
-  // One more stratified draw of `count` pixels, with its own seed: the union
-  // of independent unbiased draws (equal total weights) is unbiased.
-  auto drawMore = [&](Validation* into) -> Status {
+  // One more draw of `count` pixels, with its own seed: stratified before
+  // any run, else by importance after the error proxy of run `from`. Each
+  // draw's weights sum to the pixel count (on average for importance draws):
+  // the union of independent unbiased draws is unbiased.
+  auto drawMore = [&](Validation* into, const Reconstruction* from) -> Status {
     Validation more;
-    more.pixels = DrawValidation(outW, outH, count, goal.seed + uint64_t(draws), &more.weights);
+    more.pixels = from ? DrawImportance(ErrorProxy(*from, goal, s, caps.variance), outW, count, goal.seed + uint64_t(draws),
+                                        &more.weights)
+                       : DrawValidation(outW, outH, count, goal.seed + uint64_t(draws), &more.weights);
+    more.total = double(outPixels);
+    more.importance = from != nullptr;
     DCM_RETURN_IF_ERROR(EvaluateValidation(cache, options, what, &more, pending));
     ++draws;
-    for (size_t k = 0; k < more.pixels.size(); ++k) {
-      const Point2i p = more.pixels[k];
+    for (const Point2i& p : more.pixels) {
       uint8_t& mark = drawn[size_t(p.y) * size_t(outW) + size_t(p.x)];
       if (!mark) {
         const int bw = std::min(s, caps.width - p.x * s), bh = std::min(s, caps.height - p.y * s);
@@ -477,11 +613,11 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
         ++report->validationPixels;
         mark = 1;
       }
-      into->Append(more, k);
     }
+    into->AppendAll(more);
     return Status::Ok();
   };
-  if (Status st = drawMore(&v); !st.ok()) {
+  if (Status st = drawMore(&v, nullptr); !st.ok()) {
     if (cache.BudgetHit())
       return Status::Error("--budget " + Num(goal.budget) + ": too small for the validation pixels");
     return st;
@@ -572,7 +708,7 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
     // carry most of it). More draws before more samples of the image.
     while (target > 0 && !meets(*best) && best->estimate.psnr >= target && draws < kMaxSearchDraws) {
       cache.ClearBudgetHit();
-      if (Status st = drawMore(&v); !st.ok()) {
+      if (Status st = drawMore(&v, &best->rec); !st.ok()) {
         if (cache.BudgetHit()) break;
         return st;
       }
@@ -647,19 +783,38 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
 
   // The search stopped where its validation pixels looked good enough: on
   // them the result errs high (the more runs, the more; 10 dB on the tracer's
-  // room). A fresh draw, which chose nothing, estimates the result.
-  Validation fresh;
-  if (target > 0 && best->threshold >= 0) {
+  // room). A fresh draw, which chose nothing, estimates the result, drawn by
+  // importance where the result's error is likely (ErrorProxy). Where it
+  // finds the target missed although the search's pixels met it, the descent
+  // goes on, one step at a time, each result confirmed by a draw of its own
+  // (the draws before join the search's pixels).
+  const bool searchMet = meets(*best);
+  for (int confirmation = 0; target > 0 && best->threshold >= 0; ++confirmation) {
+    Validation fresh;
     cache.ClearBudgetHit();
-    if (Status st = drawMore(&fresh); st.ok()) {
-      best->estimate = EstimateAt(fresh, goal, best->rec.image, best->rec.width, sampledBy(best->rec), workW, s);
-      report->confirmed = true;
-    } else if (!cache.BudgetHit()) {
-      return st;
+    if (Status st = drawMore(&fresh, &best->rec); !st.ok()) {
+      if (!cache.BudgetHit()) return st;
+      break;
     }
+    best->estimate = EstimateAt(fresh, goal, best->rec.image, best->rec.width, sampledBy(best->rec), workW, s);
+    report->confirmed = true;
+    v.AppendAll(fresh);
+    if (meets(*best) || !searchMet || confirmation + 1 >= kMaxConfirmations) break;
+    const double next = best->threshold <= kMinThreshold ? -1 : std::max(kMinThreshold, best->threshold * kDefaultStep);
+    if (limit > 0) {
+      const int64_t used = cache.Distinct();
+      cache.SetLimit(used + int64_t(kDescentShare * double(limit - used)));
+    }
+    DCM_RETURN_IF_ERROR(runAt(next, &tried));
+    cache.SetLimit(limit);
+    if (!tried) {
+      report->budgetBound = true;
+      break;
+    }
+    best = std::move(tried);
+    report->confirmed = false;
   }
   // The render's own error does not depend on the search: every draw counts.
-  for (size_t k = 0; k < fresh.pixels.size(); ++k) v.Append(fresh, k);
   report->renderEstimate = RenderEstimate(v, goal);
   report->estimate = best->estimate;
   report->levels = std::move(best->levels);

@@ -4,8 +4,10 @@
 // noisy samples of known variance, the estimate is against the converged
 // (noise-free) image, and the full render's own PSNR is estimated beside it.
 //
-// The estimate comes from validation pixels drawn at random (stratified,
-// seeded) and evaluated exactly; they count in the exact pixels. The knob is
+// The estimate comes from validation pixels drawn at random (seeded: the
+// first draw stratified, the later ones by importance where the result shows
+// detail, with Hansen-Hurwitz weights) and evaluated exactly; they count in
+// the exact pixels. The knob is
 // the contrast threshold, lowered until the estimate's lower bound reaches the
 // target or the next step would exceed the budget (docs/QUALITY.md).
 #pragma once
@@ -106,7 +108,9 @@ struct QualityReport {
 /// options' threshold (sixteen times it, at most 1, with a budget) down, until
 /// the estimate's lower bound reaches goal.targetPsnr, stops rising (a
 /// plateau), or the next run would exceed the budget (then bisected between
-/// the two); with a target, a last validation draw estimates the result. The
+/// the two); with a target, a last validation draw by importance estimates
+/// the result, and where it finds the target missed the descent goes on (up
+/// to three such draws). The
 /// provider is evaluated at most once per pixel across the runs. Every other
 /// option is used as given. A target that the budget (or the smallest
 /// threshold, then the full evaluation) cannot reach is no error: `report`
@@ -124,7 +128,11 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
 /// The estimate from per-pixel mean squared display errors `d` with weights
 /// `w` (the share of the image each stands for): exposed for tests. A `d`
 /// may be negative (an unbiased estimate of an error from which a noise
-/// variance was subtracted); a mean at or below 0 gives +inf.
-PsnrEstimate EstimatePsnr(const std::vector<double>& d, const std::vector<double>& w);
+/// variance was subtracted); a mean at or below 0 gives +inf. With `total`
+/// > 0, the weights are those of independent draws (1 / (draws * probability))
+/// whose sum is `total` on average: the Hansen-Hurwitz mean sum(w d) / total
+/// and its variance; else the weighted mean sum(w d) / sum(w) (a stratified
+/// draw, whose weights sum to the pixel count exactly).
+PsnrEstimate EstimatePsnr(const std::vector<double>& d, const std::vector<double>& w, double total = 0);
 
 }  // namespace dcm
