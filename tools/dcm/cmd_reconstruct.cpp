@@ -180,6 +180,21 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
   return kExitOk;
 }
 
+/// The share of exact pixels the noisy default may spend (issue 26's bound).
+constexpr double kNoisyBudget = 0.35;
+
+/// With noisy dense samples (their variance given or estimated) and no goal,
+/// threshold or method of the user's, dcm aims at a result at least as close
+/// to the converged image as the render itself, within kNoisyBudget of exact
+/// pixels: --target-psnr render --budget 0.35 (docs/NOISE.md).
+bool NoisyDefaultGoal(const aov::AovProvider& provider, bool sparse, EngineFlags* e) {
+  if (sparse || !provider.Capabilities().variance) return false;
+  if (e->threshold || e->targetPsnr || e->budget || e->full || e->method != "dcm") return false;
+  e->targetPsnr = kTargetRender;
+  e->budget = kNoisyBudget;
+  return true;
+}
+
 int RunReconstruct(const ReconstructFlags& f) {
   const std::string cmd = "reconstruct";
   if (!f.pipe.command.empty()) {
@@ -261,10 +276,16 @@ int RunReconstruct(const ReconstructFlags& f) {
   options.recordInterpolation = layout.Reconstructs();
   if (f.engine.verbose)
     for (const auto& note : layout.notes) std::cerr << "dcm " << cmd << ": " << note << "\n";
+  EngineFlags engine = f.engine;
+  if (NoisyDefaultGoal(*provider, sparse, &engine) && engine.verbose)
+    std::cerr << "dcm " << cmd << ": noisy samples: refining until the result is estimated at least as close to "
+              << "the converged image as the render itself, within " << 100 * kNoisyBudget
+              << " % exact pixels (--target-psnr render --budget " << kNoisyBudget
+              << "; --threshold T for one threshold's result)\n";
   aov_common::Outputs outputs(cmd);  // before the run: --progressive writes during it
   ExrReconstruction run;
   bool usage = false;
-  st = ReconstructWholeExr(cmd, *provider, f.aov, f.engine, options, f.reference, &run, &usage);
+  st = ReconstructWholeExr(cmd, *provider, f.aov, engine, options, f.reference, &run, &usage);
   if (!st.ok()) return aov_common::Fail(cmd, st.message(), usage ? kExitUsage : kExitFailure);
   const Reconstruction& r = run.result;
   const bool haveRef = run.haveReference;
