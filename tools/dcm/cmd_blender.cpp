@@ -310,7 +310,8 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   // The variance is pooled over the elementary block of the noisy regime.
   ProviderCapabilities noisyCaps = provider->Capabilities();
   noisyCaps.variance = true;
-  PooledVarianceProvider pooled(*provider, ResolveSettings(options, noisyCaps).elementaryBlock, useVariance);
+  const int poolRadius = ResolveSettings(options, noisyCaps).elementaryBlock;
+  PooledVarianceProvider pooled(*provider, poolRadius, useVariance);
   const ProviderCapabilities caps = pooled.Capabilities();
   RoundSchedule schedule = RoundSchedule::kLevels;
   if (Status st = ScheduleFor(f.rounds, provider->roundCost(), provider->hasPreview(), &schedule); !st.ok())
@@ -350,7 +351,10 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     const auto tp = Clock::now();
     std::unique_ptr<SampleProvider> preview;
     timed.step = "reading the preview";
-    st = provider->FetchPreview({options.textureSplit && caps.splitRadiance, false}, &preview);
+    // With the exact pixels' variance the engine plans in its noise regime: the
+    // preview's own variance (its halves, pooled as the exact pixels') keeps
+    // the preview's noise from passing for edges.
+    st = provider->FetchPreview({options.textureSplit && caps.splitRadiance, useVariance}, &preview, poolRadius);
     previewS = Since(tp);
     PreviewScheduleOptions so;
     so.maxRounds = f.rounds.maxRounds;
