@@ -374,7 +374,8 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
     }
     ++report->runs;
     cache.ClearBudgetHit();
-    const Status st = Reconstruct(cache, o, &r.rec, pending);
+    const Status st =
+        goal.reconstruct ? goal.reconstruct(cache, o, &r.rec, pending) : Reconstruct(cache, o, &r.rec, pending);
     spent.timeGuidesS += r.rec.stats.timeGuidesS;
     spent.timeProviderS += r.rec.stats.timeProviderS;
     spent.timeEngineS += r.rec.stats.timeEngineS;
