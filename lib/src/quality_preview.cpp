@@ -29,7 +29,7 @@ class RoundKeeper : public SampleProvider {
  public:
   RoundKeeper(SampleProvider& exact, SampleProvider& preview, QualityRoundStats* stats)
       : exact_(exact), preview_(preview), caps_(exact.Capabilities()), stats_(stats) {
-    caps_.threadSafe = false;  // the engine's calls come from one thread; the records need no locks
+    caps_.threadSafe = false;  // the engine then calls one at a time: the records need no locks
     const size_t n = size_t(caps_.width) * size_t(caps_.height);
     epoch_.assign(n, -1);
     mask_.assign(n, 0);
