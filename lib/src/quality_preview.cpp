@@ -89,7 +89,7 @@ class RoundKeeper : public SampleProvider {
     return Status::Ok();
   }
 
-  /// A new search: no run yet, nothing owed.
+  /// A new search: no run yet (what was owed is rendered by then).
   void BeginPass() {
     runs_ = 0;
     run_ = 0;
