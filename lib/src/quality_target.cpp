@@ -662,7 +662,8 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
     ++report->runs;
     cache.ClearBudgetHit();
     cache.MarkEngine(true);
-    const Status st = Reconstruct(cache, o, &r.rec, pending);
+    const Status st =
+        goal.reconstruct ? goal.reconstruct(cache, o, &r.rec, pending) : Reconstruct(cache, o, &r.rec, pending);
     cache.MarkEngine(false);
     spent.timeGuidesS += r.rec.stats.timeGuidesS;
     spent.timeProviderS += r.rec.stats.timeProviderS;

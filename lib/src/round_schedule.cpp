@@ -204,20 +204,23 @@ Status ReconstructWithPreview(SampleProvider& exact, SampleProvider& preview,
 
 ImagePreviewProvider::ImagePreviewProvider(int workWidth, int workHeight, int previewWidth,
                                            int previewHeight, std::vector<RGB> L,
-                                           std::vector<RGB> Li, std::vector<RGB> Lc)
+                                           std::vector<RGB> Li, std::vector<RGB> Lc,
+                                           std::vector<RGB> variance)
     : workWidth_(workWidth),
       workHeight_(workHeight),
       previewWidth_(previewWidth),
       previewHeight_(previewHeight),
       L_(std::move(L)),
       Li_(std::move(Li)),
-      Lc_(std::move(Lc)) {}
+      Lc_(std::move(Lc)),
+      variance_(std::move(variance)) {}
 
 ProviderCapabilities ImagePreviewProvider::Capabilities() const {
   ProviderCapabilities caps;
   caps.width = workWidth_;
   caps.height = workHeight_;
   caps.splitRadiance = !Li_.empty() && !Lc_.empty();
+  caps.variance = !variance_.empty();
   caps.name = "preview";
   return caps;
 }
@@ -244,7 +247,8 @@ Status ImagePreviewProvider::Evaluate(std::span<const Point2i> pixels, const Sam
                                       std::span<ExactSample> out) {
   const size_t n = size_t(previewWidth_) * size_t(previewHeight_);
   if (previewWidth_ < 1 || previewHeight_ < 1 || L_.size() != n ||
-      (!Li_.empty() && Li_.size() != n) || (!Lc_.empty() && Lc_.size() != n))
+      (!Li_.empty() && Li_.size() != n) || (!Lc_.empty() && Lc_.size() != n) ||
+      (!variance_.empty() && variance_.size() != n))
     return Status::Error("preview image of " + std::to_string(previewWidth_) + "x" +
                          std::to_string(previewHeight_) + " pixels has " +
                          std::to_string(L_.size()) + " values");
@@ -261,6 +265,8 @@ Status ImagePreviewProvider::Evaluate(std::span<const Point2i> pixels, const Sam
       s.Li = at(Li_);
       s.Lc = at(Lc_);
     }
+    // Without a variance the stand-ins count as noise-free (0).
+    if (what.variance && !variance_.empty()) s.variance = at(variance_);
   }
   return Status::Ok();
 }

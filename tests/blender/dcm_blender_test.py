@@ -1,11 +1,12 @@
 """`dcm blender` on the tiny test scene: with --variance off the exact pixels
 equal a full Cycles render of the same file; by default they are the mean of
 two renders at half the samples with two seeds, and the engine gets their
-variance; the .blend is unchanged, and bad input ends with a message naming
+variance; --target-psnr and --budget are met, in about one render call per
+run of the quality search; the .blend is unchanged, and bad input ends with a message naming
 the file and the step, exit 1, no output and no Blender left; a signal to dcm
 (SIGTERM, SIGKILL) leaves no output, no Blender and no scratch folder.
 
-    /usr/bin/python3 dcm_blender_test.py DCM BLENDER SOURCE_DIR exact|variance|errors
+    /usr/bin/python3 dcm_blender_test.py DCM BLENDER SOURCE_DIR exact|variance|quality|errors
 Exit 77 (skipped) when Blender is missing."""
 import hashlib
 import json
@@ -92,7 +93,8 @@ def variance(dcm, blender, src, tmp):
     half_b = bs.render_full(blender, src, blend, tmp, 8, 1)
     h, w = half_a.shape[:2]
     runs = {}
-    for name, flags in (("auto", []), ("on", ["--variance", "on"]), ("raw", ["--variance", "on", "--no-denoise-samples"])):
+    for name, flags in (("auto", []), ("on", ["--variance", "on"]), ("raw", ["--variance", "on", "--no-denoise-samples"]),
+                        ("exact preview", ["--variance", "on", "--preview-samples", "16"])):
         out, stats, smap = (os.path.join(tmp, name + e) for e in (".exr", ".json", ".png"))
         code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--sample-map", smap, "--blender", blender,
                                  "--max-rounds", "8"] + flags)
@@ -106,6 +108,12 @@ def variance(dcm, blender, src, tmp):
         # The variance reached the engine: it runs its noise regime.
         assert j["settings"]["noisy"] == used, j["settings"]
         runs[name] = (bs.read_exr(out)[0], exact_mask(smap, h, w), j)
+    # The preview (4 samples of the exact pixels' 16: twice their noise) comes with its variance: the engine tests its contrasts against its noise, and its
+    # first round asks for no more than a plan on a preview of the exact pixels' samples
+    # (16), but for the two previews' different noise (25 %). Without the variance the
+    # preview's noise passed for edges: 996 pixels against 761 at 16 samples.
+    first = {k: runs[k][2]["blender"]["rounds"][0]["pixels"] for k in ("on", "exact preview")}
+    assert first["on"] <= 1.25 * first["exact preview"], first
     # The engine denoises exact samples with their neighbours on the same surface.
     assert runs["on"][2]["denoised_samples"] > 0, runs["on"][2]
     assert runs["raw"][2]["denoised_samples"] == 0, runs["raw"][2]
@@ -118,9 +126,58 @@ def variance(dcm, blender, src, tmp):
     assert (err <= 1e-5 * np.maximum(np.abs(mean[is_exact][:, :3]), 1) + 1e-7).all(), err.max()
     differ = (np.abs(half_a - half_b)[is_exact][:, :3] > 1e-4).any(axis=1).mean()
     assert differ > 0.5, differ
-    print("%.1f %% exact; %.0f %% of them differ between the seeds; %d denoised; auto: noise %.1f dB, %s"
+    print("%.1f %% exact; %.0f %% of them differ between the seeds; %d denoised; auto: noise %.1f dB, %s; first "
+          "round %d pixels (%d with an exact preview)"
           % (100 * is_exact.mean(), 100 * differ, runs["on"][2]["denoised_samples"],
-             runs["auto"][2]["blender"]["noise_psnr"], runs["auto"][2]["blender"]["variance"]))
+             runs["auto"][2]["blender"]["noise_psnr"], runs["auto"][2]["blender"]["variance"], first["on"],
+             first["exact preview"]))
+    assert no_blender_left(blend)
+
+
+def display_psnr(a, b):
+    """PSNR of a against b on sRGB-encoded values clipped to [0, 1], as the stats' (tools/common/metrics.h)."""
+    enc = lambda x: np.clip(np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(np.maximum(x, 0), 1 / 2.4) - 0.055),
+                            0, 1)
+    return 10 * np.log10(1 / np.mean((enc(a[..., :3]) - enc(b[..., :3])) ** 2))
+
+
+def quality(dcm, blender, src, tmp):
+    """--target-psnr and --budget: the quality search with preview-planned runs. With
+    --variance off the exact pixels are the full render's, so the PSNR the search
+    estimates (against the full render) can be checked against the full render."""
+    blend = bs.make_scene(blender, src, tmp)
+    ref = bs.render_full(blender, src, blend, tmp)
+    total = ref.shape[0] * ref.shape[1]
+    target = 32.0
+    out, stats = os.path.join(tmp, "target.exr"), os.path.join(tmp, "target.json")
+    code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--blender", blender, "--variance", "off",
+                             "--schedule", "preview", "--target-psnr", str(target)])
+    assert code == 0, se
+    j = json.load(open(stats))
+    q, b = j["quality"], j["blender"]
+    true = display_psnr(bs.read_exr(out)[0], ref)
+    assert q["target_reached"] and q["confirmed"], q
+    # The estimate's lower bound reached the target; the truth is below it only by chance, not by 0.5 dB.
+    assert true >= target - 0.5, (true, j["estimated_psnr_low"])
+    # Two render calls per run of the search at most (the first validation draw with the first
+    # run's first), one per later draw: at most three where the estimate's bound falls short, and
+    # the last, independent one.
+    assert 1 <= len(b["rounds"]) <= 2 * q["runs"] + 4, (b["rounds"], q["runs"])
+    # Every pixel rendered once, and every one rendered counted.
+    assert sum(r["pixels"] for r in b["rounds"]) == j["exact_pixels"] == q["exact_pixels"], (b["rounds"], q)
+    assert "quality" in so, so
+    print("--target-psnr %g: estimated %.2f dB (low %.2f), true %.2f dB, %.1f %% exact, %d runs, %d render calls"
+          % (target, j["estimated_psnr"], j["estimated_psnr_low"], true, 100 * j["exact_fraction"], q["runs"],
+             len(b["rounds"])))
+    budget = 0.3
+    code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--blender", blender, "--variance", "off",
+                             "--schedule", "preview", "--budget", str(budget)])
+    assert code == 0, se
+    j = json.load(open(stats))
+    rendered = sum(r["pixels"] for r in j["blender"]["rounds"])
+    assert j["exact_fraction"] <= budget and rendered <= budget * total, (j["exact_fraction"], rendered)
+    print("--budget %g: %.1f %% exact (%d pixels rendered), estimated %.2f dB, true %.2f dB"
+          % (budget, 100 * j["exact_fraction"], rendered, j["estimated_psnr"], display_psnr(bs.read_exr(out)[0], ref)))
     assert no_blender_left(blend)
 
 
@@ -151,8 +208,8 @@ def errors(dcm, blender, src, tmp):
     assert os.listdir(scratch) == [], os.listdir(scratch)
     signalled(dcm, blender, blend, out, scratch)
     refused([blend, "-o", os.path.join(tmp, "no-such-dir", "out.exr"), "--blender", blender], "no-such-dir")
-    refused([blend, "-o", out, "--blender", blender, "--target-psnr", "40"], "--target-psnr: not with dcm blender",
-            code=2)
+    refused([blend, "-o", out, "--blender", blender, "--target-psnr", "40", "--full"],
+            "--target-psnr: not with --full", code=2)
     # A scene set to Eevee: the child says why it cannot render it.
     eevee = os.path.join(tmp, "eevee.blend")
     subprocess.run([blender, "-b", blend, "--python-expr",
@@ -204,7 +261,7 @@ def main():
     os.environ["TMPDIR"] = os.path.join(tmp, "tmpdir")
     os.mkdir(os.environ["TMPDIR"])
     try:
-        {"exact": exact, "variance": variance, "errors": errors}[what](dcm, blender, src, tmp)
+        {"exact": exact, "variance": variance, "quality": quality, "errors": errors}[what](dcm, blender, src, tmp)
         print("ok")
         return 0
     finally:

@@ -5,6 +5,7 @@
 
 #include "analytic_provider.h"
 #include "dcm/reconstructor.h"
+#include "dcm/round_schedule.h"
 
 namespace dcm::testing {
 
@@ -29,6 +30,23 @@ double MeanLuminanceError(const Reconstruction& r, const std::vector<RGB>& ref, 
         ++n;
       }
   return n ? sum / n : 0;
+}
+
+/// The provider's L, L_i and L_c box-filtered to 1/`factor` of its resolution:
+/// a preview a renderer would make at low resolution.
+inline ImagePreviewProvider LowResolutionPreview(const AnalyticProvider& p, int w, int h, int factor) {
+  const int pw = w / factor, ph = h / factor;
+  std::vector<RGB> L(size_t(pw) * ph), Li(L.size()), Lc(L.size());
+  const float weight = 1.f / float(factor * factor);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const PixelTruth t = p.Truth(x, y);
+      const size_t k = size_t(y / factor) * pw + size_t(x / factor);
+      L[k] += t.L() * weight;
+      Li[k] += t.Li * weight;
+      Lc[k] += t.Lc * weight;
+    }
+  return ImagePreviewProvider(w, h, pw, ph, L, Li, Lc);
 }
 
 }  // namespace dcm::testing

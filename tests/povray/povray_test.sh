@@ -1,7 +1,7 @@
 #!/bin/bash
 # `dcm povray` driven with the real POV-Ray on examples/povray/scene.pov.
 #
-#   povray_test.sh exact|errors DCM_BINARY SOURCE_DIR [POVRAY]
+#   povray_test.sh exact|quality|errors DCM_BINARY SOURCE_DIR [POVRAY]
 #
 # exact: at 96x72, the exact pixels of `dcm povray` (those its sample map marks,
 #   with --max-rounds 10 so that no preview stand-in is left) equal the --full
@@ -9,6 +9,11 @@
 #   why); with the defaults, at most 5 POV-Ray processes render the lit
 #   passes (docs/POVRAY.md: 1 preview + 2 rounds x 2) and 10 in all (5 guides),
 #   and the PSNR against --full is at least 35 dB (measured 38.5 dB).
+# quality: --target-psnr 35 is reached by the report and against --full (within
+#   the 0.5 dB), in at most two rounds per run of the quality search
+#   (the first validation draw goes with the first) and one per later draw (at
+#   most three where the estimate's bound falls short, and the last);
+#   --budget 0.2 renders at most 20 % of the pixels.
 # errors: a missing scene, a scene without the pass convention, POV-Ray that
 #   fails (/bin/false) or crashes in the exact round, an output folder that
 #   does not exist, SIGTERM during a render: exit 1 with a message naming the
@@ -17,7 +22,7 @@
 # Exit 77 (ctest: skipped) where povray is not installed.
 set -uo pipefail
 
-mode=${1:?usage: povray_test.sh exact|errors DCM_BINARY SOURCE_DIR [POVRAY]}
+mode=${1:?usage: povray_test.sh exact|quality|errors DCM_BINARY SOURCE_DIR [POVRAY]}
 dcm=${2:?}
 src=${3:?}
 povray_bin=${4:-}
@@ -101,6 +106,27 @@ exact)
   awk -v p="$psnr" 'BEGIN { exit !(p >= 35) }' || fail "PSNR $psnr dB against --full, below 35 dB"
   ok "defaults: $all POV-Ray processes ($lit lit), PSNR $psnr dB against --full"
   ;;
+quality)
+  "$dcm" povray "$scene" -o "$tmp/full.exr" --size $size --full --povray "$pov" -q || fail "dcm povray --full failed"
+  "$dcm" povray "$scene" -o "$tmp/q.exr" --size $size --target-psnr 35 --reference "$tmp/full.exr" \
+    --stats "$tmp/q.json" --povray "$pov" -q || fail "dcm povray --target-psnr 35 failed"
+  reached=$(json "$tmp/q.json" quality.target_reached)
+  psnr=$(json "$tmp/q.json" reference.psnr)
+  est=$(json "$tmp/q.json" estimated_psnr_low)
+  runs=$(json "$tmp/q.json" quality.runs)
+  rounds=$(json "$tmp/q.json" povray.rounds)
+  [[ $reached == True ]] || fail "--target-psnr 35: not reached by the report (lower bound $est dB)"
+  awk -v p="$psnr" 'BEGIN { exit !(p >= 34.5) }' || fail "--target-psnr 35: $psnr dB against --full"
+  [[ $rounds -ge 1 && $rounds -le $((2 * runs + 4)) ]] || fail "--target-psnr 35: $rounds rounds for $runs runs"
+  ok "--target-psnr 35: $psnr dB against --full (lower bound $est dB), $runs runs in $rounds rounds"
+  "$dcm" povray "$scene" -o "$tmp/b.exr" --size $size --budget 0.2 --stats "$tmp/b.json" --povray "$pov" -q ||
+    fail "dcm povray --budget 0.2 failed"
+  fraction=$(json "$tmp/b.json" exact_fraction)
+  rendered=$(json "$tmp/b.json" povray.exact_pixels_rendered)
+  awk -v f="$fraction" -v r="$rendered" 'BEGIN { exit !(f <= 0.2 && r <= 0.2 * 96 * 72) }' ||
+    fail "--budget 0.2: exact fraction $fraction, $rendered pixels rendered"
+  ok "--budget 0.2: exact fraction $fraction ($rendered pixels rendered)"
+  ;;
 errors)
   out=$tmp/out.exr
   expect "missing scene" 1 "no-such.pov is not a file" "$out" -- "$dcm" povray "$tmp/no-such.pov" -o "$out" --size $size
@@ -128,8 +154,8 @@ EOS
   expect "output = scene" 2 "an output never replaces an input" "$out" -- "$dcm" povray "$scene" -o "$scene" --size $size
   cmp -s "$scene" "$src/examples/povray/scene.pov" || fail "the scene was changed"
   expect "bad --size" 2 "--size: must be WIDTHxHEIGHT" "$out" -- "$dcm" povray "$scene" -o "$out" --size 96
-  expect "quality goal" 2 "--target-psnr: not with dcm povray yet" "$out" -- \
-    "$dcm" povray "$scene" -o "$out" --size $size --target-psnr 40
+  expect "quality goal with --full" 2 "--target-psnr: not with --full" "$out" -- \
+    "$dcm" povray "$scene" -o "$out" --size $size --target-psnr 40 --full
   # SIGTERM while POV-Ray renders: dcm ends it and removes the scratch folder.
   "$dcm" povray "$scene" -o "$out" --size 320x240 --full --povray "$pov" -q 2>"$tmp/err" &
   pid=$!

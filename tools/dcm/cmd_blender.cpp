@@ -28,6 +28,7 @@
 #include <iostream>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,7 @@
 #include "dcm/noise_estimate.h"
 #include "dcm/pipe/pipe_provider.h"
 #include "dcm/pipe/scratch_folder.h"
+#include "dcm/quality_preview.h"
 #include "dcm/reconstructor.h"
 #include "dcm/round_schedule.h"
 #include "engine_flags.h"
@@ -245,7 +247,6 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   };
   ReconstructionOptions options;
   if (Status st = ToOptions(f.pipe.engine, &options); !st.ok()) return Fail(st.message(), kExitUsage);
-  if (Status st = RefuseQualityGoal(f.pipe.engine, cmd); !st.ok()) return Fail(st.message(), kExitUsage);
   if (Status st = toolkit::CheckExrFormat(f.pipe.exr); !st.ok()) return Fail(st.message(), kExitUsage);
   if (Status st = toolkit::CheckOutputs({{"scene", f.scene}}, {{"-o", output},
                                                                {"--stats", stats},
@@ -310,7 +311,8 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   // The variance is pooled over the elementary block of the noisy regime.
   ProviderCapabilities noisyCaps = provider->Capabilities();
   noisyCaps.variance = true;
-  PooledVarianceProvider pooled(*provider, ResolveSettings(options, noisyCaps).elementaryBlock, useVariance);
+  const int poolRadius = ResolveSettings(options, noisyCaps).elementaryBlock;
+  PooledVarianceProvider pooled(*provider, poolRadius, useVariance);
   const ProviderCapabilities caps = pooled.Capabilities();
   RoundSchedule schedule = RoundSchedule::kLevels;
   if (Status st = ScheduleFor(f.rounds, provider->roundCost(), provider->hasPreview(), &schedule); !st.ok())
@@ -344,19 +346,40 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   TimedProvider timed(pooled);
   Reconstruction rec;
   PreviewScheduleStats sched;
-  double previewS = 0;
+  // --target-psnr / --budget: the quality search, each run planned on the preview.
+  QualityGoal goal;
+  const bool haveGoal = QualityGoalOf(f.pipe.engine, &goal);
+  std::optional<QualityReport> quality;
+  QualityRoundStats qrounds;
+  double previewS = 0, goalS = 0;
   Status st;
   if (schedule == RoundSchedule::kPreview) {
     const auto tp = Clock::now();
     std::unique_ptr<SampleProvider> preview;
     timed.step = "reading the preview";
-    st = provider->FetchPreview({options.textureSplit && caps.splitRadiance, false}, &preview);
+    // With the exact pixels' variance the engine plans in its noise regime: the
+    // preview's own variance (its halves, pooled as the exact pixels') keeps
+    // the preview's noise from passing for edges.
+    st = provider->FetchPreview({options.textureSplit && caps.splitRadiance, useVariance}, &preview, poolRadius);
     previewS = Since(tp);
     PreviewScheduleOptions so;
     so.maxRounds = f.rounds.maxRounds;
-    if (st.ok()) st = ReconstructWithPreview(timed, *preview, options, so, &rec, &sched);
+    if (st.ok() && haveGoal) {
+      // Each run of the search in two rounds at most: its validation pixels go
+      // with its first; pixels left at their preview value after one round
+      // carry errors few validation pixels see (docs/QUALITY.md).
+      so.maxRounds = std::min(f.rounds.maxRounds, 2);
+      QualityReport report;
+      const auto tq = Clock::now();
+      st = ReconstructToQualityWithPreview(timed, *preview, options, goal, so, &rec, &report, &qrounds);
+      goalS = Since(tq);
+      if (st.ok()) quality = std::move(report);
+      sched.previewStandIns = qrounds.previewStandIns;
+    } else if (st.ok()) {
+      st = ReconstructWithPreview(timed, *preview, options, so, &rec, &sched);
+    }
   } else {
-    st = Reconstruct(timed, options, &rec);
+    st = ReconstructFor(timed, options, f.pipe.engine, &rec, &quality);
   }
   progress.Done();
   if (!st.ok()) return Fail("'" + f.scene + "': " + timed.step + ": " + st.message());
@@ -366,7 +389,10 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   const ReconstructionStats& stats_ = rec.stats;
   double roundsS = 0;
   for (const auto& r : timed.rounds) roundsS += r.seconds;
-  const double engineS = schedule == RoundSchedule::kPreview ? sched.timeEngineS : stats_.timeEngineS;
+  // With a goal: the search's time but its rounds (engine runs, validation, the cache).
+  const double engineS = schedule != RoundSchedule::kPreview ? stats_.timeEngineS
+                         : quality                            ? goalS - qrounds.timeExactS
+                                                              : sched.timeEngineS;
   const std::string method = options.fullEvaluation ? "full" : f.pipe.engine.method;
 
   // Blender's own layout: <view layer>.Combined.R/G/B/A.
@@ -390,6 +416,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   meta.strings.push_back({"dcm:schedule", std::string(ToString(schedule))});
   meta.strings.push_back({"dcm:options", toolkit::OptionsToJson(options).dump()});
   meta.floats.push_back({"dcm:exact_fraction", float(stats_.exactFraction())});
+  if (quality) toolkit::AddQualityMetadata(*quality, &meta);
   if (frame >= 0) meta.strings.push_back({"Frame", std::to_string(frame)});
   toolkit::AddMetadata(meta, &image.attributes);
   if (Status w = toolkit::WriteOutputExr(output, image, f.pipe.exr); !w.ok()) return Fail(w.message());
@@ -428,6 +455,10 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     b["variance"] = useVariance ? "halves" : provider->Capabilities().variance ? "halves, not used" : "none";
     if (!std::isnan(noisePsnr)) b["noise_psnr"] = noisePsnr;
     j["blender"] = b;
+    if (quality) {
+      toolkit::AddQualityJson(*quality, f.pipe.engine.targetPsnr.value_or(0), f.pipe.engine.budget.value_or(0), &j);
+      if (schedule == RoundSchedule::kPreview) j["quality"]["searches"] = qrounds.passes;
+    }
     if (Status w = toolkit::WriteJson(stats, j); !w.ok()) return Fail(w.message());
   }
   if (Status w = outputs.Commit(); !w.ok()) return Fail(w.message());
@@ -441,6 +472,12 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   std::printf("  time           Blender start %.2f s, guides %.2f s, preview %.2f s, rounds %.2f s, DCM %.2f s, "
               "total %.2f s\n",
               handshakeS - guidesRenderS, guidesRenderS + timed.guidesS, previewS, roundsS, engineS, wallS);
+  if (quality) {
+    std::printf("  quality        %s\n", QualityLine(*quality, f.pipe.engine).c_str());
+    if (f.pipe.engine.verbose) std::cerr << QualityLine(*quality, f.pipe.engine) << "\n";
+    if (const std::string w = QualityWarning(*quality, f.pipe.engine); !w.empty())
+      std::cerr << "dcm " << cmd << ": warning: " << w << "\n";
+  }
   for (const auto& w : toolkit::SampleWarnings(stats_)) std::cerr << "dcm " << cmd << ": warning: " << w << "\n";
   return kExitOk;
 }

@@ -18,6 +18,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
@@ -25,6 +26,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "commands.h"
@@ -37,6 +39,7 @@
 #include "dcm/downsample.h"
 #include "dcm/povray/povray_preview.h"
 #include "dcm/povray/povray_provider.h"
+#include "dcm/quality_preview.h"
 #include "dcm/reconstructor.h"
 #include "dcm/round_schedule.h"
 #include "engine_flags.h"
@@ -126,7 +129,6 @@ int RunPovray(const PovrayFlags& f) {
   if (Status st = ParseSize(f.size, &outW, &outH); !st.ok()) return Fail(st.message(), kExitUsage);
   ReconstructionOptions options;
   if (Status st = ToOptions(f.engine, &options); !st.ok()) return Fail(st.message(), kExitUsage);
-  if (Status st = RefuseQualityGoal(f.engine, "povray"); !st.ok()) return Fail(st.message(), kExitUsage);
   if (Status st = toolkit::CheckExrFormat(f.exr); !st.ok()) return Fail(st.message(), kExitUsage);
   const bool full = options.fullEvaluation;
   if (full && !f.sampleMap.empty())
@@ -158,6 +160,11 @@ int RunPovray(const PovrayFlags& f) {
 
   Reconstruction rec;
   PreviewScheduleStats sched;
+  // --target-psnr / --budget: the quality search, each run planned on the preview.
+  QualityGoal goal;
+  const bool haveGoal = QualityGoalOf(f.engine, &goal);
+  std::optional<QualityReport> quality;
+  QualityRoundStats qrounds;
   double denseS = 0, engineS = 0;
   int64_t previewPixels = 0;
   if (full) {
@@ -199,12 +206,26 @@ int RunPovray(const PovrayFlags& f) {
       std::vector<RGB> L, Li, Lc;
       for (size_t i = 0; i < lit.size(); ++i) (lit[i] == povray::Pass::kBeauty ? L : Li) = std::move(preview[i]);
       PreviewSplit(L, &Li, pw, ph, W, H, g.texture, &Lc);
-      povray::PovrayPreview previewProvider(*provider, pw, ph, std::move(Li), std::move(Lc));
+      // With a goal, stand-ins from the preview alone: one that borrowed from
+      // rendered neighbours would take a validation pixel's own exact value,
+      // and the estimate would err high.
+      povray::PovrayPreview previewProvider(*provider, pw, ph, std::move(Li), std::move(Lc), haveGoal ? -1 : 2);
       PreviewScheduleOptions so;
       so.maxRounds = f.rounds.maxRounds;
-      st = ReconstructWithPreview(*provider, previewProvider, options, so, &rec, &sched);
+      if (haveGoal) {
+        // Each run of the search in two rounds at most: its validation pixels go
+        // with its first; pixels left at their preview value after one round
+        // carry errors few validation pixels see (docs/QUALITY.md).
+        so.maxRounds = std::min(f.rounds.maxRounds, 2);
+        QualityReport report;
+        st = ReconstructToQualityWithPreview(*provider, previewProvider, options, goal, so, &rec, &report, &qrounds);
+        if (st.ok()) quality = std::move(report);
+        sched.previewStandIns = qrounds.previewStandIns;
+      } else {
+        st = ReconstructWithPreview(*provider, previewProvider, options, so, &rec, &sched);
+      }
     } else {
-      st = Reconstruct(*provider, options, &rec);
+      st = ReconstructFor(*provider, options, f.engine, &rec, &quality);
     }
     if (!st.ok()) return Fail(st.message());
     engineS = Since(te);
@@ -240,7 +261,10 @@ int RunPovray(const PovrayFlags& f) {
   p["preview_passes"] = full || schedule != RoundSchedule::kPreview ? "" : f.previewPasses;
   // The engine counts the stand-ins among its exact pixels (exact_pixels).
   p["preview_stand_ins"] = sched.previewStandIns;
-  p["exact_pixels_rendered"] = rec.stats.exactPixels - sched.previewStandIns;
+  // The quality search counts only what was rendered.
+  p["exact_pixels_rendered"] = quality && schedule == RoundSchedule::kPreview
+                                   ? qrounds.renderedPixels
+                                   : rec.stats.exactPixels - sched.previewStandIns;
   p["processes_at_a_time"] = f.processes;
   nlohmann::json phases;
   phases[full ? "full_s" : "guides_and_preview_s"] = denseS;
@@ -248,6 +272,10 @@ int RunPovray(const PovrayFlags& f) {
   phases["engine_s"] = engineS;
   p["phases_s"] = phases;
   j["povray"] = p;
+  if (quality) {
+    toolkit::AddQualityJson(*quality, f.engine.targetPsnr.value_or(0), f.engine.budget.value_or(0), &j);
+    if (schedule == RoundSchedule::kPreview) j["quality"]["searches"] = qrounds.passes;
+  }
 
   toolkit::Metadata meta;
   meta.strings.push_back({"dcm:provider", "povray"});
@@ -256,6 +284,7 @@ int RunPovray(const PovrayFlags& f) {
   meta.strings.push_back({"dcm:method", full ? "full" : f.engine.method});
   meta.strings.push_back({"dcm:options", toolkit::OptionsToJson(options).dump()});
   meta.floats.push_back({"dcm:exact_fraction", float(rec.stats.exactFraction())});
+  if (quality) toolkit::AddQualityMetadata(*quality, &meta);
   const Bounds2i frame{{0, 0}, {rec.width, rec.height}};
   if (Status w = toolkit::WriteRgbExr(f.output, frame, frame, rec.image, meta, false, f.exr); !w.ok())
     return Fail(w.message());
@@ -280,7 +309,13 @@ int RunPovray(const PovrayFlags& f) {
       for (double s : runs.roundS) std::printf(" %.2f", s);
       std::printf(" s, engine %.2f s\n", engineS);
     }
+    if (quality) std::printf("  quality        %s\n", QualityLine(*quality, f.engine).c_str());
     if (haveRef) std::printf("  PSNR           %.2f dB against %s\n", error.psnr, f.reference.c_str());
+  }
+  if (quality) {
+    if (f.engine.verbose) std::cerr << QualityLine(*quality, f.engine) << "\n";
+    if (const std::string w = QualityWarning(*quality, f.engine); !w.empty())
+      std::cerr << "dcm povray: warning: " << w << "\n";
   }
   return kExitOk;
 }

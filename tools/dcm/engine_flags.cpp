@@ -210,7 +210,8 @@ void AddRoundFlags(CLI::App* app, RoundFlags* f) {
       ->capture_default_str();
   app->add_option("--max-rounds", f->maxRounds,
                   "with the preview schedule: calls to the renderer at most; pixels still wanted after them keep "
-                  "their preview value (counted in the stats)")
+                  "their preview value (counted in the stats). With --target-psnr or --budget: per run of the "
+                  "search, at most 2)")
       ->transform(Integer(1, 1000))
       ->capture_default_str();
 }
@@ -224,15 +225,6 @@ Status ScheduleFor(const RoundFlags& flags, const RoundCost& cost, bool previewA
   if (*out == RoundSchedule::kPreview && !previewAvailable)
     return Status::Error("--schedule preview: the renderer gives no preview");
   return Status::Ok();
-}
-
-Status RefuseQualityGoal(const EngineFlags& f, const std::string& command) {
-  if (!f.targetPsnr && !f.budget) return Status::Ok();
-  // The quality search reruns the engine level by level on a sample cache;
-  // with a renderer whose rounds cost a latency it would pay one per step.
-  return Status::Error(std::string(f.targetPsnr ? "--target-psnr" : "--budget") + ": not with dcm " + command +
-                       " yet (its rounds are planned on a preview; set --threshold, or reconstruct its passes with "
-                       "dcm reconstruct --target-psnr)");
 }
 
 Status CheckDownsample(int width, int height, int n, const std::string& what) {

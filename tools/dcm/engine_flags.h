@@ -64,10 +64,6 @@ void AddRoundFlags(CLI::App* app, RoundFlags* flags);
 /// `previewAvailable` (a preview asked for without one is an error naming --schedule).
 Status ScheduleFor(const RoundFlags& flags, const RoundCost& cost, bool previewAvailable, RoundSchedule* out);
 
-/// An error naming --target-psnr or --budget for a command that cannot
-/// reach a quality goal yet (`command`: "povray", "blender"), else Ok.
-Status RefuseQualityGoal(const EngineFlags& flags, const std::string& command);
-
 /// --downsample `n` on an input of `width` x `height` pixels: both must be
 /// multiples of n (a partial box at the edge would average fewer samples).
 /// `what` names the input ("the provider's image", "the inputs").

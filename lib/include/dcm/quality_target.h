@@ -50,6 +50,14 @@ struct QualityGoal {
   /// sRGB of each channel clipped to [0,1], as the stats' PSNR
   /// (tools/common/metrics.h). A host with a colour pipeline passes its own.
   std::function<RGB(RGB)> display;
+  /// How one run of the search reconstructs at the options it is given, from
+  /// the provider the search hands it (a cache over the caller's, which
+  /// counts the pixels and enforces the budget). Empty: dcm::Reconstruct. A
+  /// renderer whose rounds cost a latency plans each run on a preview
+  /// instead (ReconstructToQualityWithPreview, dcm/quality_preview.h).
+  std::function<Status(SampleProvider& provider, const ReconstructionOptions& options, Reconstruction* out,
+                       std::vector<Point2i>* pending)>
+      reconstruct;
 
   /// Checks the ranges ("--target-psnr: ..."); the message names the flag.
   Status Validate() const;

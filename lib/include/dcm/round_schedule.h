@@ -80,12 +80,16 @@ RGB UpsampleBilinear(const std::vector<RGB>& image, int previewWidth, int previe
 
 /// A provider of stand-in samples from a dense image at `scale` times coarser
 /// resolution than the working image (1: the same), upsampled bilinearly:
-/// L, and L_i/L_c when given (empty vectors: not given). For previews that a
-/// renderer makes at low resolution.
+/// L, and L_i/L_c when given (empty vectors: not given), and the variance of
+/// the preview's L when given (a few-samples render is noisy: with it, the
+/// engine's noise regime tests the preview's contrasts against its noise
+/// instead of taking the noise for edges). For previews that a renderer makes
+/// at low resolution or at few samples.
 class ImagePreviewProvider : public SampleProvider {
  public:
   ImagePreviewProvider(int workWidth, int workHeight, int previewWidth, int previewHeight,
-                       std::vector<RGB> L, std::vector<RGB> Li = {}, std::vector<RGB> Lc = {});
+                       std::vector<RGB> L, std::vector<RGB> Li = {}, std::vector<RGB> Lc = {},
+                       std::vector<RGB> variance = {});
   ProviderCapabilities Capabilities() const override;
   Status Guides(const Bounds2i& region, const GuideRequest& what, GuideImage* out) override;
   Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what,
@@ -93,7 +97,7 @@ class ImagePreviewProvider : public SampleProvider {
 
  private:
   int workWidth_, workHeight_, previewWidth_, previewHeight_;
-  std::vector<RGB> L_, Li_, Lc_;
+  std::vector<RGB> L_, Li_, Lc_, variance_;
 };
 
 }  // namespace dcm

@@ -116,7 +116,9 @@ def serve(proto, session):
             g = session.guides()
             sl = (slice(y0, y1), slice(x0, x1))
             n = (x1 - x0) * (y1 - y0)
-            flat = [g[k][sl].reshape(n, 3) for k in ("L", "Li", "Lc")]
+            # A preview of one sample has no halves: its variance unknown (NaN, which dcm takes as none).
+            flat = [g[k][sl].reshape(n, 3) if k in g else np.full((n, 3), np.nan, np.float32)
+                    for k in ("L", "Li", "Lc", "var")]
             proto.send("samples %d" % n, _records(t[5].split(","), *flat))
         else:
             raise ValueError("unknown request '%s'" % line[:60])

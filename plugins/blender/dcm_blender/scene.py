@@ -420,9 +420,10 @@ class Session:
             g["Lc"] = g["L"] - g["Li"] * g["texture"]
             if len(pls) == 2:
                 # The preview's variance (dcm::HalvesVariance), at the exact pixels' samples.
+                # g["var"]: the preview's own, which dcm weighs while it plans on the preview.
                 a, b = self._rgb(pls[0], "Combined"), self._rgb(pls[1], "Combined")
-                var = (a - b) ** 2 * (counts[0] * counts[1] / float(ps) ** 2) * (ps / float(self.samples))
-                self.noise_psnr = _noise_psnr(var, g["L"])
+                g["var"] = ((a - b) ** 2 * (counts[0] * counts[1] / float(ps) ** 2)).astype(np.float32)
+                self.noise_psnr = _noise_psnr(g["var"] * (ps / float(self.samples)), g["L"])
             self._guides = g
         return self._guides
 

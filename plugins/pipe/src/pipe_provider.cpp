@@ -378,13 +378,14 @@ Status PipeProvider::Preview(const Bounds2i& region, const SampleRequest& what, 
   if (region.empty() || Intersect(region, all) != region)
     return Status::Error(Prefix() + ": preview region outside the image");
   const bool split = what.split && caps_.splitRadiance;
+  const bool variance = what.variance && caps_.variance;
   const std::string request = "preview " + std::to_string(region.min.x) + " " + std::to_string(region.min.y) + " " +
                               std::to_string(region.max.x) + " " + std::to_string(region.max.y) + " L" +
-                              (split ? ",split" : "");
+                              (split ? ",split" : "") + (variance ? ",variance" : "");
   const std::string line = request + "\n";
   const size_t n = size_t(region.area());
   out->assign(n, ExactSample{});
-  return ReadSamples(request, std::vector<char>(line.begin(), line.end()), n, split, false, out->data());
+  return ReadSamples(request, std::vector<char>(line.begin(), line.end()), n, split, variance, out->data());
 }
 
 Status PipeProvider::Finish() {

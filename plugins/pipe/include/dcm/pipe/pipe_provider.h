@@ -76,12 +76,16 @@ class PipeProvider final : public SampleProvider {
   bool hasPreview() const { return preview_; }
 
   /// Asks the child for the preview samples of every pixel of `region`
-  /// ("preview" request), row-major. Only when hasPreview().
+  /// ("preview" request), row-major, with the preview's variance where
+  /// `what.variance` and the child announced `variance`. Only when hasPreview().
   Status Preview(const Bounds2i& region, const SampleRequest& what, std::vector<ExactSample>* out);
 
   /// The child's preview of the whole image, fetched in one request, as a
-  /// provider of stand-in samples for ReconstructWithPreview().
-  Status FetchPreview(const SampleRequest& what, std::unique_ptr<SampleProvider>* out);
+  /// provider of stand-in samples for ReconstructWithPreview(); with
+  /// `what.variance`, the preview's variance, pooled over the pixels of the
+  /// same surface (object and shader IDs) within `varianceRadius` pixels
+  /// (dcm::SurfaceWindowMean; 0: each pixel's own).
+  Status FetchPreview(const SampleRequest& what, std::unique_ptr<SampleProvider>* out, int varianceRadius = 0);
 
   /// Sends "quit", closes the child's stdin and waits for it to exit. An exit
   /// status other than 0 (or a signal) is an error. Idempotent: returns the

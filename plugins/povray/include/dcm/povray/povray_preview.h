@@ -20,7 +20,9 @@ namespace dcm::povray {
 /// their preview value by the schedule) take their neighbours' light.
 class PovrayPreview final : public SampleProvider {
  public:
-  /// `Li`, `Lc`: the preview at `previewWidth` x `previewHeight`.
+  /// `Li`, `Lc`: the preview at `previewWidth` x `previewHeight`. `radius`
+  /// below 0: the preview alone, whatever was rendered (the quality search
+  /// needs stand-ins that do not take a validation pixel's own exact value).
   PovrayPreview(const PovrayProvider& exact, int previewWidth, int previewHeight, std::vector<RGB> Li,
                 std::vector<RGB> Lc, int radius = 2);
   ProviderCapabilities Capabilities() const override;
