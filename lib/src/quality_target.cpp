@@ -278,8 +278,9 @@ constexpr double kProxySpread = 0.25;
 /// the bilinear interpolation of its elementary lattice, spread by a max
 /// filter (kProxySpread). The error that remains sits by what the engine has
 /// seen of an edge, a highlight or a thin object: the ends it did not follow,
-/// the crossings it filled. Noise-free, a box the engine evaluated entirely
-/// has no error (the result is its exact value): 0 there.
+/// the crossings it filled, the preview stand-ins it kept. Noise-free, a box
+/// the engine evaluated entirely has no error (the result is its exact
+/// value): 0 there.
 std::vector<double> ErrorProxy(const Reconstruction& rec, const QualityGoal& goal, int s, bool noise) {
   const int outW = rec.width, outH = rec.height;
   const size_t N = size_t(outW) * size_t(outH);
@@ -317,6 +318,16 @@ std::vector<double> ErrorProxy(const Reconstruction& rec, const QualityGoal& goa
         m = std::max(m, rows[size_t(k) * size_t(outW) + size_t(x)]);
       proxy[size_t(y) * size_t(outW) + size_t(x)] = m;
     }
+  // A preview stand-in is a pixel the engine wanted exact and did not get:
+  // as likely wrong as the likeliest detail.
+  double top = 0;
+  for (double p : proxy) top = std::max(top, p);
+  for (int y = 0; y < outH; ++y)
+    for (int x = 0; x < outW; ++x)
+      for (int wy = y * s; wy < std::min(rec.workHeight, (y + 1) * s); ++wy)
+        for (int wx = x * s; wx < std::min(rec.workWidth, (x + 1) * s); ++wx)
+          if (rec.sampleMap[size_t(wy) * size_t(rec.workWidth) + size_t(wx)] == SampleReason::kPreviewStandIn)
+            proxy[size_t(y) * size_t(outW) + size_t(x)] = top > 0 ? top : 1.0;
   if (noise) return proxy;
   for (int y = 0; y < outH; ++y)
     for (int x = 0; x < outW; ++x) {
