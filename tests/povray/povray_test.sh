@@ -117,7 +117,9 @@ quality)
   rounds=$(json "$tmp/q.json" povray.rounds)
   [[ $reached == True ]] || fail "--target-psnr 35: not reached by the report (lower bound $est dB)"
   awk -v p="$psnr" 'BEGIN { exit !(p >= 34.5) }' || fail "--target-psnr 35: $psnr dB against --full"
-  [[ $rounds -ge 1 && $rounds -le $((2 * runs + 4)) ]] || fail "--target-psnr 35: $rounds rounds for $runs runs"
+  # Two calls per run (the first validation draw with the first), one per later draw: at most three
+  # where the bound falls short, and up to three confirming draws (kMaxConfirmations).
+  [[ $rounds -ge 1 && $rounds -le $((2 * runs + 6)) ]] || fail "--target-psnr 35: $rounds rounds for $runs runs"
   ok "--target-psnr 35: $psnr dB against --full (lower bound $est dB), $runs runs in $rounds rounds"
   "$dcm" povray "$scene" -o "$tmp/b.exr" --size $size --budget 0.2 --stats "$tmp/b.json" --povray "$pov" -q ||
     fail "dcm povray --budget 0.2 failed"
