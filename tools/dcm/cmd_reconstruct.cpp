@@ -180,18 +180,15 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
   return kExitOk;
 }
 
-/// The share of exact pixels the noisy default may spend (issue 26's bound).
-constexpr double kNoisyBudget = 0.35;
-
 /// With noisy dense samples (their variance given or estimated) and no goal,
-/// threshold or method of the user's, dcm aims at a result at least as close
-/// to the converged image as the render itself, within kNoisyBudget of exact
-/// pixels: --target-psnr render --budget 0.35 (docs/NOISE.md).
+/// threshold or method of the user's, dcm refines from the default threshold
+/// until the result is estimated at least as close to the converged image as
+/// the render itself: --target-psnr render (docs/NOISE.md). No budget: with
+/// one the search would start coarser than the default (QualityGoal).
 bool NoisyDefaultGoal(const aov::AovProvider& provider, bool sparse, EngineFlags* e) {
   if (sparse || !provider.Capabilities().variance) return false;
   if (e->threshold || e->targetPsnr || e->budget || e->full || e->method != "dcm") return false;
   e->targetPsnr = kTargetRender;
-  e->budget = kNoisyBudget;
   return true;
 }
 
@@ -279,9 +276,8 @@ int RunReconstruct(const ReconstructFlags& f) {
   EngineFlags engine = f.engine;
   if (NoisyDefaultGoal(*provider, sparse, &engine) && engine.verbose)
     std::cerr << "dcm " << cmd << ": noisy samples: refining until the result is estimated at least as close to "
-              << "the converged image as the render itself, within " << 100 * kNoisyBudget
-              << " % exact pixels (--target-psnr render --budget " << kNoisyBudget
-              << "; --threshold T for one threshold's result)\n";
+              << "the converged image as the render itself (--target-psnr render; --threshold T for one "
+              << "threshold's result)\n";
   aov_common::Outputs outputs(cmd);  // before the run: --progressive writes during it
   ExrReconstruction run;
   bool usage = false;
