@@ -5,8 +5,9 @@
 #include <chrono>
 #include <new>
 #include <string>
-#include <tuple>
 #include <utility>
+
+#include "guide_cache.h"
 
 namespace dcm {
 
@@ -40,15 +41,7 @@ class RoundKeeper : public SampleProvider {
   ProviderCapabilities Capabilities() const override { return caps_; }
 
   Status Guides(const Bounds2i& region, const GuideRequest& what, GuideImage* out) override {
-    for (const auto& [r, w, image] : guides_)
-      if (r == region && w.objectId == what.objectId && w.shaderId == what.shaderId && w.texture == what.texture &&
-          w.normal == what.normal) {
-        *out = image;
-        return Status::Ok();
-      }
-    DCM_RETURN_IF_ERROR(exact_.Guides(region, what, out));
-    guides_.push_back({region, what, *out});
-    return Status::Ok();
+    return guides_.Get(exact_, region, what, out);
   }
 
   Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what, std::span<ExactSample> out) override {
@@ -173,7 +166,7 @@ class RoundKeeper : public SampleProvider {
   SampleProvider& preview_;
   ProviderCapabilities caps_;
   QualityRoundStats* stats_;
-  std::vector<std::tuple<Bounds2i, GuideRequest, GuideImage>> guides_;
+  GuideCache guides_;
   std::vector<int32_t> epoch_;  ///< per pixel: the run it was rendered in, -1 not rendered
   std::vector<uint8_t> mask_;   ///< what its sample holds (Mask)
   std::vector<ExactSample> samples_;

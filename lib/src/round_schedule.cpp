@@ -8,8 +8,9 @@
 #include <cmath>
 #include <new>
 #include <string>
-#include <tuple>
 #include <utility>
+
+#include "guide_cache.h"
 
 namespace dcm {
 
@@ -20,11 +21,6 @@ constexpr std::array<std::pair<std::string_view, RoundSchedule>, 2> kSchedules{{
 
 double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
-
-bool SameGuideRequest(const GuideRequest& a, const GuideRequest& b) {
-  return a.objectId == b.objectId && a.shaderId == b.shaderId && a.texture == b.texture &&
-         a.normal == b.normal;
 }
 
 /// What the engine sees during planning: the exact provider's guides (asked
@@ -46,14 +42,7 @@ class PlanningProvider : public SampleProvider {
   ProviderCapabilities Capabilities() const override { return caps_; }
 
   Status Guides(const Bounds2i& region, const GuideRequest& what, GuideImage* out) override {
-    for (const auto& [r, w, image] : guides_)
-      if (r == region && SameGuideRequest(w, what)) {
-        *out = image;
-        return Status::Ok();
-      }
-    Status s = exact_.Guides(region, what, out);
-    if (s.ok()) guides_.push_back({region, what, *out});
-    return s;
+    return guides_.Get(exact_, region, what, out);
   }
 
   Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what,
@@ -109,7 +98,7 @@ class PlanningProvider : public SampleProvider {
   SampleProvider& preview_;
   ProviderCapabilities caps_;
   SampleRequest request_;
-  std::vector<std::tuple<Bounds2i, GuideRequest, GuideImage>> guides_;
+  GuideCache guides_;
   std::vector<uint8_t> known_, wanted_;
   std::vector<ExactSample> samples_;
   std::vector<Point2i> wantedList_;
