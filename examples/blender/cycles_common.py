@@ -1,8 +1,9 @@
 # What every Cycles scene of examples/blender shares, so that
 # `dcm reconstruct --preset blender` reads all their renders alike: the render
-# settings and passes (setup_render), materials with a pass index, and the
-# small geometry helpers. Imported by make_and_render.py (the room, the tuning
-# scene) and check_scenes.py (the check set); Blender 3.4.
+# settings and passes (setup_render, enable_dcm_passes), materials with a pass
+# index, and the small geometry helpers. Imported by make_and_render.py (the
+# room, the tuning scene), check_scenes.py (the check set) and enable_passes.py
+# (a user's file); Blender 3.4.
 import math
 import os
 
@@ -117,6 +118,25 @@ def look_at_camera(loc, target, lens):
 
 # ------------------------------------------------------------------ render --
 
+def enable_dcm_passes(vl):
+    """The passes `dcm reconstruct --preset blender` reads, on view layer vl:
+    Combined, Normal (creases inside one object, --crease-angle), IndexOB,
+    IndexMA, UV, Diffuse/Glossy/Transmission Color+Direct+Indirect, Emit, Env,
+    Cryptomatte object and material."""
+    vl.use_pass_combined = True
+    vl.use_pass_normal = True
+    vl.use_pass_object_index = True
+    vl.use_pass_material_index = True
+    vl.use_pass_uv = True
+    for kind in ("diffuse", "glossy", "transmission"):
+        for part in ("color", "direct", "indirect"):
+            setattr(vl, "use_pass_%s_%s" % (kind, part), True)
+    vl.use_pass_emit = True
+    vl.use_pass_environment = True
+    vl.use_pass_cryptomatte_object = True
+    vl.use_pass_cryptomatte_material = True
+
+
 def setup_render(args):
     sc = bpy.context.scene
     sc.render.engine = "CYCLES"
@@ -153,19 +173,8 @@ def setup_render(args):
 
     vl = sc.view_layers[0]
     vl.name = "ViewLayer"
-    vl.use_pass_combined = True
+    enable_dcm_passes(vl)
     vl.use_pass_z = True
-    vl.use_pass_normal = True
-    vl.use_pass_object_index = True
-    vl.use_pass_material_index = True
-    vl.use_pass_uv = True
-    for kind in ("diffuse", "glossy", "transmission"):
-        for part in ("color", "direct", "indirect"):
-            setattr(vl, "use_pass_%s_%s" % (kind, part), True)
-    vl.use_pass_emit = True
-    vl.use_pass_environment = True
-    vl.use_pass_cryptomatte_object = True
-    vl.use_pass_cryptomatte_material = True
     vl.pass_cryptomatte_depth = 2
 
     im = sc.render.image_settings

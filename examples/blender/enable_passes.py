@@ -22,6 +22,9 @@ import sys
 
 import bpy
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from cycles_common import enable_dcm_passes  # noqa: E402
+
 
 def main():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
@@ -67,18 +70,7 @@ def main():
 
     rendering = [vl for vl in sc.view_layers if vl.use]
     for vl in sc.view_layers:
-        vl.use_pass_combined = True
-        vl.use_pass_normal = True  # creases inside one object (dcm --crease-angle)
-        vl.use_pass_object_index = True
-        vl.use_pass_material_index = True
-        vl.use_pass_uv = True
-        for kind in ("diffuse", "glossy", "transmission"):
-            for part in ("color", "direct", "indirect"):
-                setattr(vl, "use_pass_%s_%s" % (kind, part), True)
-        vl.use_pass_emit = True
-        vl.use_pass_environment = True
-        vl.use_pass_cryptomatte_object = True
-        vl.use_pass_cryptomatte_material = True
+        enable_dcm_passes(vl)
     if len(rendering) > 1:
         print("enable_passes.py: %d view layers render; pass --layer NAME to dcm (%s)"
               % (len(rendering), ", ".join(vl.name for vl in rendering)))
