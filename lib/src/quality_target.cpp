@@ -322,12 +322,10 @@ std::vector<double> ErrorProxy(const Reconstruction& rec, const QualityGoal& goa
   // as likely wrong as the likeliest detail.
   double top = 0;
   for (double p : proxy) top = std::max(top, p);
-  for (int y = 0; y < outH; ++y)
-    for (int x = 0; x < outW; ++x)
-      for (int wy = y * s; wy < std::min(rec.workHeight, (y + 1) * s); ++wy)
-        for (int wx = x * s; wx < std::min(rec.workWidth, (x + 1) * s); ++wx)
-          if (rec.sampleMap[size_t(wy) * size_t(rec.workWidth) + size_t(wx)] == SampleReason::kPreviewStandIn)
-            proxy[size_t(y) * size_t(outW) + size_t(x)] = top > 0 ? top : 1.0;
+  for (int wy = 0; wy < rec.workHeight; ++wy)
+    for (int wx = 0; wx < rec.workWidth; ++wx)
+      if (rec.sampleMap[size_t(wy) * size_t(rec.workWidth) + size_t(wx)] == SampleReason::kPreviewStandIn)
+        proxy[size_t(wy / s) * size_t(outW) + size_t(wx / s)] = top > 0 ? top : 1.0;
   if (noise) return proxy;
   for (int y = 0; y < outH; ++y)
     for (int x = 0; x < outW; ++x) {
