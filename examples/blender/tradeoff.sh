@@ -23,6 +23,9 @@ if [ -n "${BLEND:-}" ]; then
   src=$(cd "$(dirname "$BLEND")" && pwd)
   for f in "$src"/*; do [ -e "$out/$(basename "$f")" ] || ln -s "$f" "$out/"; done
   [ -e "$out/room.blend" ] || ln -s "$src/$(basename "$BLEND")" "$out/room.blend"
+elif [ ! -e "$out/room.blend" ]; then  # the room, made once, in OUT_DIR
+  (cd "$out" && blender -b --factory-startup --python "$here/make_and_render.py" -- \
+    --out room_1spp.exr --view "${VIEW:-a}" --res "$res" --samples 1 --save-blend room.blend >/dev/null)
 fi
 top=${spps##* }
 for spp in $spps; do
@@ -34,10 +37,6 @@ for spp in $spps; do
     [ -e "$d/$(basename "$f")" ] || ln -s "$f" "$d/"
   done
   [ -f "$d/done" ] && continue
-  [ -e "$out/room.blend" ] || {  # the room, made once, in OUT_DIR
-    (cd "$out" && blender -b --factory-startup --python "$here/make_and_render.py" -- \
-      --out room_1spp.exr --view "${VIEW:-a}" --res "$res" --samples 1 --save-blend room.blend >/dev/null)
-    ln -sf "$out/room.blend" "$d/"; for f in "$out"/*.png; do ln -sf "$f" "$d/"; done; }
   adaptive=""
   [ "$spp" = "$top" ] && adaptive=${ADAPTIVE:-0.1 0.03 0.01}
   ADAPTIVE="$adaptive" DCM_VARIANTS="${DCM_FLAGS:- }" "$here/dcm_vs_cycles.sh" "$d" "$res" "$spp" "$ref_spp" "${VIEW:-a}" \
