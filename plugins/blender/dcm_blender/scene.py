@@ -179,8 +179,9 @@ class Session:
             self.notes.append("denoising off (it would see a frame of black, unrendered pixels)")
             c.set(cy, "use_denoising", False)
         c.set(cy, "samples", self.samples)
-        # Rounds of exact pixels switch adaptive sampling on (masked_pixels_stop).
-        c.restore_later(cy, ("adaptive_threshold", "adaptive_min_samples"))
+        # Rounds of exact pixels switch adaptive sampling on (_masked_pixels_stop); a round
+        # that fails leaves it so, and the restore undoes it.
+        c.restore_later(cy, ("use_adaptive_sampling", "adaptive_threshold", "adaptive_min_samples"))
         # Two halves of the samples with two seeds: the second seed is the next one.
         self.halves = a.variance_halves and self.samples >= 2
         self.seeds = (cy.seed, (cy.seed + 1) % 2 ** 31) if self.halves else (cy.seed,)
