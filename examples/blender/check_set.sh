@@ -48,7 +48,7 @@ render() {  # SCENE EXR SAMPLES SEED [ARGS...]: renders EXR unless it exists
     { tail -20 "$log" >&2; rm -f "$tmp"; exit 1; }
   mv "$tmp" "$exr"
   local wall cycles
-  wall=$(echo "$(date +%s.%N) - $t0" | bc)
+  wall=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.3f", b - a }')
   cycles=$(oiiotool --info -v "$exr" | sed -n 's/.*cycles\.ViewLayer\.render_time: "\(.*\)"/\1/p')
   printf '%s\t%s\t%s\t%.1f\t%s\n' "$(basename "$exr")" "$spp" "$seed" "$wall" "$cycles" >> "$times"
   echo "$(basename "$exr"): ${wall%.*} s (Cycles $cycles)" >&2

@@ -35,25 +35,26 @@ sc.render.filepath = '$PWD/$2'
 bpy.ops.render.render(write_still=True)" >/dev/null
 }
 now() { /usr/bin/python3 -c 'import time; print(time.monotonic())'; }  # the clock dcm's --stats use
+since() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.3f", b - a }'; }  # seconds from $1 to $2
 # DCM_VARIANTS: extra dcm flags per run, separated by '|' (default: one run, no flags).
 IFS='|' read -r -a variants <<< "${DCM_VARIANTS:- }"
 t0=$(now); render "$spp" full.exr; t1=$(now)
-full_s=$(echo "$t1 - $t0" | bc -l)
+full_s=$(since "$t0" "$t1")
 printf "full %.2f s\n" "$full_s" > times.txt
 dcm_s=()
 for i in "${!variants[@]}"; do
   t1=$(now)
   "$dcm" blender room.blend -o "dcm$i.exr" --stats "dcm$i.json" --samples "$spp" -q ${variants[$i]} >/dev/null
   t2=$(now)
-  dcm_s+=("$(echo "$t2 - $t1" | bc -l)")
+  dcm_s+=("$(since "$t1" "$t2")")
   printf "dcm %s: %.2f s\n" "${variants[$i]}" "${dcm_s[$i]}" >> times.txt
 done
 # ADAPTIVE="T1 T2 ...": Cycles' adaptive sampling at these noise thresholds, the rival at equal time.
 adaptive_s=()
 for t in ${ADAPTIVE:-}; do
   t1=$(now); render "$spp" "adaptive_$t.exr" "$t"; t2=$(now)
-  adaptive_s+=("$t:$(echo "$t2 - $t1" | bc -l)")
-  printf "adaptive %s: %.2f s\n" "$t" "$(echo "$t2 - $t1" | bc -l)" >> times.txt
+  adaptive_s+=("$t:$(since "$t1" "$t2")")
+  printf "adaptive %s: %.2f s\n" "$t" "$(since "$t1" "$t2")" >> times.txt
 done
 # The reference with a seed of its own: with the file's, its first samples
 # would be the full render's and dcm's, and their errors against it smaller.
