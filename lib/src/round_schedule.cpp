@@ -136,6 +136,8 @@ Status ReconstructWithPreview(SampleProvider& exact, SampleProvider& preview,
   if (schedule.maxRounds < 1)
     return Status::Error("preview schedule: maxRounds must be at least 1 (is " +
                          std::to_string(schedule.maxRounds) + ")");
+  if (schedule.correctionRadius < 0)
+    return Status::Error("preview schedule: correctionRadius must not be negative");
   if (!(schedule.minRoundShare >= 0 && schedule.minRoundShare <= 1))
     return Status::Error("preview schedule: minRoundShare must be in [0, 1]");
   const ProviderCapabilities exactCaps = exact.Capabilities();
@@ -158,7 +160,7 @@ Status ReconstructWithPreview(SampleProvider& exact, SampleProvider& preview,
       ++stats.engineRuns;
       if (!s.ok()) return s;
       std::vector<Point2i> wanted = planning.TakeWanted();
-      const bool small = double(wanted.size()) < schedule.minRoundShare * total;
+      const bool small = stats.rounds > 0 && double(wanted.size()) < schedule.minRoundShare * total;
       if (wanted.empty() || stats.rounds == schedule.maxRounds || small) {
         stats.previewStandIns = int64_t(wanted.size());
         // What was not rendered is not exact: the sample map and the counts say so.
@@ -183,6 +185,11 @@ Status ReconstructWithPreview(SampleProvider& exact, SampleProvider& preview,
     }
   } catch (const std::bad_alloc&) {
     return Status::Error("out of memory while planning rounds on the preview");
+  }
+  if (schedule.correctionRadius > 0 && previewCaps.variance) {
+    const auto start = std::chrono::steady_clock::now();
+    DCM_RETURN_IF_ERROR(CorrectTowardPreview(preview, schedule.correctionRadius, out, &stats.correction));
+    stats.timeEngineS += Seconds(start);
   }
   // The final run's engine time excludes the rounds; the provider time is the rounds'.
   out->stats.timeProviderS = stats.timeExactS;

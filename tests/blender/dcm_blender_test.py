@@ -43,7 +43,7 @@ def exact(dcm, blender, src, tmp):
     for schedule in ("preview", "levels"):
         out, stats, smap = (os.path.join(tmp, schedule + e) for e in (".exr", ".json", ".png"))
         code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--sample-map", smap, "--schedule", schedule,
-                                 "--blender", blender, "--max-rounds", "8", "--variance", "off"])
+                                 "--blender", blender, "--max-rounds", "8", "--min-round-share", "0", "--variance", "off"])
         assert code == 0, se
         img, spec = bs.read_exr(out)
         assert spec.channelnames == ("ViewLayer.Combined.R", "ViewLayer.Combined.G", "ViewLayer.Combined.B",
@@ -97,7 +97,7 @@ def variance(dcm, blender, src, tmp):
                         ("exact preview", ["--variance", "on", "--preview-samples", "16"])):
         out, stats, smap = (os.path.join(tmp, name + e) for e in (".exr", ".json", ".png"))
         code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--sample-map", smap, "--blender", blender,
-                                 "--max-rounds", "8"] + flags)
+                                 "--max-rounds", "8", "--min-round-share", "0"] + flags)
         assert code == 0, se
         j = json.load(open(stats))
         b = j["blender"]

@@ -146,7 +146,11 @@ TEST(RoundSchedule, ANoisyPreviewWithItsVarianceIsNotTakenForEdges) {
     NoisyProvider exact(truth, exactNoise);
     ImagePreviewProvider preview = NoisyPreview(N, N, previewNoise, variance);
     ASSERT_EQ(preview.Capabilities().variance, variance);
-    ASSERT_TRUE(ReconstructWithPreview(exact, preview, {}, {}, variance ? &recWith : &recWithout,
+    // The planning alone: no preview correction (a preview with a variance
+    // would get one, the other not; tests/engine/preview_correction_test.cpp).
+    PreviewScheduleOptions schedule;
+    schedule.correctionRadius = 0;
+    ASSERT_TRUE(ReconstructWithPreview(exact, preview, {}, schedule, variance ? &recWith : &recWithout,
                                        variance ? &with : &without)
                     .ok());
   }
@@ -167,7 +171,7 @@ TEST(RoundSchedule, ANoisyPreviewWithItsVarianceIsNotTakenForEdges) {
   EXPECT_GE(psnrWith, psnrWithout - 0.3);
 }
 
-TEST(RoundSchedule, MinRoundShareStopsBeforeASmallRound) {
+TEST(RoundSchedule, MinRoundShareStopsAfterTheFirstRound) {
   const int N = 128;
   AnalyticProvider truth(N, N, FurnishedScene(N, N));
   ImagePreviewProvider preview = LowResolutionPreview(truth, N, N, 4);
@@ -177,10 +181,11 @@ TEST(RoundSchedule, MinRoundShareStopsBeforeASmallRound) {
   Reconstruction planned;
   PreviewScheduleStats stats;
   ASSERT_TRUE(ReconstructWithPreview(truth, preview, {}, schedule, &planned, &stats).ok());
-  EXPECT_EQ(stats.rounds, 0);
-  EXPECT_EQ(truth.TotalEvaluations(), 0);
-  EXPECT_GT(stats.previewStandIns, 0);
-  EXPECT_EQ(planned.stats.exactPixels, 0) << "nothing was rendered, nothing is exact";
+  ASSERT_EQ(stats.rounds, 1) << "the first round is made whatever its size";
+  EXPECT_EQ(truth.TotalEvaluations(), stats.pixelsPerRound[0]);
+  EXPECT_GT(stats.previewStandIns, 0) << "the second round's pixels keep their preview value";
+  EXPECT_GT(planned.stats.exactPixels, 0);
+  EXPECT_LE(planned.stats.exactPixels, stats.pixelsPerRound[0]) << "only the first round's pixels are exact";
 }
 
 TEST(RoundSchedule, BadSchedulesAndPreviewsAreRefused) {

@@ -4,7 +4,7 @@
 #   povray_test.sh exact|quality|errors DCM_BINARY SOURCE_DIR [POVRAY]
 #
 # exact: at 96x72, the exact pixels of `dcm povray` (those its sample map marks,
-#   with --max-rounds 10 so that no preview stand-in is left) equal the --full
+#   with --max-rounds 10 --min-round-share 0: no preview stand-in is left) equal the --full
 #   render's within two half-float steps (tests/povray/exact_check.py says
 #   why); with the defaults, at most 5 POV-Ray processes render the lit
 #   passes (docs/POVRAY.md: 1 preview + 2 rounds x 2) and 10 in all (5 guides),
@@ -87,7 +87,7 @@ expect() {
 case $mode in
 exact)
   "$dcm" povray "$scene" -o "$tmp/full.exr" --size $size --full --povray "$pov" -q || fail "dcm povray --full failed"
-  "$dcm" povray "$scene" -o "$tmp/all.exr" --size $size --max-rounds 10 --stats "$tmp/all.json" --povray "$pov" \
+  "$dcm" povray "$scene" -o "$tmp/all.exr" --size $size --max-rounds 10 --min-round-share 0 --stats "$tmp/all.json" --povray "$pov" \
     --sample-map "$tmp/all.png" -q || fail "dcm povray --max-rounds 10 failed"
   [[ $(json "$tmp/all.json" povray.preview_stand_ins) == 0 ]] || fail "--max-rounds 10 left preview stand-ins"
   read -r _ n _ total _ maxrel _ beyond < <("$py" "$src/tests/povray/exact_check.py" "$tmp/all.exr" "$tmp/full.exr" "$tmp/all.png")

@@ -359,11 +359,15 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     timed.step = "reading the preview";
     // With the exact pixels' variance the engine plans in its noise regime: the
     // preview's own variance (its halves, pooled as the exact pixels') keeps
-    // the preview's noise from passing for edges.
-    st = provider->FetchPreview({options.textureSplit && caps.splitRadiance, useVariance}, &preview, poolRadius);
+    // the preview's noise from passing for edges. The preview correction
+    // needs that variance in any case.
+    const bool previewVariance = useVariance || (f.rounds.previewCorrection > 0 && provider->Capabilities().variance);
+    st = provider->FetchPreview({options.textureSplit && caps.splitRadiance, previewVariance}, &preview, poolRadius);
     previewS = Since(tp);
     PreviewScheduleOptions so;
     so.maxRounds = f.rounds.maxRounds;
+    so.correctionRadius = f.rounds.previewCorrection;
+    so.minRoundShare = f.rounds.minRoundShare;
     if (st.ok() && haveGoal) {
       // Each run of the search in two rounds at most: its validation pixels go
       // with its first; pixels left at their preview value after one round
@@ -439,6 +443,8 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     for (const auto& r : timed.rounds) rounds.push_back({{"pixels", r.pixels}, {"seconds", r.seconds}});
     b["rounds"] = rounds;
     b["preview_stand_ins"] = sched.previewStandIns;
+    b["preview_corrected"] = sched.correction.pixels;
+    b["preview_correction_weight"] = sched.correction.meanWeight;
     b["round_latency_s"] = provider->roundCost().latencyS;
     b["sample_cost_s"] = provider->roundCost().perSampleS;
     // The seeds of the exact pixels' renders: two when they carry their variance.

@@ -212,6 +212,8 @@ int RunPovray(const PovrayFlags& f) {
       povray::PovrayPreview previewProvider(*provider, pw, ph, std::move(Li), std::move(Lc), haveGoal ? -1 : 2);
       PreviewScheduleOptions so;
       so.maxRounds = f.rounds.maxRounds;
+      so.correctionRadius = f.rounds.previewCorrection;
+      so.minRoundShare = f.rounds.minRoundShare;
       if (haveGoal) {
         // Each run of the search in two rounds at most: its validation pixels go
         // with its first; pixels left at their preview value after one round

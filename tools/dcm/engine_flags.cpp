@@ -214,6 +214,18 @@ void AddRoundFlags(CLI::App* app, RoundFlags* f) {
                   "search, at most 2)")
       ->transform(Integer(1, 1000))
       ->capture_default_str();
+  app->add_option("--min-round-share", f->minRoundShare,
+                  "with the preview schedule and no --target-psnr or --budget: a round after the first that would "
+                  "render fewer than this share of the pixels is not made; they keep their preview value (a "
+                  "render call costs its latency however few pixels it has)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  app->add_option("--preview-correction", f->previewCorrection,
+                  "with the preview schedule and a preview that carries its variance: interpolated pixels move "
+                  "toward the preview by the share of their difference, in a window of this radius, that its "
+                  "noise does not explain (lib/include/dcm/preview_correction.h); 0: off")
+      ->transform(Integer(0, 64))
+      ->capture_default_str();
 }
 
 Status ScheduleFor(const RoundFlags& flags, const RoundCost& cost, bool previewAvailable, RoundSchedule* out) {

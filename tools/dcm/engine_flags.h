@@ -54,9 +54,14 @@ void AddEngineFlags(CLI::App* app, EngineFlags* flags);
 struct RoundFlags {
   std::string schedule = "auto";  ///< auto | levels | preview
   int maxRounds = 3;              ///< calls to the renderer at most, with the preview schedule
+  /// A round after the first for fewer than this share of the pixels is not
+  /// made: they keep their preview value (PreviewScheduleOptions::minRoundShare).
+  double minRoundShare = 0.001;
+  /// Window radius of the preview correction (PreviewScheduleOptions::correctionRadius); 0: off.
+  int previewCorrection = PreviewScheduleOptions{}.correctionRadius;
 };
 
-/// Adds --schedule and --max-rounds (help group "Rounds").
+/// Adds --schedule, --max-rounds, --min-round-share and --preview-correction (help group "Rounds").
 void AddRoundFlags(CLI::App* app, RoundFlags* flags);
 
 /// The schedule the flags select for a renderer whose rounds cost `cost`:

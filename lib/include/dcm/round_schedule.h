@@ -8,6 +8,7 @@
 #include <string_view>
 #include <vector>
 
+#include "dcm/preview_correction.h"
 #include "dcm/reconstructor.h"
 #include "dcm/sample_provider.h"
 #include "dcm/status.h"
@@ -47,9 +48,14 @@ RoundSchedule ChooseSchedule(const RoundCost& cost, double latencySamplesThresho
 struct PreviewScheduleOptions {
   /// Calls to the exact provider at most (>= 1).
   int maxRounds = 3;
-  /// Stop early when a round would evaluate fewer than this share of the
-  /// working pixels; those keep their preview value. 0: only `maxRounds` stops.
+  /// Stop early when a round after the first would evaluate fewer than this
+  /// share of the working pixels; those keep their preview value. 0: only
+  /// `maxRounds` stops.
   double minRoundShare = 0;
+  /// After the last round, where the preview carries its variance: the
+  /// interpolated pixels move toward it by CorrectTowardPreview() in windows
+  /// of this radius (0: off). 5 chose on the tuning set (docs/TUNING.md).
+  int correctionRadius = 5;
 };
 
 /// What a preview-planned reconstruction did.
@@ -60,13 +66,16 @@ struct PreviewScheduleStats {
   int engineRuns = 0;                   ///< reconstructions run (one more than the rounds, at most)
   double timeEngineS = 0;               ///< in the engine runs (preview evaluation included)
   double timeExactS = 0;                ///< in the exact provider's Evaluate()
+  PreviewCorrectionStats correction;    ///< the preview correction (pixels 0: not made)
 };
 
 /// Reconstructs `exact`'s image, choosing the exact pixels from `preview`
 /// (RoundSchedule::kPreview). `exact` gives the guides (asked once) and the
 /// exact samples; `preview` gives stand-in samples for any pixel, cheaply
 /// (its guides are not used). The samples the engine sees in the final run
-/// are exact except the reported stand-ins; `out->stats` are that run's.
+/// are exact except the reported stand-ins; `out->stats` are that run's. With
+/// a preview that carries its variance the interpolated pixels are then
+/// corrected toward it (PreviewScheduleOptions::correctionRadius).
 Status ReconstructWithPreview(SampleProvider& exact, SampleProvider& preview,
                               const ReconstructionOptions& options,
                               const PreviewScheduleOptions& schedule, Reconstruction* out,

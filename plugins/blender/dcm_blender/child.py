@@ -109,8 +109,9 @@ def serve(proto, session):
             xs, ys = xy[:, 0].astype(np.int64), xy[:, 1].astype(np.int64)
             if n and (xs.min() < 0 or ys.min() < 0 or xs.max() >= session.width or ys.max() >= session.height):
                 raise ValueError("eval: a pixel outside the %dx%d image" % (session.width, session.height))
-            L, Li, Lc, var = session.evaluate(xs, ys) if n else (np.zeros((0, 3)),) * 4
-            proto.send("samples %d" % n, _records(t[2].split(","), L, Li, Lc, var))
+            what = t[2].split(",")
+            L, Li, Lc, var = session.evaluate(xs, ys, "variance" in what) if n else (np.zeros((0, 3)),) * 4
+            proto.send("samples %d" % n, _records(what, L, Li, Lc, var))
         elif t[0] == "preview" and len(t) == 6:
             x0, y0, x1, y1 = (int(v) for v in t[1:5])
             g = session.guides()

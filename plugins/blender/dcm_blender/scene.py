@@ -446,22 +446,22 @@ class Session:
                 rects.append((start * t, ty * t, min(tx * t, self.width), min((ty + 1) * t, self.height)))
         return rects
 
-    def rectangles(self, xs, ys):
+    def rectangles(self, xs, ys, calls=1):
         """Where to render pixels (xs, ys): a list of (x0, y0, x1, y1), or [None] for
         the whole frame. A masked pixel costs Cycles a camera ray and a shader per
         sample (about a seventh of a rendered one) until it stops
         (_masked_pixels_stop), a render call a fixed time: of tiles of 16, 32 or
         64 px that hold the pixels (each tile row's runs one render border) and
-        the whole frame, the cheapest."""
+        the whole frame, the cheapest, with `calls` renders per rectangle."""
         if self.args.border_tile > 0:
             return self._runs(xs, ys, self.args.border_tile)
-        n = self.samples // len(self.seeds)
+        n = self.samples // calls
         masked = 0.14 * self.pixel_seconds() * self._masked_min_samples(n) / n
-        best, best_cost = [None], len(self.seeds) * self.args.call_seconds + self.width * self.height * masked
+        best, best_cost = [None], calls * self.args.call_seconds + self.width * self.height * masked
         for t in (16, 32, 64):
             rects = self._runs(xs, ys, t)
             area = sum((x1 - x0) * (y1 - y0) for x0, y0, x1, y1 in rects)
-            cost = len(rects) * len(self.seeds) * self.args.call_seconds + area * masked
+            cost = len(rects) * calls * self.args.call_seconds + area * masked
             if len(rects) <= self.args.max_calls and cost < best_cost:
                 best, best_cost = rects, cost
         return best
@@ -495,10 +495,12 @@ class Session:
         r.border_min_x, r.border_max_x = x0 / self.width, x1 / self.width
         r.border_min_y, r.border_max_y = 1 - y1 / self.height, 1 - y0 / self.height
 
-    def evaluate(self, xs, ys):
+    def evaluate(self, xs, ys, variance=True):
         """L, L_i, L_c, var [n, 3] of pixels (xs, ys) at full samples: one mask, and one
-        render call per rectangle of rectangles(), two with halves (var: the variance
-        of L from the two halves at this pixel alone; None without halves)."""
+        render call per rectangle of rectangles(), two with halves where the variance
+        is asked for (var: the variance of L from the two halves at this pixel alone;
+        None without halves). A round whose variance dcm does not weigh costs one
+        render call per rectangle, with the file's seed."""
         g = self.guides()
         if os.environ.get("DCM_BLENDER_TEST_FAULT") == "crash-on-eval":  # tests: Blender dies mid-round
             os.kill(os.getpid(), 9)
@@ -506,12 +508,13 @@ class Session:
         self._write_mask(texels)
         reached = self.reached(texels)
         # Samples per render: all of them, or two halves (the first takes the odd one).
-        counts = [self.samples] if not self.halves else [self.samples - self.samples // 2, self.samples // 2]
+        halves = self.halves and variance
+        counts = [self.samples] if not halves else [self.samples - self.samples // 2, self.samples // 2]
         L = np.zeros((len(counts), len(xs), 3), np.float32)
         Li = np.zeros((len(counts), len(xs), 3), np.float32)
         done = np.zeros(len(xs), bool)
         self._evals = getattr(self, "_evals", 0) + 1
-        for rect in self.rectangles(xs, ys):
+        for rect in self.rectangles(xs, ys, len(counts)):
             self._set_border(rect)
             inside = np.ones(len(xs), bool) if rect is None else (
                 (xs >= rect[0]) & (xs < rect[2]) & (ys >= rect[1]) & (ys < rect[3]))
@@ -534,7 +537,7 @@ class Session:
         if not done.all():
             raise SceneError("%d pixels fell outside every render border" % int((~done).sum()))
         var = None
-        if self.halves:
+        if halves:
             # The mean weighted by samples; its variance (A - B)^2 nA nB / N^2 (dcm::HalvesVariance).
             nA, nB = counts
             N = float(self.samples)

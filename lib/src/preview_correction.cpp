@@ -1,0 +1,133 @@
+// Preview correction: a local Wiener shrinkage of the interpolation toward a
+// noisy, unbiased preview (lib/include/dcm/preview_correction.h).
+#include "dcm/preview_correction.h"
+
+#include <algorithm>
+#include <cmath>
+#include <new>
+#include <string>
+#include <vector>
+
+#include "dcm/downsample.h"
+
+namespace dcm {
+
+namespace {
+
+/// The excess of a window's mean d^2 over its mean variance counts as bias
+/// beyond this many sd of its chance fluctuation (sqrt(2 / m) of the mean
+/// variance over m pixels of Gaussian noise); below it, a weight would only let
+/// the preview's noise in.
+constexpr double kSignificance = 2.0;
+
+/// Window sums over a W x H grid by a summed-area table (doubles: the sums of
+/// squares of 10^6 pixels keep their precision).
+class WindowSums {
+ public:
+  WindowSums(const std::vector<double>& v, int W, int H) : W_(W), H_(H), t_(size_t(W + 1) * size_t(H + 1), 0.0) {
+    for (int y = 0; y < H; ++y) {
+      double row = 0;
+      for (int x = 0; x < W; ++x) {
+        row += v[size_t(y) * size_t(W) + size_t(x)];
+        At(x + 1, y + 1) = At(x + 1, y) + row;
+      }
+    }
+  }
+  /// The sum over the window of radius r around (x, y), clipped to the grid.
+  double Sum(int x, int y, int r) const {
+    const int x0 = std::max(x - r, 0), x1 = std::min(x + r + 1, W_);
+    const int y0 = std::max(y - r, 0), y1 = std::min(y + r + 1, H_);
+    return At(x1, y1) - At(x0, y1) - At(x1, y0) + At(x0, y0);
+  }
+
+ private:
+  double& At(int x, int y) { return t_[size_t(y) * size_t(W_ + 1) + size_t(x)]; }
+  double At(int x, int y) const { return t_[size_t(y) * size_t(W_ + 1) + size_t(x)]; }
+  int W_, H_;
+  std::vector<double> t_;
+};
+
+}  // namespace
+
+Status CorrectTowardPreview(SampleProvider& preview, int radius, Reconstruction* rec,
+                            PreviewCorrectionStats* stats) {
+  if (radius < 0) return Status::Error("preview correction: radius " + std::to_string(radius) + " is negative");
+  PreviewCorrectionStats result;
+  if (stats) *stats = result;
+  if (radius == 0) return Status::Ok();
+  const int W = rec->workWidth, H = rec->workHeight;
+  const size_t n = size_t(W) * size_t(H);
+  if (rec->workImage.size() != n || rec->sampleMap.size() != n)
+    return Status::Error("preview correction: the reconstruction has no working image");
+  const ProviderCapabilities caps = preview.Capabilities();
+  if (caps.width != W || caps.height != H)
+    return Status::Error("preview correction: the preview is " + std::to_string(caps.width) + "x" +
+                         std::to_string(caps.height) + ", the working image " + std::to_string(W) + "x" +
+                         std::to_string(H));
+  if (!caps.variance) return Status::Error("preview correction: the preview has no variance");
+  try {
+    std::vector<Point2i> all(n);
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) all[size_t(y) * size_t(W) + size_t(x)] = {x, y};
+    std::vector<ExactSample> p(n);
+    if (Status s = preview.Evaluate(all, SampleRequest{false, true}, p); !s.ok())
+      return Status::Error("preview correction: " + s.message());
+
+    std::vector<uint8_t> usable(n);
+    for (size_t i = 0; i < n; ++i) {
+      bool ok = true;
+      for (int c = 0; c < 3; ++c)
+        ok = ok && std::isfinite(p[i].L[c]) && std::isfinite(p[i].variance[c]) && p[i].variance[c] >= 0 &&
+             std::isfinite(rec->workImage[i][c]);
+      usable[i] = ok;
+    }
+    std::vector<double> count(n);
+    for (size_t i = 0; i < n; ++i) count[i] = usable[i];
+    const WindowSums counts(count, W, H);
+    count = {};
+
+    std::vector<RGB> corrected = rec->workImage;
+    std::vector<uint8_t> moved(n, 0);
+    double weightSum = 0;
+    int64_t interpolated = 0;
+    for (size_t i = 0; i < n; ++i) interpolated += rec->sampleMap[i] == SampleReason::kInterpolated;
+    std::vector<double> d2(n), v(n);
+    for (int c = 0; c < 3; ++c) {
+      // Linear: a noisy preview's mean is the truth there, not after the display's clip and curve.
+      for (size_t i = 0; i < n; ++i) {
+        const double d = usable[i] ? double(p[i].L[c]) - double(rec->workImage[i][c]) : 0.0;
+        d2[i] = d * d;
+        v[i] = usable[i] ? double(p[i].variance[c]) : 0.0;
+      }
+      const WindowSums sd2(d2, W, H), sv(v, W, H);
+      for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+          const size_t i = size_t(y) * size_t(W) + size_t(x);
+          if (rec->sampleMap[i] != SampleReason::kInterpolated || !usable[i]) continue;
+          const double m = counts.Sum(x, y, radius);  // >= 1: this pixel is usable
+          const double meanV = sv.Sum(x, y, radius) / m;
+          const double bias2 = std::max(sd2.Sum(x, y, radius) / m - meanV, 0.0);
+          const double k =
+              bias2 > kSignificance * std::sqrt(2.0 / m) * meanV && bias2 > 0 ? bias2 / (bias2 + meanV) : 0.0;
+          if (k <= 0) continue;
+          corrected[i][c] = float(double(rec->workImage[i][c]) + k * (double(p[i].L[c]) - double(rec->workImage[i][c])));
+          moved[i] = 1;
+          weightSum += k;
+        }
+    }
+    rec->workImage = std::move(corrected);
+    // The downsampling factor the engine used: the smallest that gives the output size.
+    int factor = 1;
+    while (factor < W && ((W + factor - 1) / factor != rec->width || (H + factor - 1) / factor != rec->height))
+      ++factor;
+    rec->image = BoxDownsample(rec->workImage, W, H, factor, &rec->width, &rec->height);
+    for (uint8_t m : moved) result.pixels += m;
+    result.meanWeight = interpolated > 0 ? weightSum / (3.0 * double(interpolated)) : 0.0;
+  } catch (const std::bad_alloc&) {
+    return Status::Error("out of memory in the preview correction");
+  }
+  if (stats) *stats = result;
+  return Status::Ok();
+}
+
+}  // namespace dcm

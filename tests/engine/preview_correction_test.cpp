@@ -1,0 +1,169 @@
+// Preview correction: the interpolation moves toward a noisy, unbiased preview
+// only by the share of their difference the preview's noise does not explain.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "dcm/preview_correction.h"
+#include "dcm/round_schedule.h"
+#include "run_helpers.h"
+
+namespace dcm::testing {
+namespace {
+
+constexpr int N = 64;
+constexpr float kSd = 0.05f;  // the preview's noise
+
+/// A smooth truth: a ramp in x.
+RGB Truth(int x, int) { return RGB::Gray(0.2f + 0.5f * float(x) / float(N)); }
+
+/// A reconstruction of N x N interpolated pixels with the values `value(x, y)`.
+Reconstruction Interpolated(RGB (*value)(int, int)) {
+  Reconstruction r;
+  r.width = r.workWidth = N;
+  r.height = r.workHeight = N;
+  for (int y = 0; y < N; ++y)
+    for (int x = 0; x < N; ++x) r.workImage.push_back(value(x, y));
+  r.image = r.workImage;
+  r.sampleMap.assign(size_t(N) * N, SampleReason::kInterpolated);
+  return r;
+}
+
+/// The truth plus Gaussian noise of sd kSd, with that variance.
+ImagePreviewProvider NoisyPreview(unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> noise(0.f, kSd);
+  std::vector<RGB> L, var(size_t(N) * N, RGB::Gray(kSd * kSd));
+  for (int y = 0; y < N; ++y)
+    for (int x = 0; x < N; ++x) {
+      const RGB t = Truth(x, y);
+      L.push_back({t.r + noise(rng), t.g + noise(rng), t.b + noise(rng)});
+    }
+  return ImagePreviewProvider(N, N, N, N, std::move(L), {}, {}, std::move(var));
+}
+
+double MseAgainstTruth(const Reconstruction& r, bool onlyStripe = false) {
+  double sum = 0;
+  int n = 0;
+  for (int y = 0; y < N; ++y)
+    for (int x = 0; x < N; ++x) {
+      if (onlyStripe && (x < 24 || x >= 40)) continue;
+      const RGB d = r.workImage[size_t(y) * N + x] - Truth(x, y);
+      sum += double(d.r) * d.r + double(d.g) * d.g + double(d.b) * d.b;
+      n += 3;
+    }
+  return sum / n;
+}
+
+TEST(PreviewCorrection, WhereTheInterpolationIsRightThePreviewsNoiseStaysOut) {
+  Reconstruction r = Interpolated(Truth);
+  ImagePreviewProvider preview = NoisyPreview(1);
+  PreviewCorrectionStats stats;
+  ASSERT_TRUE(CorrectTowardPreview(preview, 5, &r, &stats).ok());
+  // Unbiased: the window's mean d^2 exceeds its mean variance only by chance
+  // (121 pixels: a relative sd of sqrt(2/121) = 0.13), so weights stay near
+  // 0.13 / 1.13 at most and the noise let in is a few hundredths of kSd^2.
+  EXPECT_LT(stats.meanWeight, 0.1);
+  EXPECT_LT(MseAgainstTruth(r), 0.05 * kSd * kSd);
+}
+
+TEST(PreviewCorrection, WhatTheInterpolationMissedComesBackAtThePreviewsNoise) {
+  // The interpolation lost a bright stripe (x in [24, 40)) of height 0.3 = 6 sd.
+  Reconstruction r = Interpolated(+[](int x, int y) {
+    return x >= 24 && x < 40 ? Truth(x, y) - RGB::Gray(0.3f) : Truth(x, y);
+  });
+  const double before = MseAgainstTruth(r, true);
+  ImagePreviewProvider preview = NoisyPreview(2);
+  ASSERT_TRUE(CorrectTowardPreview(preview, 5, &r).ok());
+  const double after = MseAgainstTruth(r, true);
+  EXPECT_NEAR(before, 0.09, 1e-6);
+  // Inside the stripe the weight is b^2 / (b^2 + v) = 0.97; near its edges the
+  // window straddles it and the weight is lower: a few times the noise at most.
+  EXPECT_LT(after, 3.0 * kSd * kSd) << "before " << before;
+}
+
+TEST(PreviewCorrection, ExactPixelsKeepTheirValuesAndANaNStaysInItsPixel) {
+  Reconstruction r = Interpolated(+[](int x, int y) { return Truth(x, y) - RGB::Gray(0.3f); });
+  for (int x = 0; x < N; ++x) r.sampleMap[size_t(10) * N + x] = SampleReason::kBorder;
+  const std::vector<RGB> before = r.workImage;
+  std::vector<RGB> L(size_t(N) * N), var(size_t(N) * N, RGB::Gray(kSd * kSd));
+  for (int y = 0; y < N; ++y)
+    for (int x = 0; x < N; ++x) L[size_t(y) * N + x] = Truth(x, y);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  L[size_t(30) * N + 30] = RGB::Gray(nan);
+  var[size_t(40) * N + 40] = RGB::Gray(std::numeric_limits<float>::infinity());
+  ImagePreviewProvider preview(N, N, N, N, std::move(L), {}, {}, std::move(var));
+  ASSERT_TRUE(CorrectTowardPreview(preview, 5, &r).ok());
+  for (int x = 0; x < N; ++x) EXPECT_EQ(r.workImage[size_t(10) * N + x].r, before[size_t(10) * N + x].r);
+  EXPECT_EQ(r.workImage[size_t(30) * N + 30].r, before[size_t(30) * N + 30].r) << "no preview: no move";
+  EXPECT_EQ(r.workImage[size_t(40) * N + 40].r, before[size_t(40) * N + 40].r) << "no variance: no move";
+  for (size_t i = 0; i < r.workImage.size(); ++i) ASSERT_TRUE(std::isfinite(r.workImage[i].r)) << i;
+  EXPECT_NEAR(r.workImage[size_t(31) * N + 31].r, Truth(31, 31).r, 0.02) << "the neighbours still move";
+  EXPECT_EQ(r.image.size(), r.workImage.size());
+}
+
+TEST(PreviewCorrection, RadiusZeroChangesNothingAndAPreviewWithoutVarianceIsRefused) {
+  Reconstruction r = Interpolated(Truth);
+  const std::vector<RGB> before = r.workImage;
+  ImagePreviewProvider preview = NoisyPreview(3);
+  ASSERT_TRUE(CorrectTowardPreview(preview, 0, &r).ok());
+  for (size_t i = 0; i < before.size(); ++i) ASSERT_EQ(r.workImage[i].g, before[i].g);
+  ImagePreviewProvider noVariance(N, N, N, N, std::vector<RGB>(size_t(N) * N));
+  EXPECT_FALSE(CorrectTowardPreview(noVariance, 5, &r).ok());
+  EXPECT_FALSE(CorrectTowardPreview(preview, -1, &r).ok());
+}
+
+TEST(PreviewCorrection, TheOutputIsTheCorrectedWorkingImageDownsampled) {
+  // Working 2N x 2N for an N x N output (downsample 2).
+  Reconstruction r;
+  r.workWidth = r.workHeight = 2 * N;
+  r.width = r.height = N;
+  r.workImage.assign(size_t(4) * N * N, RGB::Gray(0.1f));
+  r.image.assign(size_t(N) * N, RGB::Gray(0.1f));
+  r.sampleMap.assign(r.workImage.size(), SampleReason::kInterpolated);
+  ImagePreviewProvider preview(2 * N, 2 * N, 2 * N, 2 * N, std::vector<RGB>(r.workImage.size(), RGB::Gray(0.5f)),
+                               {}, {}, std::vector<RGB>(r.workImage.size(), RGB::Gray(1e-4f)));
+  ASSERT_TRUE(CorrectTowardPreview(preview, 3, &r).ok());
+  ASSERT_EQ(r.width, N);
+  ASSERT_EQ(r.image.size(), size_t(N) * N);
+  // b^2 = 0.16 against v = 1e-4: the weight is 0.9994.
+  EXPECT_NEAR(r.image[0].r, 0.5f, 1e-3f);
+}
+
+TEST(PreviewCorrection, APreviewPlannedRunWithANoisyPreviewGetsCloserToTheTruth) {
+  // The analytic furnished scene, its preview the truth plus noise of known
+  // variance: the correction must not make the result worse than without it.
+  constexpr int M = 128;
+  AnalyticProvider truth(M, M, FurnishedScene(M, M));
+  const std::vector<RGB> ref = truth.FullRender();
+  std::mt19937 rng(7);
+  std::normal_distribution<float> noise(0.f, 0.02f);
+  std::vector<RGB> L = ref, var(ref.size(), RGB::Gray(0.02f * 0.02f));
+  for (RGB& v : L) v = {v.r + noise(rng), v.g + noise(rng), v.b + noise(rng)};
+  ImagePreviewProvider preview(M, M, M, M, std::move(L), {}, {}, std::move(var));
+  ReconstructionOptions o;
+  o.textureSplit = false;
+  double mse[2];
+  for (int radius : {0, 5}) {
+    PreviewScheduleOptions schedule;
+    schedule.correctionRadius = radius;
+    Reconstruction r;
+    PreviewScheduleStats stats;
+    ASSERT_TRUE(ReconstructWithPreview(truth, preview, o, schedule, &r, &stats).ok());
+    EXPECT_EQ(stats.correction.pixels > 0, radius > 0);
+    double s = 0;
+    for (size_t i = 0; i < ref.size(); ++i) {
+      const RGB d = r.image[i] - ref[i];
+      s += double(d.r) * d.r + double(d.g) * d.g + double(d.b) * d.b;
+    }
+    mse[radius > 0] = s / double(3 * ref.size());
+  }
+  // Where the interpolation is exact the weights stay near 0 (the first test);
+  // where it errs by more than the noise, the error shrinks.
+  EXPECT_LE(mse[1], mse[0]) << "without " << mse[0] << ", with " << mse[1];
+}
+
+}  // namespace
+}  // namespace dcm::testing
