@@ -14,11 +14,11 @@ namespace dcm {
 
 namespace {
 
-/// The excess of a window's mean d^2 over its mean variance counts as bias
-/// beyond this many sd of its chance fluctuation (sqrt(2 / m) of the mean
-/// variance over m pixels of Gaussian noise); below it, a weight would only let
-/// the preview's noise in.
-constexpr double kSignificance = 2.0;
+/// The excess e = d^2 - v, averaged over a window, counts as bias where it
+/// stands this many standard errors above 0 (its sd measured in the window:
+/// a path tracer's noise is heavy-tailed, and one bright outlier is not a
+/// bias of its window); below it, a weight would only let the noise in.
+constexpr double kSignificance = 1.5;
 
 /// Window sums over a W x H grid by a summed-area table (doubles: the sums of
 /// squares of 10^6 pixels keep their precision).
@@ -91,24 +91,25 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, Reconstruction*
     double weightSum = 0;
     int64_t interpolated = 0;
     for (size_t i = 0; i < n; ++i) interpolated += rec->sampleMap[i] == SampleReason::kInterpolated;
-    std::vector<double> d2(n), v(n);
+    std::vector<double> e(n), e2(n), v(n);
     for (int c = 0; c < 3; ++c) {
       // Linear: a noisy preview's mean is the truth there, not after the display's clip and curve.
       for (size_t i = 0; i < n; ++i) {
         const double d = usable[i] ? double(p[i].L[c]) - double(rec->workImage[i][c]) : 0.0;
-        d2[i] = d * d;
         v[i] = usable[i] ? double(p[i].variance[c]) : 0.0;
+        e[i] = d * d - v[i];
+        e2[i] = e[i] * e[i];
       }
-      const WindowSums sd2(d2, W, H), sv(v, W, H);
+      const WindowSums se(e, W, H), se2(e2, W, H), sv(v, W, H);
       for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
           const size_t i = size_t(y) * size_t(W) + size_t(x);
           if (rec->sampleMap[i] != SampleReason::kInterpolated || !usable[i]) continue;
           const double m = counts.Sum(x, y, radius);  // >= 1: this pixel is usable
           const double meanV = sv.Sum(x, y, radius) / m;
-          const double bias2 = std::max(sd2.Sum(x, y, radius) / m - meanV, 0.0);
-          const double k =
-              bias2 > kSignificance * std::sqrt(2.0 / m) * meanV && bias2 > 0 ? bias2 / (bias2 + meanV) : 0.0;
+          const double bias2 = se.Sum(x, y, radius) / m;
+          const double sdE = std::sqrt(std::max(se2.Sum(x, y, radius) / m - bias2 * bias2, 0.0));
+          const double k = bias2 > 0 && bias2 > kSignificance * sdE / std::sqrt(m) ? bias2 / (bias2 + meanV) : 0.0;
           if (k <= 0) continue;
           corrected[i][c] = float(double(rec->workImage[i][c]) + k * (double(p[i].L[c]) - double(rec->workImage[i][c])));
           moved[i] = 1;
