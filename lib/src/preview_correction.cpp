@@ -20,32 +20,26 @@ namespace {
 /// bias of its window); below it, a weight would only let the noise in.
 constexpr double kSignificance = 1.5;
 
-/// Window sums over a W x H grid by a summed-area table (doubles: the sums of
-/// squares of 10^6 pixels keep their precision).
-class WindowSums {
- public:
-  WindowSums(const std::vector<double>& v, int W, int H) : W_(W), H_(H), t_(size_t(W + 1) * size_t(H + 1), 0.0) {
-    for (int y = 0; y < H; ++y) {
-      double row = 0;
-      for (int x = 0; x < W; ++x) {
-        row += v[size_t(y) * size_t(W) + size_t(x)];
-        At(x + 1, y + 1) = At(x + 1, y) + row;
-      }
+/// Sums of `v` (W x H) over the window of radius r around each pixel,
+/// clipped to the grid: a horizontal then a vertical pass, each summed
+/// afresh per pixel. Running sums would subtract: after one outlier (a
+/// firefly's d^4 can reach 1e12) the small windows behind it lose their digits.
+std::vector<double> WindowSums(const std::vector<double>& v, int W, int H, int r) {
+  std::vector<double> rows(v.size()), out(v.size());
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      double s = 0;
+      for (int i = std::max(x - r, 0); i <= std::min(x + r, W - 1); ++i) s += v[size_t(y) * size_t(W) + size_t(i)];
+      rows[size_t(y) * size_t(W) + size_t(x)] = s;
     }
-  }
-  /// The sum over the window of radius r around (x, y), clipped to the grid.
-  double Sum(int x, int y, int r) const {
-    const int x0 = std::max(x - r, 0), x1 = std::min(x + r + 1, W_);
-    const int y0 = std::max(y - r, 0), y1 = std::min(y + r + 1, H_);
-    return At(x1, y1) - At(x0, y1) - At(x1, y0) + At(x0, y0);
-  }
-
- private:
-  double& At(int x, int y) { return t_[size_t(y) * size_t(W_ + 1) + size_t(x)]; }
-  double At(int x, int y) const { return t_[size_t(y) * size_t(W_ + 1) + size_t(x)]; }
-  int W_, H_;
-  std::vector<double> t_;
-};
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      double s = 0;
+      for (int j = std::max(y - r, 0); j <= std::min(y + r, H - 1); ++j) s += rows[size_t(j) * size_t(W) + size_t(x)];
+      out[size_t(y) * size_t(W) + size_t(x)] = s;
+    }
+  return out;
+}
 
 }  // namespace
 
@@ -83,7 +77,7 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, Reconstruction*
     }
     std::vector<double> count(n);
     for (size_t i = 0; i < n; ++i) count[i] = usable[i];
-    const WindowSums counts(count, W, H);
+    const std::vector<double> counts = WindowSums(count, W, H, radius);
     count = {};
 
     std::vector<RGB> corrected = rec->workImage;
@@ -100,15 +94,16 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, Reconstruction*
         e[i] = d * d - v[i];
         e2[i] = e[i] * e[i];
       }
-      const WindowSums se(e, W, H), se2(e2, W, H), sv(v, W, H);
+      const std::vector<double> se = WindowSums(e, W, H, radius), se2 = WindowSums(e2, W, H, radius),
+                                sv = WindowSums(v, W, H, radius);
       for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
           const size_t i = size_t(y) * size_t(W) + size_t(x);
           if (rec->sampleMap[i] != SampleReason::kInterpolated || !usable[i]) continue;
-          const double m = counts.Sum(x, y, radius);  // >= 1: this pixel is usable
-          const double meanV = sv.Sum(x, y, radius) / m;
-          const double bias2 = se.Sum(x, y, radius) / m;
-          const double sdE = std::sqrt(std::max(se2.Sum(x, y, radius) / m - bias2 * bias2, 0.0));
+          const double m = counts[i];  // >= 1: this pixel is usable
+          const double meanV = sv[i] / m;
+          const double bias2 = se[i] / m;
+          const double sdE = std::sqrt(std::max(se2[i] / m - bias2 * bias2, 0.0));
           const double k = bias2 > 0 && bias2 > kSignificance * sdE / std::sqrt(m) ? bias2 / (bias2 + meanV) : 0.0;
           if (k <= 0) continue;
           corrected[i][c] = float(double(rec->workImage[i][c]) + k * (double(p[i].L[c]) - double(rec->workImage[i][c])));

@@ -171,6 +171,31 @@ TEST(RoundSchedule, ANoisyPreviewWithItsVarianceIsNotTakenForEdges) {
   EXPECT_GE(psnrWith, psnrWithout - 0.3);
 }
 
+TEST(RoundSchedule, ThePreviewCorrectionCostsLittleWhereThePreviewIsMuchNoisier) {
+  // The case above: noisy exact pixels, denoised, and a preview with four
+  // times their noise, on a scene whose interpolation errs little. Chance
+  // excesses of the preview's noise pass the correction's test here and there.
+  const int N = 128;
+  const NoiseModel exactNoise{0.05f, 0.005f, 1}, previewNoise{0.2f, 0.02f, 2};
+  AnalyticProvider truth(N, N, FurnishedScene(N, N));
+  const std::vector<RGB> ref = truth.FullRender();
+  double psnr[2];
+  for (int radius : {0, 5}) {
+    NoisyProvider exact(truth, exactNoise);
+    ImagePreviewProvider preview = NoisyPreview(N, N, previewNoise, true);
+    PreviewScheduleOptions schedule;
+    schedule.correctionRadius = radius;
+    Reconstruction rec;
+    PreviewScheduleStats stats;
+    ASSERT_TRUE(ReconstructWithPreview(exact, preview, {}, schedule, &rec, &stats).ok());
+    psnr[radius > 0] = DisplayPsnr(rec.workImage, ref);
+    if (radius > 0) EXPECT_LT(stats.correction.meanWeight, 0.05) << "few pixels move, and little";
+  }
+  std::printf("without the correction %.2f dB, with %.2f dB\n", psnr[0], psnr[1]);
+  // Measured 38.44 and 38.04 dB (docs/ENGINE.md): a loss, bounded here at 0.6 dB.
+  EXPECT_GE(psnr[1], psnr[0] - 0.6);
+}
+
 TEST(RoundSchedule, MinRoundShareStopsAfterTheFirstRound) {
   const int N = 128;
   AnalyticProvider truth(N, N, FurnishedScene(N, N));
