@@ -443,8 +443,10 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     for (const auto& r : timed.rounds) rounds.push_back({{"pixels", r.pixels}, {"seconds", r.seconds}});
     b["rounds"] = rounds;
     b["preview_stand_ins"] = sched.previewStandIns;
-    b["preview_corrected"] = sched.correction.pixels;
-    b["preview_correction_weight"] = sched.correction.meanWeight;
+    if (schedule == RoundSchedule::kPreview && !quality) {  // the search's runs each make their own
+      b["preview_corrected"] = sched.correction.pixels;
+      b["preview_correction_weight"] = sched.correction.meanWeight;
+    }
     b["round_latency_s"] = provider->roundCost().latencyS;
     b["sample_cost_s"] = provider->roundCost().perSampleS;
     // The seeds of the exact pixels' renders: two when they carry their variance.
