@@ -367,7 +367,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     PreviewScheduleOptions so;
     so.maxRounds = f.rounds.maxRounds;
     so.correctionRadius = f.rounds.previewCorrection;
-    so.minRoundShare = f.rounds.minRoundShare;
+    so.minRoundShare = haveGoal ? 0 : f.rounds.minRoundShare;  // the search validates what each run asks for
     if (st.ok() && haveGoal) {
       // Each run of the search in two rounds at most: its validation pixels go
       // with its first; pixels left at their preview value after one round
