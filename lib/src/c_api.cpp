@@ -55,7 +55,7 @@ struct DCMReconstructorImpl {
   dcm::RoundCost roundCost;
   int maxRounds = 3;
   int previewWidth = 0, previewHeight = 0;
-  std::vector<dcm::RGB> previewL, previewLi, previewLc;
+  std::vector<dcm::RGB> previewL, previewLi, previewLc, previewVariance;
   double targetPsnr = 0, budget = 0;  ///< "target_psnr", "budget" (0: none; dcm/quality_target.h)
   bool targetRender = false;          ///< "target_render" (QualityGoal::targetRender)
 
@@ -510,6 +510,7 @@ DCM_API void dcmSetPreview(DCMReconstructor r, int width, int height, const floa
     r->previewL.clear();
     r->previewLi.clear();
     r->previewLc.clear();
+    r->previewVariance.clear();
     r->previewWidth = r->previewHeight = 0;
     if (!rgb) return;
     if (width < 1 || height < 1 || width > r->width || height > r->height)
@@ -523,6 +524,18 @@ DCM_API void dcmSetPreview(DCMReconstructor r, int width, int height, const floa
     CopyTriples(lc, n, &r->previewLc);
     r->previewWidth = width;
     r->previewHeight = height;
+  });
+}
+
+DCM_API void dcmSetPreviewVariance(DCMReconstructor r, const float* variance) {
+  if (!r) return SetError(nullptr, DCM_ERROR_INVALID_ARGUMENT, "dcmSetPreviewVariance: NULL reconstructor");
+  Guard(r, "dcmSetPreviewVariance", [&] {
+    r->previewVariance.clear();
+    if (!variance) return;
+    if (r->previewL.empty() || r->previewWidth != r->width || r->previewHeight != r->height)
+      return SetError(r, DCM_ERROR_INVALID_ARGUMENT,
+                      "dcmSetPreviewVariance: needs a preview at the image size (dcmSetPreview() first)");
+    CopyTriples(variance, size_t(r->width) * size_t(r->height), &r->previewVariance);
   });
 }
 
@@ -585,7 +598,7 @@ DCM_API DCMError dcmExecute(DCMReconstructor r) {
       if (st.ok()) r->quality = std::move(report);
     } else if (!r->previewL.empty() && dcm::ChooseSchedule(r->roundCost) == dcm::RoundSchedule::kPreview) {
       dcm::ImagePreviewProvider preview(r->width, r->height, r->previewWidth, r->previewHeight, r->previewL,
-                                        r->previewLi, r->previewLc);
+                                        r->previewLi, r->previewLc, r->previewVariance);
       dcm::PreviewScheduleOptions schedule;
       schedule.maxRounds = r->maxRounds;
       st = dcm::ReconstructWithPreview(provider, preview, options, schedule, &r->result, &r->schedule);
@@ -669,6 +682,7 @@ DCM_API double dcmGetStat(DCMReconstructor r, const char* name) {
   if (n == "time_engine_s") return s.timeEngineS;
   if (n == "rounds") return double(r->schedule.rounds);
   if (n == "preview_stand_ins") return double(r->schedule.previewStandIns);
+  if (n == "preview_corrected") return double(r->schedule.correction.pixels);
   if (r->quality) {
     const dcm::QualityReport& q = *r->quality;
     if (n == "estimated_psnr") return q.estimate.psnr;

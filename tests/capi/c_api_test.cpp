@@ -308,6 +308,52 @@ TEST(CApi, RoundCostPlansOnThePreviewInFewCalls) {
   dcmReleaseReconstructor(b);
 }
 
+TEST(CApi, APreviewWithItsVarianceCorrectsTheInterpolatedPixels) {
+  Scene scene;
+  DCMReconstructor r = Make(scene, 0);
+  const size_t n = size_t(scene.width * scene.height);
+  // A preview 0.1 above the truth everywhere, said to have sd 0.01: its
+  // departure from the interpolation is far beyond its noise, so the
+  // interpolated pixels follow it by b / (b + v) = 0.0099 / 0.01 = 0.99.
+  std::vector<float> preview(3 * n), variance(3 * n, 1e-4f);
+  for (int y = 0; y < scene.height; ++y)
+    for (int x = 0; x < scene.width; ++x) {
+      float* p = &preview[3 * size_t(y * scene.width + x)];
+      scene.Truth(x, y, p);
+      for (int c = 0; c < 3; ++c) p[c] += 0.1f;
+    }
+  dcmSetPreview(r, scene.width, scene.height, preview.data(), nullptr, nullptr);
+  dcmSetPreviewVariance(r, variance.data());
+  dcmSetRoundCost(r, 0.5, 0.0, 3);
+  ASSERT_EQ(dcmExecute(r), DCM_ERROR_NONE) << TakeError(r);
+  EXPECT_GT(dcmGetStat(r, "preview_corrected"), 0.0);
+  int w = 0, h = 0;
+  const float* image = dcmGetImage(r, &w, &h);
+  const uint8_t* map = dcmGetSampleMap(r, nullptr, nullptr);
+  int interpolated = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      float truth[3];
+      scene.Truth(x, y, truth);
+      const size_t i = size_t(y * w + x);
+      // Exact pixels keep the truth; interpolated ones are 0.099 above it
+      // (windows at the image's edge count fewer pixels, not other values).
+      const float expected = map[i] == DCM_REASON_INTERPOLATED ? truth[0] + 0.099f : truth[0];
+      EXPECT_NEAR(image[3 * i], expected, 2e-3f) << x << "," << y;
+      interpolated += map[i] == DCM_REASON_INTERPOLATED;
+    }
+  EXPECT_GT(interpolated, 0);
+  // dcmSetPreview() removes the variance: no correction.
+  dcmSetPreview(r, scene.width, scene.height, preview.data(), nullptr, nullptr);
+  ASSERT_EQ(dcmExecute(r), DCM_ERROR_NONE) << TakeError(r);
+  EXPECT_EQ(dcmGetStat(r, "preview_corrected"), 0.0);
+  // A coarser preview takes no variance.
+  dcmSetPreview(r, scene.width / 2, scene.height / 2, preview.data(), nullptr, nullptr);
+  dcmSetPreviewVariance(r, variance.data());
+  EXPECT_NE(TakeError(r).find("dcmSetPreviewVariance"), std::string::npos);
+  dcmReleaseReconstructor(r);
+}
+
 TEST(CApi, TargetAndBudgetReportTheEstimateAndStayWithinTheBudget) {
   Scene scene;
   DCMReconstructor r = Make(scene);

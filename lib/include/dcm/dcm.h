@@ -45,8 +45,9 @@ extern "C" {
  *  supersampled rules, noisy samples) are one option each, unset by default;
  *  their twins "noisy_elementary_block", "contrast_threshold_supersampled",
  *  "contrast_metric_supersampled", "directions_supersampled" and
- *  "thin_objects_supersampled" are gone (a value set serves every regime). */
-#define DCM_C_API_VERSION 4
+ *  "thin_objects_supersampled" are gone (a value set serves every regime).
+ *  Version 5 adds dcmSetPreviewVariance(). */
+#define DCM_C_API_VERSION 5
 
 /** A reconstructor: options, guides, the sample callback and the last result. */
 typedef struct DCMReconstructorImpl* DCMReconstructor;
@@ -277,6 +278,17 @@ DCM_API void dcmSetRoundCost(DCMReconstructor r, double latency_s, double second
 DCM_API void dcmSetPreview(DCMReconstructor r, int width, int height, const float* rgb, const float* li,
                            const float* lc);
 
+/** Sets (or with NULL removes) the variance of the preview's L, per pixel and
+ *  channel: width*height*3 floats for a preview at the image size (a
+ *  few-samples render), copied; call after dcmSetPreview(), which removes it.
+ *  With it the planning weighs the preview's noise where the samples carry
+ *  their variance, and after the last round the interpolated pixels move
+ *  toward the preview where they differ from it by more than its noise
+ *  explains (the preview correction, lib/include/dcm/preview_correction.h;
+ *  statistic "preview_corrected"). A coarser preview takes none: its
+ *  upsampling would pass for the interpolation's error. Since API version 5. */
+DCM_API void dcmSetPreviewVariance(DCMReconstructor r, const float* variance);
+
 /** Runs the reconstruction: calls the sample function for the pixels it needs
  *  and keeps the result on `r`. Returns DCM_ERROR_NONE on success, otherwise
  *  the error (also recorded for dcmGetError()); the previous result is then
@@ -300,7 +312,7 @@ DCM_API const uint8_t* dcmGetSampleMap(DCMReconstructor r, int* width, int* heig
  *  "smooth_blocks", "simple_edge_blocks", "complex_edge_blocks",
  *  "fallback_blocks", "time_provider_s", "time_guides_s", "time_engine_s",
  *  "rounds" (calls planned on the preview; 0 without), "preview_stand_ins"
- *  (since API version 3); with "target_psnr" or "budget" set also
+ *  (since API version 3), "preview_corrected" (since API version 5); with "target_psnr" or "budget" set also
  *  "estimated_psnr", "estimated_psnr_low", "estimated_psnr_high" (the 90 %
  *  interval), "validation_pixels", "quality_runs", "target_reached" and
  *  "budget_bound" (0/1), "estimate_against_converged" (1: the provider
