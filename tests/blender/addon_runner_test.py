@@ -25,6 +25,9 @@ for pair in (["--samples", "64"], ["--preview-samples", "8"], ["--method", "pape
     check(i >= 0 and cmd[i:i + 2] == pair, "flag %s" % pair)
 check("--full" not in cmd and "--method" not in runner.command_line("d", "s", "o"), "defaults add no flags")
 check("--samples" not in runner.command_line("d", "s", "o"), "samples 0: the scene's")
+check("--preview-correction" not in runner.command_line("d", "s", "o") and
+      runner.command_line("d", "s", "o", preview_correction=False)[-2:] == ["--preview-correction", "0"],
+      "the preview correction: dcm's default, or off")
 check(runner.parse_progress("rounds  42% (3.5 s)") == ("rounds", 0.42), "a progress line")
 check(runner.parse_progress("\r\x1b[Kengine 100% (0.1 s)") == ("engine", 1.0), "a terminal progress line")
 check(runner.parse_progress("dcm blender: error: x") is None, "an error line is no progress")

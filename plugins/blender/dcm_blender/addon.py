@@ -65,6 +65,11 @@ class DCMSettings(bpy.types.PropertyGroup):
     )
     max_rounds: IntProperty(name="Max rounds", description="Render calls for exact pixels at most",
                             default=3, min=1, max=50)
+    preview_correction: BoolProperty(
+        name="Preview correction",
+        description="Move interpolated pixels toward the preview where they differ from it by more than its "
+                    "noise explains",
+        default=True)
     output: StringProperty(name="Output", description="Keep the EXR here (empty: a temporary file)",
                            subtype="FILE_PATH", default="")
     sample_map: BoolProperty(name="Sample map", description="Also load the sample map as 'DCM Sample Map'",
@@ -103,7 +108,7 @@ def _build(context, workdir):
         sample_map=os.path.join(workdir, "sample_map.png") if s.sample_map else None,
         samples=s.samples, preview_samples=s.preview_samples, method=s.method, full=s.full,
         threshold=s.threshold if s.threshold > 0 and not s.full else None,
-        schedule=s.schedule, max_rounds=s.max_rounds,
+        schedule=s.schedule, max_rounds=s.max_rounds, preview_correction=s.preview_correction,
         view_layer=context.view_layer.name, frame=context.scene.frame_current, extra=s.extra)
     return cmd, out
 
@@ -243,6 +248,7 @@ class RENDER_PT_dcm(bpy.types.Panel):
         col = layout.column(heading="Rounds")
         col.prop(s, "schedule", text="Schedule")
         col.prop(s, "max_rounds")
+        col.prop(s, "preview_correction")
         layout.prop(s, "output")
         layout.prop(s, "sample_map")
         layout.prop(s, "extra")
