@@ -94,7 +94,8 @@ def variance(dcm, blender, src, tmp):
     h, w = half_a.shape[:2]
     runs = {}
     for name, flags in (("auto", []), ("on", ["--variance", "on"]), ("raw", ["--variance", "on", "--no-denoise-samples"]),
-                        ("exact preview", ["--variance", "on", "--preview-samples", "16"])):
+                        ("exact preview", ["--variance", "on", "--preview-samples", "16"]),
+                        ("uncorrected", ["--variance", "on", "--preview-correction", "0"])):
         out, stats, smap = (os.path.join(tmp, name + e) for e in (".exr", ".json", ".png"))
         code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--sample-map", smap, "--blender", blender,
                                  "--max-rounds", "8", "--min-round-share", "0"] + flags)
@@ -126,6 +127,17 @@ def variance(dcm, blender, src, tmp):
     assert (err <= 1e-5 * np.maximum(np.abs(mean[is_exact][:, :3]), 1) + 1e-7).all(), err.max()
     differ = (np.abs(half_a - half_b)[is_exact][:, :3] > 1e-4).any(axis=1).mean()
     assert differ > 0.5, differ
+    # The preview correction (the preview carries its halves' variance) moves
+    # interpolated pixels only: the same exact pixels, the same values there,
+    # and the pixels that differ are among those it says it moved (a move
+    # smaller than half a float step of the value leaves it: 384 of 390 differ).
+    on, unc = runs["on"], runs["uncorrected"]
+    assert (on[1] == unc[1]).all(), "the correction changed which pixels are exact"
+    assert (on[0][on[1]] == unc[0][unc[1]]).all(), "the correction changed an exact pixel"
+    moved = (on[0][:, :, :3] != unc[0][:, :, :3]).any(axis=2)
+    assert unc[2]["blender"]["preview_corrected"] == 0, unc[2]["blender"]
+    corrected = on[2]["blender"]["preview_corrected"]
+    assert 0.9 * corrected <= moved.sum() <= corrected and corrected > 0, (moved.sum(), on[2]["blender"])
     print("%.1f %% exact; %.0f %% of them differ between the seeds; %d denoised; auto: noise %.1f dB, %s; first "
           "round %d pixels (%d with an exact preview)"
           % (100 * is_exact.mean(), 100 * differ, runs["on"][2]["denoised_samples"],
