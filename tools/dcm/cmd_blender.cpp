@@ -480,6 +480,9 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   std::printf("  time           Blender start %.2f s, guides %.2f s, preview %.2f s, rounds %.2f s, DCM %.2f s, "
               "total %.2f s\n",
               handshakeS - guidesRenderS, guidesRenderS + timed.guidesS, previewS, roundsS, engineS, wallS);
+  if (sched.correction.pixels > 0)
+    std::printf("  correction     %lld interpolated pixels moved toward the preview (mean weight %.3f)\n",
+                static_cast<long long>(sched.correction.pixels), sched.correction.meanWeight);
   if (quality) {
     std::printf("  quality        %s\n", QualityLine(*quality, f.pipe.engine).c_str());
     if (f.pipe.engine.verbose) std::cerr << QualityLine(*quality, f.pipe.engine) << "\n";
