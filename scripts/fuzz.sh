@@ -52,9 +52,14 @@ for target in "${targets[@]}"; do
   [ -f "$here/fuzz/${target#fuzz_}.dict" ] && dict=(-dict="$here/fuzz/${target#fuzz_}.dict")
   echo "fuzz.sh: $target for ${seconds} s"
   set +e
-  runs=()
+  runs=() pin=()
   [ -n "${DCM_FUZZ_RUNS:-}" ] && runs=(-runs="$DCM_FUZZ_RUNS")
-  "$build/$target" "$corpus" "$seeds" "${dict[@]}" "${runs[@]}" \
+  # A counted run is the same run every time only without address
+  # randomisation: libFuzzer's comparison tables hold pointers (docs/FUZZING.md).
+  if [ -n "${DCM_FUZZ_RUNS:-}" ] && setarch "$(uname -m)" -R true 2>/dev/null; then
+    pin=(setarch "$(uname -m)" -R)
+  fi
+  "${pin[@]}" "$build/$target" "$corpus" "$seeds" "${dict[@]}" "${runs[@]}" \
     -max_total_time="$seconds" -timeout=60 -rss_limit_mb=2560 -malloc_limit_mb=2048 \
     -max_len=65536 -print_final_stats=1 -seed="${DCM_FUZZ_SEED:-0}" \
     -artifact_prefix="$build/artifacts/$target/" >"$build/$target.log" 2>&1
