@@ -52,18 +52,32 @@ for target in "${targets[@]}"; do
   [ -f "$here/fuzz/${target#fuzz_}.dict" ] && dict=(-dict="$here/fuzz/${target#fuzz_}.dict")
   echo "fuzz.sh: $target for ${seconds} s"
   set +e
-  runs=() pin=()
+  runs=()
   [ -n "${DCM_FUZZ_RUNS:-}" ] && runs=(-runs="$DCM_FUZZ_RUNS")
-  # A counted run is the same run every time only without address
-  # randomisation: libFuzzer's comparison tables hold pointers (docs/FUZZING.md).
+  flags=(-max_total_time="$seconds" -timeout=60 -rss_limit_mb=2560 -malloc_limit_mb=2048
+         -max_len=65536 -print_final_stats=1 -seed="${DCM_FUZZ_SEED:-0}")
   if [ -n "${DCM_FUZZ_RUNS:-}" ] && setarch "$(uname -m)" -R true 2>/dev/null; then
-    pin=(setarch "$(uname -m)" -R)
+    # A counted run is the same run every time only where the process's
+    # addresses are: libFuzzer's comparison tables hold pointers
+    # (docs/FUZZING.md). So: no address randomisation, and the same
+    # environment, arguments and program path wherever the clone is (the
+    # stack's layout follows their size).
+    stage="$build/run/$target"
+    rm -rf "$stage"
+    mkdir -p "$stage/corpus" "$stage/artifacts"
+    cp -r "$seeds" "$stage/seeds"
+    cp "$build/$target" "$stage/target"
+    [ ${#dict[@]} -gt 0 ] && cp "${dict[0]#-dict=}" "$stage/dict" && dict=(-dict=dict)
+    (cd "$stage" && env -i PATH=/usr/bin:/bin ASAN_OPTIONS="$ASAN_OPTIONS" UBSAN_OPTIONS="$UBSAN_OPTIONS" TMPDIR=/tmp \
+      setarch "$(uname -m)" -R ./target corpus seeds "${dict[@]}" "${runs[@]}" "${flags[@]}" \
+      -artifact_prefix=artifacts/) >"$build/$target.log" 2>&1
+    rc=$?
+    cp "$stage"/artifacts/* "$build/artifacts/$target/" 2>/dev/null
+  else
+    "$build/$target" "$corpus" "$seeds" "${dict[@]}" "${runs[@]}" "${flags[@]}" \
+      -artifact_prefix="$build/artifacts/$target/" >"$build/$target.log" 2>&1
+    rc=$?
   fi
-  "${pin[@]}" "$build/$target" "$corpus" "$seeds" "${dict[@]}" "${runs[@]}" \
-    -max_total_time="$seconds" -timeout=60 -rss_limit_mb=2560 -malloc_limit_mb=2048 \
-    -max_len=65536 -print_final_stats=1 -seed="${DCM_FUZZ_SEED:-0}" \
-    -artifact_prefix="$build/artifacts/$target/" >"$build/$target.log" 2>&1
-  rc=$?
   set -e
   grep -E '^stat::number_of_executed_units|^#[0-9]+.*DONE' "$build/$target.log" | tail -2 || true
   if [ $rc -ne 0 ]; then
