@@ -57,11 +57,10 @@ for target in "${targets[@]}"; do
   flags=(-max_total_time="$seconds" -timeout=60 -rss_limit_mb=2560 -malloc_limit_mb=2048
          -max_len=65536 -print_final_stats=1 -seed="${DCM_FUZZ_SEED:-0}")
   if [ -n "${DCM_FUZZ_RUNS:-}" ] && setarch "$(uname -m)" -R true 2>/dev/null; then
-    # A counted run is the same run every time only where the process's
-    # addresses are: libFuzzer's comparison tables hold pointers
-    # (docs/FUZZING.md). So: no address randomisation, and the same
-    # environment, arguments and program path wherever the clone is (the
-    # stack's layout follows their size).
+    # libFuzzer's comparison tables hold pointers: a counted run repeats only
+    # where the process's addresses do (docs/FUZZING.md). So: no address
+    # randomisation, and the same environment, arguments and program path
+    # wherever the clone is (the stack's layout follows their size).
     stage="$build/run/$target"
     rm -rf "$stage"
     mkdir -p "$stage/corpus" "$stage/artifacts"
