@@ -43,9 +43,11 @@ std::vector<double> WindowSums(const std::vector<double>& v, int W, int H, int r
 
 }  // namespace
 
-Status CorrectTowardPreview(SampleProvider& preview, int radius, Reconstruction* rec,
+Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample, Reconstruction* rec,
                             PreviewCorrectionStats* stats) {
   if (radius < 0) return Status::Error("preview correction: radius " + std::to_string(radius) + " is negative");
+  if (downsample < 1)
+    return Status::Error("preview correction: downsample " + std::to_string(downsample) + " is below 1");
   PreviewCorrectionStats result;
   if (stats) *stats = result;
   if (radius == 0) return Status::Ok();
@@ -69,11 +71,8 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, Reconstruction*
 
     std::vector<uint8_t> usable(n);
     for (size_t i = 0; i < n; ++i) {
-      bool ok = true;
-      for (int c = 0; c < 3; ++c)
-        ok = ok && std::isfinite(p[i].L[c]) && std::isfinite(p[i].variance[c]) && p[i].variance[c] >= 0 &&
-             std::isfinite(rec->workImage[i][c]);
-      usable[i] = ok;
+      const RGB& v = p[i].variance;
+      usable[i] = IsFinite(p[i].L) && IsFinite(v) && IsFinite(rec->workImage[i]) && v.r >= 0 && v.g >= 0 && v.b >= 0;
     }
     std::vector<double> count(n);
     for (size_t i = 0; i < n; ++i) count[i] = usable[i];
@@ -112,11 +111,7 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, Reconstruction*
         }
     }
     rec->workImage = std::move(corrected);
-    // The downsampling factor the engine used: the smallest that gives the output size.
-    int factor = 1;
-    while (factor < W && ((W + factor - 1) / factor != rec->width || (H + factor - 1) / factor != rec->height))
-      ++factor;
-    rec->image = BoxDownsample(rec->workImage, W, H, factor, &rec->width, &rec->height);
+    rec->image = BoxDownsample(rec->workImage, W, H, downsample, &rec->width, &rec->height);
     for (uint8_t m : moved) result.pixels += m;
     result.meanWeight = interpolated > 0 ? weightSum / (3.0 * double(interpolated)) : 0.0;
   } catch (const std::bad_alloc&) {

@@ -188,7 +188,8 @@ Status ReconstructWithPreview(SampleProvider& exact, SampleProvider& preview,
   }
   if (schedule.correctionRadius > 0 && previewCaps.variance) {
     const auto start = std::chrono::steady_clock::now();
-    DCM_RETURN_IF_ERROR(CorrectTowardPreview(preview, schedule.correctionRadius, out, &stats.correction));
+    DCM_RETURN_IF_ERROR(CorrectTowardPreview(preview, schedule.correctionRadius, options.downsample, out,
+                                             &stats.correction));
     stats.timeEngineS += Seconds(start);
   }
   // The final run's engine time excludes the rounds; the provider time is the rounds'.

@@ -61,7 +61,7 @@ TEST(PreviewCorrection, WhereTheInterpolationIsRightThePreviewsNoiseStaysOut) {
   Reconstruction r = Interpolated(Truth);
   ImagePreviewProvider preview = NoisyPreview(1);
   PreviewCorrectionStats stats;
-  ASSERT_TRUE(CorrectTowardPreview(preview, 5, &r, &stats).ok());
+  ASSERT_TRUE(CorrectTowardPreview(preview, 5, 1, &r, &stats).ok());
   // Unbiased: the window's mean d^2 exceeds its mean variance only by chance
   // (121 pixels: a relative sd of sqrt(2/121) = 0.13), so weights stay near
   // 0.13 / 1.13 at most and the noise let in is a few hundredths of kSd^2.
@@ -76,7 +76,7 @@ TEST(PreviewCorrection, WhatTheInterpolationMissedComesBackAtThePreviewsNoise) {
   });
   const double before = MseAgainstTruth(r, true);
   ImagePreviewProvider preview = NoisyPreview(2);
-  ASSERT_TRUE(CorrectTowardPreview(preview, 5, &r).ok());
+  ASSERT_TRUE(CorrectTowardPreview(preview, 5, 1, &r).ok());
   const double after = MseAgainstTruth(r, true);
   EXPECT_NEAR(before, 0.09, 1e-6);
   // Inside the stripe the weight is b^2 / (b^2 + v) = 0.97; near its edges the
@@ -95,7 +95,7 @@ TEST(PreviewCorrection, ExactPixelsKeepTheirValuesAndANaNStaysInItsPixel) {
   L[size_t(30) * N + 30] = RGB::Gray(nan);
   var[size_t(40) * N + 40] = RGB::Gray(std::numeric_limits<float>::infinity());
   ImagePreviewProvider preview(N, N, N, N, std::move(L), {}, {}, std::move(var));
-  ASSERT_TRUE(CorrectTowardPreview(preview, 5, &r).ok());
+  ASSERT_TRUE(CorrectTowardPreview(preview, 5, 1, &r).ok());
   for (int x = 0; x < N; ++x) EXPECT_EQ(r.workImage[size_t(10) * N + x].r, before[size_t(10) * N + x].r);
   EXPECT_EQ(r.workImage[size_t(30) * N + 30].r, before[size_t(30) * N + 30].r) << "no preview: no move";
   EXPECT_EQ(r.workImage[size_t(40) * N + 40].r, before[size_t(40) * N + 40].r) << "no variance: no move";
@@ -116,7 +116,7 @@ TEST(PreviewCorrection, AFireflyChangesOnlyTheWindowsItIsIn) {
     for (int x = 0; x < N; ++x) L[size_t(y) * N + x] = Truth(x, y) + RGB::Gray(y < 12 ? 0.01f : 0.f);
   L[size_t(2) * N + 2] = RGB::Gray(1e6f);
   ImagePreviewProvider preview(N, N, N, N, std::move(L), {}, {}, std::move(var));
-  ASSERT_TRUE(CorrectTowardPreview(preview, 5, &r).ok());
+  ASSERT_TRUE(CorrectTowardPreview(preview, 5, 1, &r).ok());
   // Far from the firefly (rows from 20), where the window lies inside the
   // stripe: b = 0.09 - 0.0025 against v = 0.0025, weight 0.97, so 3 % of the
   // loss remains (tolerance 5 %).
@@ -131,11 +131,12 @@ TEST(PreviewCorrection, RadiusZeroChangesNothingAndAPreviewWithoutVarianceIsRefu
   Reconstruction r = Interpolated(Truth);
   const std::vector<RGB> before = r.workImage;
   ImagePreviewProvider preview = NoisyPreview(3);
-  ASSERT_TRUE(CorrectTowardPreview(preview, 0, &r).ok());
+  ASSERT_TRUE(CorrectTowardPreview(preview, 0, 1, &r).ok());
   for (size_t i = 0; i < before.size(); ++i) ASSERT_EQ(r.workImage[i].g, before[i].g);
   ImagePreviewProvider noVariance(N, N, N, N, std::vector<RGB>(size_t(N) * N));
-  EXPECT_FALSE(CorrectTowardPreview(noVariance, 5, &r).ok());
-  EXPECT_FALSE(CorrectTowardPreview(preview, -1, &r).ok());
+  EXPECT_FALSE(CorrectTowardPreview(noVariance, 5, 1, &r).ok());
+  EXPECT_FALSE(CorrectTowardPreview(preview, -1, 1, &r).ok());
+  EXPECT_FALSE(CorrectTowardPreview(preview, 5, 0, &r).ok());
 }
 
 TEST(PreviewCorrection, TheOutputIsTheCorrectedWorkingImageDownsampled) {
@@ -148,7 +149,7 @@ TEST(PreviewCorrection, TheOutputIsTheCorrectedWorkingImageDownsampled) {
   r.sampleMap.assign(r.workImage.size(), SampleReason::kInterpolated);
   ImagePreviewProvider preview(2 * N, 2 * N, 2 * N, 2 * N, std::vector<RGB>(r.workImage.size(), RGB::Gray(0.5f)),
                                {}, {}, std::vector<RGB>(r.workImage.size(), RGB::Gray(1e-4f)));
-  ASSERT_TRUE(CorrectTowardPreview(preview, 3, &r).ok());
+  ASSERT_TRUE(CorrectTowardPreview(preview, 3, 2, &r).ok());
   ASSERT_EQ(r.width, N);
   ASSERT_EQ(r.image.size(), size_t(N) * N);
   // b^2 = 0.16 against v = 1e-4: the weight is 0.9994.

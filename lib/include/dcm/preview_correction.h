@@ -28,8 +28,9 @@ struct PreviewCorrectionStats {
 /// out of the chance fluctuation of that difference. Exact pixels and
 /// preview stand-ins keep their values; a pixel whose preview or variance is
 /// not finite neither counts in a window nor moves. `rec->image` is made again
-/// from the corrected working image. radius 0: nothing changes.
-Status CorrectTowardPreview(SampleProvider& preview, int radius, Reconstruction* rec,
+/// from the corrected working image, downsampled by `downsample` (the
+/// reconstruction's ReconstructionOptions::downsample). radius 0: nothing changes.
+Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample, Reconstruction* rec,
                             PreviewCorrectionStats* stats = nullptr);
 
 }  // namespace dcm
