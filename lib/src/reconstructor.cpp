@@ -28,6 +28,7 @@ std::string_view ToString(SampleReason r) {
     case SampleReason::kFallback: return "fallback";
     case SampleReason::kFull: return "full";
     case SampleReason::kPreviewStandIn: return "preview_stand_in";
+    case SampleReason::kRendered: return "rendered";
     case SampleReason::kCount: break;
   }
   return "?";

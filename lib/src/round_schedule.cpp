@@ -10,6 +10,7 @@
 #include <string>
 #include <utility>
 
+#include "dcm/downsample.h"
 #include "guide_cache.h"
 
 namespace dcm {
@@ -76,6 +77,22 @@ class PlanningProvider : public SampleProvider {
   std::vector<Point2i> TakeWanted() {
     for (const Point2i& p : wantedList_) wanted_[Index(p)] = 0;
     return std::exchange(wantedList_, {});
+  }
+
+  /// Gives the interpolated pixels of `rec` that a round evaluated their exact
+  /// value (SampleReason::kRendered): they were paid for. Returns how many.
+  int64_t KeepRendered(Reconstruction* rec) const {
+    int64_t kept = 0;
+    for (size_t k = 0; k < known_.size(); ++k) {
+      // A non-finite sample stays out, as the engine keeps it out of its neighbours.
+      if (!known_[k] || rec->sampleMap[k] != SampleReason::kInterpolated || !IsFinite(samples_[k].L)) continue;
+      rec->workImage[k] = samples_[k].L;
+      rec->sampleMap[k] = SampleReason::kRendered;
+      ++kept;
+    }
+    rec->stats.byReason[size_t(SampleReason::kRendered)] += kept;
+    rec->stats.exactPixels += kept;
+    return kept;
   }
 
   /// Evaluates `pixels` with the exact provider in one call and keeps them.
@@ -174,6 +191,11 @@ Status ReconstructWithPreview(SampleProvider& exact, SampleProvider& preview,
           reason = SampleReason::kPreviewStandIn;
           ++out->stats.byReason[size_t(SampleReason::kPreviewStandIn)];
         }
+        // Noisy samples: the final run denoised its exact samples against their
+        // neighbours, and a raw one among them is noise (docs/TUNING.md).
+        if (!out->stats.settings.noisy && planning.KeepRendered(out) > 0)
+          out->image = BoxDownsample(out->workImage, out->workWidth, out->workHeight, options.downsample,
+                                     &out->width, &out->height);
         break;
       }
       const auto exactStart = std::chrono::steady_clock::now();

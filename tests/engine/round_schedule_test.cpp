@@ -71,7 +71,25 @@ TEST(RoundSchedule, ALowResolutionPreviewConvergesToTheDirectImage) {
   for (int64_t n : stats.pixelsPerRound) std::printf(" %lld", (long long)n);
   std::printf("\n");
   ASSERT_EQ(stats.previewStandIns, 0);
-  EXPECT_EQ(planned.workImage, direct.workImage);
+  // Pixels that a round rendered and the final run did not ask for keep their
+  // exact value (kRendered) where the direct run interpolates.
+  int64_t rendered = 0;
+  for (size_t i = 0; i < planned.sampleMap.size(); ++i) {
+    if (planned.sampleMap[i] == SampleReason::kRendered) {
+      ++rendered;
+      EXPECT_EQ(direct.sampleMap[i], SampleReason::kInterpolated) << "pixel " << i;
+      const Point2i p{int(i % N), int(i / N)};
+      ExactSample s;
+      ASSERT_TRUE(truth.Evaluate({&p, 1}, {}, {&s, 1}).ok());
+      EXPECT_EQ(planned.workImage[i], s.L) << "pixel " << i;
+    } else {
+      EXPECT_EQ(planned.sampleMap[i], direct.sampleMap[i]) << "pixel " << i;
+      EXPECT_EQ(planned.workImage[i], direct.workImage[i]) << "pixel " << i;
+    }
+  }
+  EXPECT_EQ(planned.stats.exactPixels, direct.stats.exactPixels + rendered) << "rendered pixels count as exact";
+  EXPECT_EQ(planned.stats.byReason[size_t(SampleReason::kRendered)], rendered);
+  EXPECT_GT(rendered, 0) << "a plan at 1/4 resolution asks for pixels the final run does not need";
   EXPECT_EQ(exact.calls, stats.rounds);
   // A plan at 1/4 resolution gets most pixels right: the later rounds are the
   // few whose choice depended on detail below the preview's resolution.
@@ -169,6 +187,12 @@ TEST(RoundSchedule, ANoisyPreviewWithItsVarianceIsNotTakenForEdges) {
   // Against the noise-free truth: no worse than without, but for 0.3 dB (the
   // two runs' exact pixels differ, and each carries noise of about 30 dB).
   EXPECT_GE(psnrWith, psnrWithout - 0.3);
+  // Noisy exact samples are denoised against their neighbours: a raw one that
+  // the final run did not ask for stays out.
+  for (const Reconstruction* rec : {&recWith, &recWithout}) {
+    ASSERT_TRUE(rec->stats.settings.noisy);
+    EXPECT_EQ(rec->stats.byReason[size_t(SampleReason::kRendered)], 0);
+  }
 }
 
 TEST(RoundSchedule, ThePreviewCorrectionCostsLittleWhereThePreviewIsMuchNoisier) {

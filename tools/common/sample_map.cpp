@@ -81,6 +81,7 @@ std::array<uint8_t, 3> ReasonColor(SampleReason reason) {
     case SampleReason::kFallback: return {255, 170, 0};         // orange
     case SampleReason::kFull: return {150, 150, 255};           // lavender
     case SampleReason::kPreviewStandIn: return {120, 80, 160};  // dull purple
+    case SampleReason::kRendered: return {140, 200, 170};       // sage
     case SampleReason::kCount: break;
   }
   return {128, 64, 0};  // brown: an unknown reason (never expected)

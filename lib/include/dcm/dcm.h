@@ -47,7 +47,7 @@ extern "C" {
  *  "contrast_metric_supersampled", "directions_supersampled" and
  *  "thin_objects_supersampled" are gone (a value set serves every regime).
  *  Version 5 adds dcmSetPreviewVariance(). */
-#define DCM_C_API_VERSION 5
+#define DCM_C_API_VERSION 6
 
 /** A reconstructor: options, guides, the sample callback and the last result. */
 typedef struct DCMReconstructorImpl* DCMReconstructor;
@@ -90,7 +90,8 @@ enum {
   DCM_REASON_FALLBACK = 7,
   DCM_REASON_FULL = 8,
   DCM_REASON_PREVIEW_STAND_IN = 9, /**< left at its preview value (dcmSetRoundCost); since API version 3 */
-  DCM_REASON_COUNT = 10
+  DCM_REASON_RENDERED = 10, /**< rendered in a round that the final plan did not need; since API version 6 */
+  DCM_REASON_COUNT = 11
 };
 
 /** Evaluates `count` pixels exactly. `xy` holds 2*count ints (x0, y0, x1, y1,

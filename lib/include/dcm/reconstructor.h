@@ -30,6 +30,9 @@ enum class SampleReason : uint8_t {
   /// wanted exact, left at a preview's stand-in value after the last round
   /// (RoundSchedule::kPreview); not counted as exact
   kPreviewStandIn,
+  /// evaluated in a round planned on the preview that the final run did not
+  /// ask for: keeps its exact value (RoundSchedule::kPreview)
+  kRendered,
   kCount
 };
 inline constexpr int kSampleReasonCount = int(SampleReason::kCount);

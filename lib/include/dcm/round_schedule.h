@@ -34,7 +34,9 @@ enum class RoundSchedule : uint8_t {
   /// provider evaluates them in one call; the engine runs again on the exact
   /// samples and asks for the pixels whose choice changed; and so on, up to
   /// `maxRounds` calls. Pixels still wanted after the last round keep their
-  /// preview value (SampleReason::kPreviewStandIn, not counted as exact).
+  /// preview value (SampleReason::kPreviewStandIn, not counted as exact);
+  /// pixels a round evaluated that the final run did not ask for keep their
+  /// exact value (SampleReason::kRendered, counted as exact).
   kPreview,
 };
 std::string_view ToString(RoundSchedule);

@@ -41,7 +41,10 @@ def parse_args(argv):
     ap.add_argument("--mask-scale", type=int, default=4, help="mask texels per pixel and side")
     ap.add_argument("--masked-min-samples", type=int, default=0,
                     help="samples after which a masked pixel may stop in a round of exact pixels "
-                         "(0: an eighth of the samples; the samples: never)")
+                         "(0: 8, which stops at 16; the samples: never)")
+    ap.add_argument("--adaptive-threshold", type=float, default=1e-8,
+                    help="tests: Cycles' noise threshold in rounds of exact pixels (exact pixels that "
+                         "stop before every sample are rendered again)")
     ap.add_argument("--workdir", default="",
                     help="scratch folder for masks and renders, made and removed by dcm (default: one of its own)")
     ap.add_argument("--verbose", action="store_true", help="the time of each render call on stderr")
@@ -182,5 +185,7 @@ def main(argv):
     if args.verbose:
         for label, s in session.render_seconds:
             print("dcm-blender: render %s %.2f s" % (label, s), file=sys.stderr)
+        print("dcm-blender: %d exact pixels stopped early and were rendered again" % session.rendered_again,
+              file=sys.stderr)
         print("dcm-blender: %.2f s in the child" % (time.monotonic() - t0), file=sys.stderr, flush=True)
     return status

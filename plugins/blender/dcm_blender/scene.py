@@ -111,6 +111,7 @@ class Session:
         self._round = 0
         self.noise_psnr = None  # of the exact pixels' samples, from the preview's halves
         self.render_seconds = []
+        self.rendered_again = 0  # exact pixels that stopped early (_stopped_early)
 
     # ------------------------------------------------------------- setup --
     def setup(self):
@@ -166,8 +167,8 @@ class Session:
                      "use_pass_cryptomatte_material"):
             c.set(vl, attr, True)
         c.set(vl, "pass_cryptomatte_depth", 2)
-        if a.keep_renders:  # tests read how many samples each pixel took
-            c.set(vl.cycles, "pass_debug_sample_count", True)
+        # How many samples each pixel took: an exact pixel that stopped early is rendered again.
+        c.set(vl.cycles, "pass_debug_sample_count", True)
 
         cy = sc.cycles
         self.samples = a.samples if a.samples > 0 else cy.samples
@@ -467,21 +468,51 @@ class Session:
         return best
 
     def _masked_min_samples(self, n):
-        """Samples after which a masked pixel of a render of n samples may stop."""
-        return max(4, min(n, self.args.masked_min_samples or n // 8))
+        """Samples after which a masked pixel of a render of n samples may stop:
+        8 by default: Cycles judges convergence every 16 samples past the minimum."""
+        return max(4, min(n, self.args.masked_min_samples or 8))
 
     def _masked_pixels_stop(self, n):
         """Lets a masked pixel stop after a few of the n samples (n = 0: off). A
         masked camera ray costs Cycles about a seventh of a rendered one per sample;
         with adaptive sampling a pixel whose samples agree stops, and a masked
         pixel's are all 0. The threshold is so low that a rendered pixel stops only
-        when its samples are all equal: the minimum, an eighth of them, makes that
-        unlikely where the pixel is not constant (docs/BLENDER.md, "Masked pixels")."""
+        when its samples are all equal (0, in practice: float rounding keeps other
+        constant sums from agreeing); _stopped_early() finds those that did
+        (docs/BLENDER.md, "Masked pixels")."""
         cy = self.scene.cycles
         cy.use_adaptive_sampling = n > 0
         if n > 0:
-            cy.adaptive_threshold = 1e-8
+            cy.adaptive_threshold = self.args.adaptive_threshold
             cy.adaptive_min_samples = self._masked_min_samples(n)
+
+    def _stopped_early(self, pl, n, xs, ys, inside):
+        """Which pixels (xs, ys) in `inside` took fewer than the n samples and are
+        not constant: their value differs from the preview's, or the preview's
+        two halves differ. A pixel whose samples were all 0 so far stops, and
+        a dark pixel that rare paths light is not 0."""
+        took = pl["Debug Sample Count.X"][ys, xs] * n  # Cycles writes the share of the samples
+        short = inside & (took < n - 0.5)
+        if not short.any():
+            return short
+        g = self.guides()
+        L = self._rgb(pl, "Combined")[ys, xs]
+        constant = (L == g["L"][ys, xs]).all(axis=1)
+        if "var" in g:
+            constant &= (g["var"][ys, xs] == 0).all(axis=1)
+        return short & ~constant
+
+    def _render_all_samples(self, n, label, seed, xs, ys):
+        """Renders pixels (xs, ys) with every one of the n samples (adaptive
+        sampling off), within borders over their 16-px tiles or, past
+        max_calls, the whole frame: the planes of each render and where it holds."""
+        self._masked_pixels_stop(0)
+        rects = self._runs(xs, ys, 16)
+        for rect in rects if len(rects) <= self.args.max_calls else [None]:
+            self._set_border(rect)
+            inside = np.ones(len(xs), bool) if rect is None else (
+                (xs >= rect[0]) & (xs < rect[2]) & (ys >= rect[1]) & (ys < rect[3]))
+            yield self._render(n, label, seed), inside
 
     def _set_border(self, rect):
         r = self.scene.render
@@ -530,6 +561,15 @@ class Session:
                                      "reach Cycles" % int(stray.sum()))
                 L[h, inside] = self._rgb(pl, "Combined")[ys[inside], xs[inside]]
                 Li[h, inside] = (self._rgb(pl, "DiffDir") + self._rgb(pl, "DiffInd"))[ys[inside], xs[inside]]
+                early = self._stopped_early(pl, n, xs, ys, inside)
+                if early.any():
+                    self.rendered_again += int(early.sum())
+                    ex, ey = xs[early], ys[early]
+                    for pl2, in2 in self._render_all_samples(n, "eval%d_again" % self._evals, seed, ex, ey):
+                        L[h, np.flatnonzero(early)[in2]] = self._rgb(pl2, "Combined")[ey[in2], ex[in2]]
+                        Li[h, np.flatnonzero(early)[in2]] = (self._rgb(pl2, "DiffDir") +
+                                                             self._rgb(pl2, "DiffInd"))[ey[in2], ex[in2]]
+                    self._set_border(rect)
             done |= inside
         self._set_border(None)
         self._masked_pixels_stop(0)
