@@ -185,7 +185,8 @@ def main(argv):
     if args.verbose:
         for label, s in session.render_seconds:
             print("dcm-blender: render %s %.2f s" % (label, s), file=sys.stderr)
-        print("dcm-blender: %d exact pixels stopped early and were rendered again" % session.rendered_again,
-              file=sys.stderr)
+        print("dcm-blender: %d renders kept masked pixels for an eighth of the samples (an exact pixel might "
+              "have stopped early); %d exact pixels stopped early and were rendered again"
+              % (session.careful_renders, session.rendered_again), file=sys.stderr)
         print("dcm-blender: %.2f s in the child" % (time.monotonic() - t0), file=sys.stderr, flush=True)
     return status

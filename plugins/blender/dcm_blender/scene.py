@@ -112,6 +112,7 @@ class Session:
         self.noise_psnr = None  # of the exact pixels' samples, from the preview's halves
         self.render_seconds = []
         self.rendered_again = 0  # exact pixels that stopped early (_stopped_early)
+        self.careful_renders = 0  # renders of exact pixels whose masked pixels stopped late (_careful)
 
     # ------------------------------------------------------------- setup --
     def setup(self):
@@ -418,6 +419,8 @@ class Session:
             g["texture"] = mean("DiffCol")
             g["normal"] = self._rgb(pl, "Normal", "XYZ")
             g["L"] = mean("Combined")
+            # Each seed's render alone: where it is 0, that seed's first samples of the pixel are.
+            g["L_of_seed"] = [self._rgb(p, "Combined") for p in pls]
             g["Li"] = mean("DiffDir") + mean("DiffInd")
             g["Lc"] = g["L"] - g["Li"] * g["texture"]
             if len(pls) == 2:
@@ -457,7 +460,9 @@ class Session:
         if self.args.border_tile > 0:
             return self._runs(xs, ys, self.args.border_tile)
         n = self.samples // calls
-        masked = 0.14 * self.pixel_seconds() * self._masked_min_samples(n) / n
+        # A masked pixel stops at Cycles' first check past the minimum (every 16 samples).
+        stops = min(n, 16 * (self._masked_min_samples(n) // 16 + 1))
+        masked = 0.14 * self.pixel_seconds() * stops / n
         best, best_cost = [None], calls * self.args.call_seconds + self.width * self.height * masked
         for t in (16, 32, 64):
             rects = self._runs(xs, ys, t)
@@ -467,12 +472,31 @@ class Session:
                 best, best_cost = rects, cost
         return best
 
-    def _masked_min_samples(self, n):
+    def _masked_min_samples(self, n, careful=False):
         """Samples after which a masked pixel of a render of n samples may stop:
-        8 by default: Cycles judges convergence every 16 samples past the minimum."""
-        return max(4, min(n, self.args.masked_min_samples or 8))
+        8 by default (Cycles judges convergence every 16 samples past the
+        minimum), an eighth of them where an exact pixel might stop (careful)."""
+        return max(4, min(n, self.args.masked_min_samples or (n // 8 if careful else 8)))
 
-    def _masked_pixels_stop(self, n):
+    def _careful(self, xs, ys, h, n):
+        """Whether a render of exact pixels (xs, ys) at n samples with the h-th
+        seed should keep its masked pixels for an eighth of the samples: where
+        exact pixels might stop early and rendering them again (one call per
+        run of 16-px tiles) would cost more than the masked samples. A pixel
+        might stop where its preview with that seed is 0 (the same seed's
+        first samples were all 0) and the preview of the other seed is not
+        (it is not black); without halves a black preview counts too."""
+        g = self.guides()
+        zero = (g["L_of_seed"][min(h, len(g["L_of_seed"]) - 1)][ys, xs] == 0).all(axis=1)
+        if len(g["L_of_seed"]) > 1:
+            zero &= ~(g["L"][ys, xs] == 0).all(axis=1)
+        if not zero.any():
+            return False
+        again = len(self._runs(xs[zero], ys[zero], 16)) * self.args.call_seconds
+        extra = 0.14 * self.pixel_seconds() * max(n // 8 - 16, 0) / n * self.width * self.height
+        return again > extra
+
+    def _masked_pixels_stop(self, n, careful=False):
         """Lets a masked pixel stop after a few of the n samples (n = 0: off). A
         masked camera ray costs Cycles about a seventh of a rendered one per sample;
         with adaptive sampling a pixel whose samples agree stops, and a masked
@@ -484,7 +508,7 @@ class Session:
         cy.use_adaptive_sampling = n > 0
         if n > 0:
             cy.adaptive_threshold = self.args.adaptive_threshold
-            cy.adaptive_min_samples = self._masked_min_samples(n)
+            cy.adaptive_min_samples = self._masked_min_samples(n, careful)
 
     def _stopped_early(self, pl, n, xs, ys, inside):
         """Which pixels (xs, ys) in `inside` took fewer than the n samples and are
@@ -550,7 +574,9 @@ class Session:
             inside = np.ones(len(xs), bool) if rect is None else (
                 (xs >= rect[0]) & (xs < rect[2]) & (ys >= rect[1]) & (ys < rect[3]))
             for h, (n, seed) in enumerate(zip(counts, self.seeds)):
-                self._masked_pixels_stop(n)
+                careful = self._careful(xs[inside], ys[inside], h, n)
+                self.careful_renders += careful
+                self._masked_pixels_stop(n, careful)
                 pl = self._render(n, "eval%d" % self._evals, seed)
                 diffcol = self._rgb(pl, "DiffCol")
                 # The mask rendered must be the mask asked for: outside it no surface
