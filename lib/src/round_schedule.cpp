@@ -191,11 +191,6 @@ Status ReconstructWithPreview(SampleProvider& exact, SampleProvider& preview,
           reason = SampleReason::kPreviewStandIn;
           ++out->stats.byReason[size_t(SampleReason::kPreviewStandIn)];
         }
-        // Noisy samples: the final run denoised its exact samples against their
-        // neighbours, and a raw one among them is noise (docs/TUNING.md).
-        if (!out->stats.settings.noisy && planning.KeepRendered(out) > 0)
-          out->image = BoxDownsample(out->workImage, out->workWidth, out->workHeight, options.downsample,
-                                     &out->width, &out->height);
         break;
       }
       const auto exactStart = std::chrono::steady_clock::now();
@@ -205,14 +200,21 @@ Status ReconstructWithPreview(SampleProvider& exact, SampleProvider& preview,
       ++stats.rounds;
       stats.pixelsPerRound.push_back(int64_t(wanted.size()));
     }
+    // The correction first: where the interpolation missed at a rendered pixel,
+    // it missed around it too, and the correction's windows see it there.
+    if (schedule.correctionRadius > 0 && previewCaps.variance) {
+      const auto start = std::chrono::steady_clock::now();
+      DCM_RETURN_IF_ERROR(CorrectTowardPreview(preview, schedule.correctionRadius, options.downsample, out,
+                                               &stats.correction));
+      stats.timeEngineS += Seconds(start);
+    }
+    // Noisy samples: the final run denoised its exact samples against their
+    // neighbours, and a raw one among them is noise (docs/TUNING.md).
+    if (!out->stats.settings.noisy && planning.KeepRendered(out) > 0)
+      out->image = BoxDownsample(out->workImage, out->workWidth, out->workHeight, options.downsample,
+                                 &out->width, &out->height);
   } catch (const std::bad_alloc&) {
     return Status::Error("out of memory while planning rounds on the preview");
-  }
-  if (schedule.correctionRadius > 0 && previewCaps.variance) {
-    const auto start = std::chrono::steady_clock::now();
-    DCM_RETURN_IF_ERROR(CorrectTowardPreview(preview, schedule.correctionRadius, options.downsample, out,
-                                             &stats.correction));
-    stats.timeEngineS += Seconds(start);
   }
   // The final run's engine time excludes the rounds; the provider time is the rounds'.
   out->stats.timeProviderS = stats.timeExactS;
