@@ -79,20 +79,26 @@ class PlanningProvider : public SampleProvider {
     return std::exchange(wantedList_, {});
   }
 
-  /// Gives the interpolated pixels of `rec` that a round evaluated their exact
-  /// value (SampleReason::kRendered): they were paid for. Returns how many.
-  int64_t KeepRendered(Reconstruction* rec) const {
+  /// Marks the interpolated pixels of `rec` that a round evaluated as exact
+  /// (SampleReason::kRendered): they were paid for. Their values stay until
+  /// FillRendered(). Returns how many.
+  int64_t MarkRendered(Reconstruction* rec) const {
     int64_t kept = 0;
     for (size_t k = 0; k < known_.size(); ++k) {
       // A non-finite sample stays out, as the engine keeps it out of its neighbours.
       if (!known_[k] || rec->sampleMap[k] != SampleReason::kInterpolated || !IsFinite(samples_[k].L)) continue;
-      rec->workImage[k] = samples_[k].L;
       rec->sampleMap[k] = SampleReason::kRendered;
       ++kept;
     }
     rec->stats.byReason[size_t(SampleReason::kRendered)] += kept;
     rec->stats.exactPixels += kept;
     return kept;
+  }
+
+  /// Gives the pixels MarkRendered() marked their exact values.
+  void FillRendered(Reconstruction* rec) const {
+    for (size_t k = 0; k < known_.size(); ++k)
+      if (rec->sampleMap[k] == SampleReason::kRendered) rec->workImage[k] = samples_[k].L;
   }
 
   /// Evaluates `pixels` with the exact provider in one call and keeps them.
@@ -200,19 +206,23 @@ Status ReconstructWithPreview(SampleProvider& exact, SampleProvider& preview,
       ++stats.rounds;
       stats.pixelsPerRound.push_back(int64_t(wanted.size()));
     }
-    // The correction first: where the interpolation missed at a rendered pixel,
-    // it missed around it too, and the correction's windows see it there.
+    // Rendered pixels keep their exact values, but not with noisy samples: the
+    // final run denoised its exact samples against their neighbours, and a raw
+    // one among them is noise (docs/TUNING.md).
+    const int64_t rendered = out->stats.settings.noisy ? 0 : planning.MarkRendered(out);
+    // The correction sees their interpolated values: where the interpolation
+    // missed at a rendered pixel, it missed around it too.
     if (schedule.correctionRadius > 0 && previewCaps.variance) {
       const auto start = std::chrono::steady_clock::now();
       DCM_RETURN_IF_ERROR(CorrectTowardPreview(preview, schedule.correctionRadius, options.downsample, out,
                                                &stats.correction));
       stats.timeEngineS += Seconds(start);
     }
-    // Noisy samples: the final run denoised its exact samples against their
-    // neighbours, and a raw one among them is noise (docs/TUNING.md).
-    if (!out->stats.settings.noisy && planning.KeepRendered(out) > 0)
+    if (rendered > 0) {
+      planning.FillRendered(out);
       out->image = BoxDownsample(out->workImage, out->workWidth, out->workHeight, options.downsample,
                                  &out->width, &out->height);
+    }
   } catch (const std::bad_alloc&) {
     return Status::Error("out of memory while planning rounds on the preview");
   }

@@ -177,6 +177,17 @@ TEST(PreviewCorrection, APreviewPlannedRunWithANoisyPreviewGetsCloserToTheTruth)
     PreviewScheduleStats stats;
     ASSERT_TRUE(ReconstructWithPreview(truth, preview, o, schedule, &r, &stats).ok());
     EXPECT_EQ(stats.correction.pixels > 0, radius > 0);
+    // Pixels a round rendered that the final run did not ask for hold their
+    // exact values, corrected or not, and the correction did not count them.
+    int64_t rendered = 0, interpolated = 0;
+    for (size_t i = 0; i < ref.size(); ++i) {
+      interpolated += r.sampleMap[i] == SampleReason::kInterpolated;
+      if (r.sampleMap[i] != SampleReason::kRendered) continue;
+      ++rendered;
+      EXPECT_EQ(r.workImage[i], ref[i]) << "pixel " << i;
+    }
+    EXPECT_GT(rendered, 0) << "the noisy preview's plan asks for pixels the exact samples do not";
+    EXPECT_LE(stats.correction.pixels, interpolated);
     double s = 0;
     for (size_t i = 0; i < ref.size(); ++i) {
       const RGB d = r.image[i] - ref[i];
