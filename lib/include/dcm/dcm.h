@@ -46,7 +46,7 @@ extern "C" {
  *  their twins "noisy_elementary_block", "contrast_threshold_supersampled",
  *  "contrast_metric_supersampled", "directions_supersampled" and
  *  "thin_objects_supersampled" are gone (a value set serves every regime).
- *  Version 5 adds dcmSetPreviewVariance(). */
+ *  Version 5 adds dcmSetPreviewVariance(). Version 6 adds DCM_REASON_RENDERED. */
 #define DCM_C_API_VERSION 6
 
 /** A reconstructor: options, guides, the sample callback and the last result. */
