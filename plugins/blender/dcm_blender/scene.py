@@ -461,8 +461,7 @@ class Session:
             return self._runs(xs, ys, self.args.border_tile)
         n = self.samples // calls
         # A masked pixel stops at Cycles' first check past the minimum (every 16 samples).
-        stops = min(n, 16 * (self._masked_min_samples(n) // 16 + 1))
-        masked = 0.14 * self.pixel_seconds() * stops / n
+        masked = self._masked_seconds(min(n, 16 * (self._masked_min_samples(n) // 16 + 1)), n)
         best, best_cost = [None], calls * self.args.call_seconds + self.width * self.height * masked
         for t in (16, 32, 64):
             rects = self._runs(xs, ys, t)
@@ -471,6 +470,11 @@ class Session:
             if len(rects) <= self.args.max_calls and cost < best_cost:
                 best, best_cost = rects, cost
         return best
+
+    def _masked_seconds(self, samples, n):
+        """What a masked pixel costs for `samples` of a render of n samples: about
+        a seventh of a rendered pixel's per sample (docs/BLENDER.md)."""
+        return 0.14 * self.pixel_seconds() * samples / n
 
     def _masked_min_samples(self, n, careful=False):
         """Samples after which a masked pixel of a render of n samples may stop:
@@ -493,7 +497,7 @@ class Session:
         if not zero.any():
             return False
         again = len(self._runs(xs[zero], ys[zero], 16)) * self.args.call_seconds
-        extra = 0.14 * self.pixel_seconds() * max(n // 8 - 16, 0) / n * self.width * self.height
+        extra = self._masked_seconds(max(n // 8 - 16, 0), n) * self.width * self.height
         return again > extra
 
     def _masked_pixels_stop(self, n, careful=False):
@@ -526,6 +530,17 @@ class Session:
             constant &= (g["var"][ys, xs] == 0).all(axis=1)
         return short & ~constant
 
+    @staticmethod
+    def _inside(rect, xs, ys):
+        """Which pixels (xs, ys) a render border (x0, y0, x1, y1) holds; None: the frame."""
+        if rect is None:
+            return np.ones(len(xs), bool)
+        return (xs >= rect[0]) & (xs < rect[2]) & (ys >= rect[1]) & (ys < rect[3])
+
+    def _exact_values(self, pl, xs, ys):
+        """L and L_i = DiffDir + DiffInd of pixels (xs, ys) in a render's planes."""
+        return self._rgb(pl, "Combined")[ys, xs], (self._rgb(pl, "DiffDir") + self._rgb(pl, "DiffInd"))[ys, xs]
+
     def _render_all_samples(self, n, label, seed, xs, ys):
         """Renders pixels (xs, ys) with every one of the n samples (adaptive
         sampling off), within borders over their 16-px tiles or, past
@@ -534,9 +549,7 @@ class Session:
         rects = self._runs(xs, ys, 16)
         for rect in rects if len(rects) <= self.args.max_calls else [None]:
             self._set_border(rect)
-            inside = np.ones(len(xs), bool) if rect is None else (
-                (xs >= rect[0]) & (xs < rect[2]) & (ys >= rect[1]) & (ys < rect[3]))
-            yield self._render(n, label, seed), inside
+            yield self._render(n, label, seed), self._inside(rect, xs, ys)
 
     def _set_border(self, rect):
         r = self.scene.render
@@ -571,8 +584,7 @@ class Session:
         self._evals = getattr(self, "_evals", 0) + 1
         for rect in self.rectangles(xs, ys, len(counts)):
             self._set_border(rect)
-            inside = np.ones(len(xs), bool) if rect is None else (
-                (xs >= rect[0]) & (xs < rect[2]) & (ys >= rect[1]) & (ys < rect[3]))
+            inside = self._inside(rect, xs, ys)
             for h, (n, seed) in enumerate(zip(counts, self.seeds)):
                 careful = self._careful(xs[inside], ys[inside], h, n)
                 self.careful_renders += careful
@@ -585,16 +597,13 @@ class Session:
                 if stray.any():
                     raise SceneError("%d pixels outside the mask were rendered: the mask of this round did not "
                                      "reach Cycles" % int(stray.sum()))
-                L[h, inside] = self._rgb(pl, "Combined")[ys[inside], xs[inside]]
-                Li[h, inside] = (self._rgb(pl, "DiffDir") + self._rgb(pl, "DiffInd"))[ys[inside], xs[inside]]
-                early = self._stopped_early(pl, n, xs, ys, inside)
-                if early.any():
-                    self.rendered_again += int(early.sum())
+                L[h, inside], Li[h, inside] = self._exact_values(pl, xs[inside], ys[inside])
+                early = np.flatnonzero(self._stopped_early(pl, n, xs, ys, inside))
+                if len(early):
+                    self.rendered_again += len(early)
                     ex, ey = xs[early], ys[early]
                     for pl2, in2 in self._render_all_samples(n, "eval%d_again" % self._evals, seed, ex, ey):
-                        L[h, np.flatnonzero(early)[in2]] = self._rgb(pl2, "Combined")[ey[in2], ex[in2]]
-                        Li[h, np.flatnonzero(early)[in2]] = (self._rgb(pl2, "DiffDir") +
-                                                             self._rgb(pl2, "DiffInd"))[ey[in2], ex[in2]]
+                        L[h, early[in2]], Li[h, early[in2]] = self._exact_values(pl2, ex[in2], ey[in2])
                     self._set_border(rect)
             done |= inside
         self._set_border(None)
