@@ -170,8 +170,9 @@ class Engine {
   /// For interior pixel q of an oriented leaf that the thin-object test
   /// rejects along the leaf's direction: the interpolant along the nearest
   /// neighbouring direction that passes it and whose ends agree
-  /// (neighbourDirections each side), or kThinObject.
-  SampleReason ResolveAlongNeighbours(const Leaf& leaf, Point2i q, Interpolant* in) const;
+  /// (neighbourDirections each side), or kThinObject. With `anyEnds`, where
+  /// no such direction's ends agree, the nearest that passes the test.
+  SampleReason ResolveAlongNeighbours(const Leaf& leaf, Point2i q, Interpolant* in, bool anyEnds = false) const;
   /// The interpolant's two border points, each on its own, do not differ
   /// significantly (false when one has no sample).
   bool EndsAgree(const Interpolant& in) const;
@@ -187,6 +188,10 @@ class Engine {
     kPreview,     ///< write what it can interpolate, leave the rest as it is
     kThinObjects, ///< only request (with ResolveInterpolant's reason) what it cannot
     kFinal,       ///< write what it can, request the rest
+    /// after kThinObjects and denoising: write every pixel that pass let
+    /// through (its decisions were on the raw samples; denoised ends may no
+    /// longer agree), request what it could not have
+    kDenoised,
   };
   /// Interpolates the pixels of an oriented leaf that are not exact along
   /// the leaf's direction (2.1), the thin-object test (3.1) deciding which

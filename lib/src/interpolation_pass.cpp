@@ -34,7 +34,7 @@ void Engine::InterpolateOriented(const Leaf& leaf, OrientedPass pass) {
       const bool found = InterpolantAlong(elements, b, {x, y}, leaf.direction, &in);
       SampleReason r = found ? ResolveInterpolant({x, y}, &in) : SampleReason::kFallback;
       if (r == SampleReason::kThinObject) {
-        r = ResolveAlongNeighbours(leaf, {x, y}, &in);
+        r = ResolveAlongNeighbours(leaf, {x, y}, &in, pass == OrientedPass::kDenoised);
       } else if (r == SampleReason::kInterpolated && NeighbourSteps() > 0 && OneEnded(in)) {
         // One border point on q's surface (the thin-object test lets it
         // pass): its value would reach across the block unchanged. A
@@ -44,12 +44,14 @@ void Engine::InterpolateOriented(const Leaf& leaf, OrientedPass pass) {
         LeastDifferentTwoEnded(leaf, {x, y}, &in);
       }
       if (r != SampleReason::kInterpolated) {
-        if (pass != OrientedPass::kPreview) RequestOrDefer(x, y, r);
+        // Deferred pixels were resolved before denoising: none may be added now.
+        if (pass == OrientedPass::kDenoised) store_.Request(x, y, r);
+        else if (pass != OrientedPass::kPreview) RequestOrDefer(x, y, r);
         continue;
       }
       if (pass == OrientedPass::kThinObjects) continue;
       Value v = Evaluate(store_, in);
-      const bool record = record_ && pass == OrientedPass::kFinal;
+      const bool record = record_ && (pass == OrientedPass::kFinal || pass == OrientedPass::kDenoised);
       if (record && !lazy) record_->Weighted(i, in);
       if (lazy) {
         // The centre sample corrects the parent's interpolation with a tent
@@ -96,7 +98,7 @@ Status Engine::InterpolateLeaves() {
     stats_.stageTimes.interpolation -= denoising;
     Progress(0.95f, "interpolation");
     ForEach(smoothLeaves_, writeSmooth);
-    ForEach(orientedLeaves_, [&](Leaf& l, size_t) { InterpolateOriented(l, OrientedPass::kFinal); });
+    ForEach(orientedLeaves_, [&](Leaf& l, size_t) { InterpolateOriented(l, OrientedPass::kDenoised); });
     // Nothing to evaluate unless the thin-object pass missed a pixel.
     DCM_RETURN_IF_ERROR(Flush());
     WriteFilledDeferred();

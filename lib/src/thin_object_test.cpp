@@ -117,19 +117,27 @@ bool Engine::LeastDifferentTwoEnded(const Leaf& leaf, Point2i q, Interpolant* in
   return least < std::numeric_limits<float>::infinity();
 }
 
-SampleReason Engine::ResolveAlongNeighbours(const Leaf& leaf, Point2i q, Interpolant* in) const {
+SampleReason Engine::ResolveAlongNeighbours(const Leaf& leaf, Point2i q, Interpolant* in, bool anyEnds) const {
   const Block& b = leaf.block;
+  Interpolant nearest;
+  bool passed = false;
   for (int step = 1; step <= NeighbourSteps(); ++step)
     for (int sign : {1, -1}) {
       if (sign < 0 && 2 * step == settings_.directions) continue;  // the perpendicular, tried once
       const int k = Turned(leaf.direction, sign * step);
       Interpolant alt;
-      if (InterpolantAlong(ElementsOf(b, k), b, q, k, &alt) && ResolveInterpolant(q, &alt) == SampleReason::kInterpolated &&
-          EndsAgree(alt)) {
+      if (!InterpolantAlong(ElementsOf(b, k), b, q, k, &alt) || ResolveInterpolant(q, &alt) != SampleReason::kInterpolated)
+        continue;
+      if (EndsAgree(alt)) {
         *in = alt;
         return SampleReason::kInterpolated;
       }
+      if (!passed) nearest = alt, passed = true;
     }
+  if (anyEnds && passed) {
+    *in = nearest;
+    return SampleReason::kInterpolated;
+  }
   return SampleReason::kThinObject;
 }
 
