@@ -20,6 +20,13 @@ namespace {
 /// bias of its window); below it, a weight would only let the noise in.
 constexpr double kSignificance = 1.5;
 
+/// Below this display-referred PSNR of the preview's own noise, its estimate
+/// of the result's error is not made: through the encoding's curve and clip,
+/// so noisy a preview errs on the side of error by several dB (chosen on the
+/// tuning set, docs/TUNING.md: the room at 64, 256 and 512 spp, previews of
+/// 20.3, 26.7 and 29.8 dB, estimates 6.4 dB low, 1.2 low and 0.7 high).
+constexpr double kMinPreviewPsnr = 25;
+
 /// Sums of `v` (W x H) over the window of radius r around each pixel,
 /// clipped to the grid: a horizontal then a vertical pass, each summed
 /// afresh per pixel. Running sums would subtract: after one outlier (a
@@ -41,10 +48,22 @@ std::vector<double> WindowSums(const std::vector<double>& v, int W, int H, int r
   return out;
 }
 
+/// The expected squared sRGB error against the truth of x + k (p - x) for a
+/// preview p whose two halves are p + s and p - s (s^2 = v, the variance of
+/// their mean: (A - B)^2 / 4 for equal halves A, B): with A, B, X the
+/// encodings, E[(X - A)(X - B)] = (X - E A)(X - E B) where x does not depend
+/// on their noise, plus k^2 the display variance of p, (A - B)^2 / 4.
+/// Negative values are part of an unbiased sum.
+double DisplayError(float p, double v, float x, double k) {
+  const double s = std::sqrt(std::max(v, 0.0));
+  const double A = SrgbEncode(float(p + s)), B = SrgbEncode(float(p - s)), X = SrgbEncode(x);
+  return (1 - k) * (1 - k) * (X - A) * (X - B) + k * k * (A - B) * (A - B) / 4;
+}
+
 }  // namespace
 
 Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample, Reconstruction* rec,
-                            PreviewCorrectionStats* stats) {
+                            PreviewCorrectionStats* stats, std::span<const RGB> ownVariance, double exactShare) {
   if (radius < 0) return Status::Error("preview correction: radius " + std::to_string(radius) + " is negative");
   if (downsample < 1)
     return Status::Error("preview correction: downsample " + std::to_string(downsample) + " is below 1");
@@ -61,6 +80,9 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample,
                          std::to_string(caps.height) + ", the working image " + std::to_string(W) + "x" +
                          std::to_string(H));
   if (!caps.variance) return Status::Error("preview correction: the preview has no variance");
+  if (!ownVariance.empty() && ownVariance.size() != n)
+    return Status::Error("preview correction: " + std::to_string(ownVariance.size()) +
+                         " own variances for " + std::to_string(n) + " working pixels");
   try {
     std::vector<Point2i> all(n);
     for (int y = 0; y < H; ++y)
@@ -85,6 +107,11 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample,
     int64_t interpolated = 0;
     for (size_t i = 0; i < n; ++i) interpolated += rec->sampleMap[i] == SampleReason::kInterpolated;
     std::vector<double> e(n), e2(n), v(n);
+    auto own = [&](size_t i, int c) {
+      return ownVariance.empty() ? double(p[i].variance[c]) : double(ownVariance[i][c]);
+    };
+    // Per pixel, the estimated squared display error of the result (a sum over channels).
+    std::vector<double> error(downsample == 1 ? n : 0, 0.0);
     for (int c = 0; c < 3; ++c) {
       // Linear: a noisy preview's mean is the truth there, not after the display's clip and curve.
       for (size_t i = 0; i < n; ++i) {
@@ -104,11 +131,38 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample,
           const double bias2 = se[i] / m;
           const double sdE = std::sqrt(std::max(se2[i] / m - bias2 * bias2, 0.0));
           const double k = bias2 > 0 && bias2 > kSignificance * sdE / std::sqrt(m) ? bias2 / (bias2 + meanV) : 0.0;
+          if (!error.empty()) error[i] += DisplayError(p[i].L[c], own(i, c), rec->workImage[i][c], k);
           if (k <= 0) continue;
           corrected[i][c] = float(double(rec->workImage[i][c]) + k * (double(p[i].L[c]) - double(rec->workImage[i][c])));
           moved[i] = 1;
           weightSum += k;
         }
+    }
+    if (!error.empty()) {
+      // A stand-in keeps the preview's value, so its error is the preview's
+      // noise; an exact pixel's is its own, a share of it.
+      std::vector<double> d, w;
+      d.reserve(n);
+      for (size_t i = 0; i < n; ++i) {
+        const SampleReason r = rec->sampleMap[i];
+        if (r == SampleReason::kInterpolated) {
+          if (usable[i]) d.push_back(error[i] / 3);
+        } else if (usable[i]) {
+          double sum = 0;
+          for (int c = 0; c < 3; ++c) sum += DisplayError(p[i].L[c], own(i, c), p[i].L[c], 1.0);
+          d.push_back((r == SampleReason::kPreviewStandIn ? 1.0 : exactShare) * sum / 3);
+        } else {
+          d.push_back(0);
+        }
+      }
+      w.assign(d.size(), 1.0);
+      result.estimate = EstimatePsnr(d, w);
+      double noise = 0;
+      for (size_t i = 0; i < n; ++i)
+        if (usable[i])
+          for (int c = 0; c < 3; ++c) noise += DisplayError(p[i].L[c], own(i, c), p[i].L[c], 1.0) / 3;
+      result.previewPsnr = 10 * std::log10(double(n) / std::max(noise, 1e-30));
+      if (!(result.previewPsnr >= kMinPreviewPsnr)) result.estimate = PreviewCorrectionStats{}.estimate;
     }
     rec->workImage = std::move(corrected);
     rec->image = BoxDownsample(rec->workImage, W, H, downsample, &rec->width, &rec->height);

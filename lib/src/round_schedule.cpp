@@ -215,7 +215,8 @@ Status ReconstructWithPreview(SampleProvider& exact, SampleProvider& preview,
     if (schedule.correctionRadius > 0 && previewCaps.variance) {
       const auto start = std::chrono::steady_clock::now();
       DCM_RETURN_IF_ERROR(CorrectTowardPreview(preview, schedule.correctionRadius, options.downsample, out,
-                                               &stats.correction));
+                                               &stats.correction, schedule.previewOwnVariance,
+                                               schedule.exactVarianceShare));
       stats.timeEngineS += Seconds(start);
     }
     if (rendered > 0) {

@@ -138,11 +138,25 @@ def variance(dcm, blender, src, tmp):
     assert unc[2]["blender"]["preview_corrected"] == 0, unc[2]["blender"]
     corrected = on[2]["blender"]["preview_corrected"]
     assert 0.9 * corrected <= moved.sum() <= corrected and corrected > 0, (moved.sum(), on[2]["blender"])
+    # The corrected run estimates its PSNR against the converged image from the
+    # preview where the preview's own noise costs less than 25 dB; without the
+    # correction there is no estimate.
+    # correction there is no estimate. (The 4-sample preview costs about 23 dB,
+    # the 16-sample one about 29.)
+    assert "estimated_psnr" not in unc[2] and "preview_psnr" not in unc[2]["blender"], unc[2]
+    for k in ("on", "exact preview"):
+        j = runs[k][2]
+        has = "estimated_psnr" in j
+        assert has == (j["blender"]["preview_psnr"] >= 25), (k, j["blender"], j.get("estimated_psnr"))
+        if has:
+            assert j["estimated_psnr_against"] == "converged" and j["estimated_psnr_from"] == "preview", j
+            assert j["estimated_psnr_low"] <= j["estimated_psnr"], j
     print("%.1f %% exact; %.0f %% of them differ between the seeds; %d denoised; auto: noise %.1f dB, %s; first "
-          "round %d pixels (%d with an exact preview)"
+          "round %d pixels (%d with an exact preview); with it, the preview's own PSNR %.1f dB, estimate %s"
           % (100 * is_exact.mean(), 100 * differ, runs["on"][2]["denoised_samples"],
              runs["auto"][2]["blender"]["noise_psnr"], runs["auto"][2]["blender"]["variance"], first["on"],
-             first["exact preview"]))
+             first["exact preview"], runs["exact preview"][2]["blender"]["preview_psnr"],
+             runs["exact preview"][2].get("estimated_psnr")))
     assert no_blender_left(blend)
 
 

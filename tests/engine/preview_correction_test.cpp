@@ -104,6 +104,62 @@ TEST(PreviewCorrection, ExactPixelsKeepTheirValuesAndANaNStaysInItsPixel) {
   EXPECT_EQ(r.image.size(), r.workImage.size());
 }
 
+std::vector<RGB> TruthImage() {
+  std::vector<RGB> t;
+  for (int y = 0; y < N; ++y)
+    for (int x = 0; x < N; ++x) t.push_back(Truth(x, y));
+  return t;
+}
+
+TEST(PreviewCorrection, ItEstimatesTheCorrectedImagesPsnrFromThePreview) {
+  // Interpolations that missed a stripe (0.3 = 6 sd, or 0.03: a bias of the
+  // size of the noise's sd/2 that the correction leaves) and a quarter of
+  // the pixels exact, corrected toward previews of 8 seeds (sd 0.05: the
+  // preview's own PSNR about 27 dB, above the 25 dB the estimate needs). The
+  // estimate from the preview alone is unbiased where the interpolation does
+  // not depend on the preview: its 90 % interval covers the true display
+  // PSNR at least 6 times in 8, and its mean error over the seeds is within
+  // 1 dB (the small miss, an error 25 times below the preview's noise, gives
+  // single estimates within about +-1.7 dB: 2.5 standard errors of the mean).
+  for (float miss : {0.3f, 0.03f}) {
+    double sumError = 0;
+    int covered = 0;
+    for (unsigned seed = 10; seed < 18; ++seed) {
+      Reconstruction r = Interpolated(+[](int x, int y) { return Truth(x, y); });
+      for (int y = 0; y < N; ++y)
+        for (int x = 0; x < N; ++x) {
+          RGB& v = r.workImage[size_t(y) * N + x];
+          if (x % 2 == 0 && y % 2 == 0) r.sampleMap[size_t(y) * N + x] = SampleReason::kCorner;
+          else if (x >= 24 && x < 40) v = v - RGB::Gray(miss);
+        }
+      ImagePreviewProvider preview = NoisyPreview(seed);
+      PreviewCorrectionStats stats;
+      ASSERT_TRUE(CorrectTowardPreview(preview, 5, 1, &r, &stats).ok());
+      const double truth = DisplayPsnr(r.workImage, TruthImage());
+      ASSERT_TRUE(std::isfinite(stats.estimate.psnr)) << "preview " << stats.previewPsnr << " dB";
+      sumError += stats.estimate.psnr - truth;
+      covered += truth >= stats.estimate.low && truth <= stats.estimate.high;
+    }
+    EXPECT_LT(std::fabs(sumError / 8), 1.0) << "missed by " << miss;
+    EXPECT_GE(covered, 6) << "missed by " << miss;
+  }
+}
+
+TEST(PreviewCorrection, ANoisyPreviewMakesNoEstimate) {
+  // sd 0.2 on values of 0.2-0.7: the preview's own PSNR about 15 dB, below 25.
+  std::mt19937 rng(5);
+  std::normal_distribution<float> noise(0.f, 0.2f);
+  std::vector<RGB> L, var(size_t(N) * N, RGB::Gray(0.04f));
+  for (int y = 0; y < N; ++y)
+    for (int x = 0; x < N; ++x) L.push_back(Truth(x, y) + RGB::Gray(noise(rng)));
+  ImagePreviewProvider preview(N, N, N, N, std::move(L), {}, {}, std::move(var));
+  Reconstruction r = Interpolated(Truth);
+  PreviewCorrectionStats stats;
+  ASSERT_TRUE(CorrectTowardPreview(preview, 5, 1, &r, &stats).ok());
+  EXPECT_LT(stats.previewPsnr, 25);
+  EXPECT_TRUE(std::isnan(stats.estimate.psnr));
+}
+
 TEST(PreviewCorrection, AFireflyChangesOnlyTheWindowsItIsIn) {
   // A lost stripe, as above, and one preview pixel of radiance 1e6 far from it
   // (a firefly): its d^4 of 1e24 must not swamp the sums of other windows.

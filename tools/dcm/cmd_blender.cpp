@@ -362,9 +362,14 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     // the preview's noise from passing for edges. The preview correction
     // needs that variance in any case.
     const bool previewVariance = useVariance || (f.rounds.previewCorrection > 0 && provider->Capabilities().variance);
-    st = provider->FetchPreview({options.textureSplit && caps.splitRadiance, previewVariance}, &preview, poolRadius);
-    previewS = Since(tp);
     PreviewScheduleOptions so;
+    st = provider->FetchPreview({options.textureSplit && caps.splitRadiance, previewVariance}, &preview, poolRadius,
+                                &so.previewOwnVariance);
+    previewS = Since(tp);
+    // An exact pixel's noise, against the converged image: the preview's at its samples.
+    const double samples = keys.count("samples") ? std::atof(keys.at("samples").c_str()) : 0.0;
+    const double previewSamples = keys.count("preview_samples") ? std::atof(keys.at("preview_samples").c_str()) : 0.0;
+    if (samples > 0 && previewSamples > 0) so.exactVarianceShare = std::min(1.0, previewSamples / samples);
     so.maxRounds = f.rounds.maxRounds;
     so.correctionRadius = f.rounds.previewCorrection;
     so.minRoundShare = haveGoal ? 0 : f.rounds.minRoundShare;  // the search validates what each run asks for
@@ -421,6 +426,14 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   meta.strings.push_back({"dcm:options", toolkit::OptionsToJson(options).dump()});
   meta.floats.push_back({"dcm:exact_fraction", float(stats_.exactFraction())});
   if (quality) toolkit::AddQualityMetadata(*quality, &meta);
+  // Without a goal, the preview correction's estimate of the whole image (against the converged image).
+  const PsnrEstimate& fromPreview = sched.correction.estimate;
+  const bool previewEstimate = !quality && std::isfinite(fromPreview.low);
+  if (previewEstimate)
+    for (const auto& [name, v] : {std::pair<const char*, double>{"dcm:estimated_psnr", fromPreview.psnr},
+                                  {"dcm:estimated_psnr_low", fromPreview.low},
+                                  {"dcm:estimated_psnr_high", fromPreview.high}})
+      if (std::isfinite(v)) meta.floats.push_back({name, float(v)});
   if (frame >= 0) meta.strings.push_back({"Frame", std::to_string(frame)});
   toolkit::AddMetadata(meta, &image.attributes);
   if (Status w = toolkit::WriteOutputExr(output, image, f.pipe.exr); !w.ok()) return Fail(w.message());
@@ -446,6 +459,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     if (schedule == RoundSchedule::kPreview && !quality) {  // the search's runs each make their own
       b["preview_corrected"] = sched.correction.pixels;
       b["preview_correction_weight"] = sched.correction.meanWeight;
+      if (std::isfinite(sched.correction.previewPsnr)) b["preview_psnr"] = sched.correction.previewPsnr;
     }
     b["round_latency_s"] = provider->roundCost().latencyS;
     b["sample_cost_s"] = provider->roundCost().perSampleS;
@@ -463,6 +477,15 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     b["variance"] = useVariance ? "halves" : provider->Capabilities().variance ? "halves, not used" : "none";
     if (!std::isnan(noisePsnr)) b["noise_psnr"] = noisePsnr;
     j["blender"] = b;
+    if (previewEstimate) {
+      auto orNull = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+      j["estimated_psnr"] = orNull(fromPreview.psnr);
+      j["estimated_psnr_low"] = orNull(fromPreview.low);
+      j["estimated_psnr_high"] = orNull(fromPreview.high);
+      j["estimated_psnr_confidence"] = 0.90;
+      j["estimated_psnr_against"] = "converged";
+      j["estimated_psnr_from"] = "preview";
+    }
     if (quality) {
       toolkit::AddQualityJson(*quality, f.pipe.engine.targetPsnr.value_or(0), f.pipe.engine.budget.value_or(0), &j);
       if (schedule == RoundSchedule::kPreview) j["quality"]["searches"] = qrounds.passes;
@@ -483,6 +506,13 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   if (sched.correction.pixels > 0)
     std::printf("  correction     %lld interpolated pixels moved toward the preview (mean weight %.3f)\n",
                 static_cast<long long>(sched.correction.pixels), sched.correction.meanWeight);
+  if (!quality && !previewEstimate && std::isfinite(sched.correction.previewPsnr) && f.pipe.engine.verbose)
+    std::fprintf(stderr, "dcm %s: no estimate of the PSNR: the preview's own is %.2f dB, too noisy to tell\n",
+                 cmd.c_str(), sched.correction.previewPsnr);
+  if (previewEstimate)
+    std::printf("  estimate       PSNR %.2f dB against the converged image, from the preview (90 %% interval %.2f to "
+                "%.2f; the preview's own %.2f dB)\n",
+                fromPreview.psnr, fromPreview.low, fromPreview.high, sched.correction.previewPsnr);
   if (quality) {
     std::printf("  quality        %s\n", QualityLine(*quality, f.pipe.engine).c_str());
     if (f.pipe.engine.verbose) std::cerr << QualityLine(*quality, f.pipe.engine) << "\n";

@@ -6,7 +6,10 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
+#include <span>
 
+#include "dcm/quality_target.h"
 #include "dcm/reconstructor.h"
 #include "dcm/sample_provider.h"
 #include "dcm/status.h"
@@ -17,6 +20,23 @@ namespace dcm {
 struct PreviewCorrectionStats {
   int64_t pixels = 0;       ///< interpolated working pixels that moved (weight > 0 in a channel)
   double meanWeight = 0;    ///< mean weight over the interpolated pixels and channels, in [0, 1]
+  /// The corrected image's display-referred PSNR (sRGB, clipped, as the
+  /// stats' PSNR) against the converged image, estimated from the preview at
+  /// every pixel; NaN where not made (downsample > 1, no pixel to estimate,
+  /// or a preview whose own noise costs more than 25 dB: there the display's
+  /// curve and clip bias the estimate low by several dB). The preview p taken as the mean of two halves with
+  /// independent noise, whose encodings are A and B: where the encoding X of
+  /// an interpolated value does not depend on p's noise, E[(X - A)(X - B)] is
+  /// X's squared error; a corrected pixel x + k (p - x) has (1 - k)^2 times
+  /// that plus k^2 the preview's display variance (k taken as fixed). An
+  /// exact pixel counts `exactShare` times the preview's display variance (its
+  /// own noise), a preview stand-in the preview's. The interval is that of
+  /// independent pixels.
+  PsnrEstimate estimate{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
+                        std::numeric_limits<double>::quiet_NaN()};
+  /// The preview's own display-referred PSNR against the converged image,
+  /// from its variance (NaN where `estimate` is not made).
+  double previewPsnr = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Corrects the interpolated pixels (SampleReason::kInterpolated) of `rec`
@@ -30,7 +50,12 @@ struct PreviewCorrectionStats {
 /// not finite neither counts in a window nor moves. `rec->image` is made again
 /// from the corrected working image, downsampled by `downsample` (the
 /// reconstruction's ReconstructionOptions::downsample). radius 0: nothing changes.
+/// `ownVariance` (empty, or one per working pixel): each pixel's own variance
+/// of the preview, from two halves of its samples, for the estimate; empty:
+/// the preview's. `exactShare`: the exact samples' variance as a share of the
+/// preview's (PreviewScheduleOptions::exactVarianceShare).
 Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample, Reconstruction* rec,
-                            PreviewCorrectionStats* stats = nullptr);
+                            PreviewCorrectionStats* stats = nullptr, std::span<const RGB> ownVariance = {},
+                            double exactShare = 0);
 
 }  // namespace dcm

@@ -58,6 +58,15 @@ struct PreviewScheduleOptions {
   /// interpolated pixels move toward it by CorrectTowardPreview() in windows
   /// of this radius (0: off). 5 chose on the tuning set (docs/TUNING.md).
   int correctionRadius = 5;
+  /// The preview's own variance per working pixel (row-major), from two
+  /// halves of its samples and not pooled over neighbours: the correction's
+  /// estimate of the result's PSNR reads it (PreviewCorrectionStats::estimate).
+  /// Empty: the preview provider's variance.
+  std::vector<RGB> previewOwnVariance;
+  /// The exact samples' variance as a share of the preview's (the preview's
+  /// samples over the exact ones'), for the estimate: an exact pixel's error
+  /// against the converged image. 0: exact samples count as noise-free.
+  double exactVarianceShare = 0;
 };
 
 /// What a preview-planned reconstruction did.

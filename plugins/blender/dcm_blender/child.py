@@ -159,9 +159,10 @@ def main(argv):
         latency, per_sample = session.round_cost()
         # view_layer (percent-encoded: names have spaces) and guides_seconds are for `dcm blender`.
         proto.send("dcm-pipe 1 width=%d height=%d caps=%s name=blender-cycles round_latency=%.4g sample_cost=%.4g "
-                   "view_layer=%s guides_seconds=%.3f seeds=%s%s"
+                   "view_layer=%s guides_seconds=%.3f samples=%d preview_samples=%d seeds=%s%s"
                    % (session.width, session.height, CAPS + (",variance" if session.halves else ""), latency, per_sample,
                       urllib.parse.quote(session.layer.name, safe=""), session.render_seconds[0][1],
+                      session.samples, session.preview_samples,
                       ",".join(str(s) for s in session.seeds),
                       "" if session.noise_psnr is None else " noise_psnr=%.2f" % session.noise_psnr))
         serve(proto, session)

@@ -12,7 +12,7 @@
 namespace dcm::pipe {
 
 Status PipeProvider::FetchPreview(const SampleRequest& what, std::unique_ptr<SampleProvider>* out,
-                                  int varianceRadius) {
+                                  int varianceRadius, std::vector<RGB>* ownVariance) {
   std::vector<ExactSample> s;
   DCM_RETURN_IF_ERROR(Preview(Bounds2i{{0, 0}, {caps_.width, caps_.height}}, what, &s));
   const bool split = what.split && caps_.splitRadiance;
@@ -31,6 +31,7 @@ Status PipeProvider::FetchPreview(const SampleRequest& what, std::unique_ptr<Sam
     }
     if (variance) var[i] = s[i].variance;
   }
+  if (ownVariance) *ownVariance = variance ? var : std::vector<RGB>{};
   if (variance && varianceRadius > 0) {
     // A pixel's own variance has a degree of freedom or two: pooled over its
     // surface, as the exact pixels' is.

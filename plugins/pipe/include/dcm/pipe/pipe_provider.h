@@ -84,8 +84,10 @@ class PipeProvider final : public SampleProvider {
   /// provider of stand-in samples for ReconstructWithPreview(); with
   /// `what.variance`, the preview's variance, pooled over the pixels of the
   /// same surface (object and shader IDs) within `varianceRadius` pixels
-  /// (dcm::SurfaceWindowMean; 0: each pixel's own).
-  Status FetchPreview(const SampleRequest& what, std::unique_ptr<SampleProvider>* out, int varianceRadius = 0);
+  /// (dcm::SurfaceWindowMean; 0: each pixel's own). `ownVariance`, when
+  /// given: each pixel's own variance before the pooling (empty without).
+  Status FetchPreview(const SampleRequest& what, std::unique_ptr<SampleProvider>* out, int varianceRadius = 0,
+                      std::vector<RGB>* ownVariance = nullptr);
 
   /// Sends "quit", closes the child's stdin and waits for it to exit. An exit
   /// status other than 0 (or a signal) is an error. Idempotent: returns the
