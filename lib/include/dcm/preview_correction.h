@@ -23,19 +23,20 @@ struct PreviewCorrectionStats {
   /// The corrected image's display-referred PSNR (sRGB, clipped, as the
   /// stats' PSNR) against the converged image, estimated from the preview at
   /// every pixel; NaN where not made (downsample > 1, no pixel to estimate,
-  /// or a preview whose own noise costs more than 25 dB: there the display's
-  /// curve and clip bias the estimate low by several dB). The preview p taken as the mean of two halves with
-  /// independent noise, whose encodings are A and B: where the encoding X of
-  /// an interpolated value does not depend on p's noise, E[(X - A)(X - B)] is
-  /// X's squared error; a corrected pixel x + k (p - x) has (1 - k)^2 times
-  /// that plus k^2 the preview's display variance (k taken as fixed). An
-  /// exact pixel counts `exactShare` times the preview's display variance (its
-  /// own noise), a preview stand-in the preview's. The interval is that of
+  /// or a preview whose own noise costs more than 25 dB: there the
+  /// display's curve and clip bias the estimate low by several dB). The
+  /// preview p is taken as the mean of two halves with independent noise,
+  /// whose encodings are A and B: where the encoding X of an interpolated
+  /// value does not depend on p's noise, E[(X - A)(X - B)] is X's squared
+  /// error; a corrected pixel x + k (p - x) has (1 - k)^2 times that plus
+  /// k^2 the preview's display variance (k taken as fixed). An exact pixel
+  /// counts `exactShare` times the preview's display variance (its own
+  /// noise), a preview stand-in the preview's. The interval is that of
   /// independent pixels.
   PsnrEstimate estimate{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
                         std::numeric_limits<double>::quiet_NaN()};
   /// The preview's own display-referred PSNR against the converged image,
-  /// from its variance (NaN where `estimate` is not made).
+  /// from its variance (NaN with downsample > 1).
   double previewPsnr = std::numeric_limits<double>::quiet_NaN();
 };
 
