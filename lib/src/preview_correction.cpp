@@ -141,28 +141,20 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample,
     if (!error.empty()) {
       // A stand-in keeps the preview's value, so its error is the preview's
       // noise; an exact pixel's is its own, a share of it.
-      std::vector<double> d, w;
+      std::vector<double> d;
       d.reserve(n);
+      double noiseSum = 0;
       for (size_t i = 0; i < n; ++i) {
-        const SampleReason r = rec->sampleMap[i];
-        if (r == SampleReason::kInterpolated) {
-          if (usable[i]) d.push_back(error[i] / 3);
-        } else if (usable[i]) {
-          double sum = 0;
-          for (int c = 0; c < 3; ++c) sum += DisplayError(p[i].L[c], own(i, c), p[i].L[c], 1.0);
-          d.push_back((r == SampleReason::kPreviewStandIn ? 1.0 : exactShare) * sum / 3);
-        } else {
-          d.push_back(0);
-        }
-      }
-      w.assign(d.size(), 1.0);
-      result.estimate = EstimatePsnr(d, w);
-      double noise = 0;
-      for (size_t i = 0; i < n; ++i)
+        double noise = 0;  // the preview's display variance at i
         if (usable[i])
           for (int c = 0; c < 3; ++c) noise += DisplayError(p[i].L[c], own(i, c), p[i].L[c], 1.0) / 3;
-      result.previewPsnr = 10 * std::log10(double(n) / std::max(noise, 1e-30));
-      if (!(result.previewPsnr >= kMinPreviewPsnr)) result.estimate = PreviewCorrectionStats{}.estimate;
+        noiseSum += noise;
+        const SampleReason r = rec->sampleMap[i];
+        if (r != SampleReason::kInterpolated) d.push_back((r == SampleReason::kPreviewStandIn ? 1.0 : exactShare) * noise);
+        else if (usable[i]) d.push_back(error[i] / 3);
+      }
+      result.previewPsnr = 10 * std::log10(double(n) / std::max(noiseSum, 1e-30));
+      if (result.previewPsnr >= kMinPreviewPsnr) result.estimate = EstimatePsnr(d, std::vector<double>(d.size(), 1.0));
     }
     rec->workImage = std::move(corrected);
     rec->image = BoxDownsample(rec->workImage, W, H, downsample, &rec->width, &rec->height);

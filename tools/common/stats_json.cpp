@@ -144,12 +144,23 @@ nlohmann::json RunToJson(const Reconstruction& r, const std::string& method, con
   return j;
 }
 
+void AddEstimateJson(const PsnrEstimate& e, double confidence, nlohmann::json* j) {
+  (*j)["estimated_psnr"] = e.psnr;
+  (*j)["estimated_psnr_low"] = e.low;
+  (*j)["estimated_psnr_high"] = e.high;
+  (*j)["estimated_psnr_confidence"] = confidence;
+}
+
+void AddEstimateMetadata(const PsnrEstimate& e, Metadata* m) {
+  for (const auto& [name, v] : {std::pair<const char*, double>{"dcm:estimated_psnr", e.psnr},
+                                {"dcm:estimated_psnr_low", e.low},
+                                {"dcm:estimated_psnr_high", e.high}})
+    if (std::isfinite(v)) m->floats.push_back({name, float(v)});
+}
+
 void AddQualityJson(const QualityReport& r, double targetPsnr, double budget, nlohmann::json* j) {
   auto orNull = [](double v) { return v > 0 ? nlohmann::json(v) : nlohmann::json(nullptr); };
-  (*j)["estimated_psnr"] = r.estimate.psnr;
-  (*j)["estimated_psnr_low"] = r.estimate.low;
-  (*j)["estimated_psnr_high"] = r.estimate.high;
-  (*j)["estimated_psnr_confidence"] = r.confidence;
+  AddEstimateJson(r.estimate, r.confidence, j);
   if (r.againstConverged) {
     // Noisy samples of known variance: the estimate is against the converged image.
     (*j)["estimated_psnr_against"] = "converged";
@@ -176,11 +187,8 @@ void AddQualityJson(const QualityReport& r, double targetPsnr, double budget, nl
 }
 
 void AddQualityMetadata(const QualityReport& r, Metadata* m) {
-  for (const auto& [name, v] : {std::pair<const char*, double>{"dcm:estimated_psnr", r.estimate.psnr},
-                                {"dcm:estimated_psnr_low", r.estimate.low},
-                                {"dcm:estimated_psnr_high", r.estimate.high},
-                                {"dcm:estimated_render_psnr", r.renderEstimate.psnr}})
-    if (std::isfinite(v)) m->floats.push_back({name, float(v)});
+  AddEstimateMetadata(r.estimate, m);
+  if (std::isfinite(r.renderEstimate.psnr)) m->floats.push_back({"dcm:estimated_render_psnr", float(r.renderEstimate.psnr)});
 }
 
 std::vector<std::string> SampleWarnings(const ReconstructionStats& s) {

@@ -35,6 +35,15 @@ std::string StageTimesLine(const ReconstructionStats& s);
 nlohmann::json RunToJson(const Reconstruction& r, const std::string& method, const ReconstructionOptions& o,
                          double wallS);
 
+/// Adds an estimate of the result's PSNR to a --stats object:
+/// estimated_psnr, estimated_psnr_low, estimated_psnr_high (the interval at
+/// estimated_psnr_confidence, `confidence`).
+void AddEstimateJson(const PsnrEstimate& estimate, double confidence, nlohmann::json* j);
+
+/// Adds dcm:estimated_psnr, dcm:estimated_psnr_low, dcm:estimated_psnr_high
+/// (finite values only) to EXR metadata.
+void AddEstimateMetadata(const PsnrEstimate& estimate, Metadata* metadata);
+
 /// Adds what --target-psnr / --budget delivered to a --stats object:
 /// estimated_psnr, estimated_psnr_low, estimated_psnr_high (the interval at
 /// estimated_psnr_confidence) and quality {target_psnr, budget, target_reached,
@@ -48,9 +57,9 @@ nlohmann::json RunToJson(const Reconstruction& r, const std::string& method, con
 /// against the converged image).
 void AddQualityJson(const QualityReport& report, double targetPsnr, double budget, nlohmann::json* j);
 
-/// Adds dcm:estimated_psnr, dcm:estimated_psnr_low, dcm:estimated_psnr_high
-/// and, with samples of known variance, dcm:estimated_render_psnr (finite
-/// values only) to EXR metadata.
+/// Adds AddEstimateMetadata() of the report's estimate and, with samples of
+/// known variance, dcm:estimated_render_psnr (finite values only) to EXR
+/// metadata.
 void AddQualityMetadata(const QualityReport& report, Metadata* metadata);
 
 /// The warnings a run's samples deserve, one sentence each: NaN/Inf samples

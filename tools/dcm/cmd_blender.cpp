@@ -429,11 +429,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   // Without a goal, the preview correction's estimate of the whole image (against the converged image).
   const PsnrEstimate& fromPreview = sched.correction.estimate;
   const bool previewEstimate = !quality && std::isfinite(fromPreview.low);
-  if (previewEstimate)
-    for (const auto& [name, v] : {std::pair<const char*, double>{"dcm:estimated_psnr", fromPreview.psnr},
-                                  {"dcm:estimated_psnr_low", fromPreview.low},
-                                  {"dcm:estimated_psnr_high", fromPreview.high}})
-      if (std::isfinite(v)) meta.floats.push_back({name, float(v)});
+  if (previewEstimate) toolkit::AddEstimateMetadata(fromPreview, &meta);
   if (frame >= 0) meta.strings.push_back({"Frame", std::to_string(frame)});
   toolkit::AddMetadata(meta, &image.attributes);
   if (Status w = toolkit::WriteOutputExr(output, image, f.pipe.exr); !w.ok()) return Fail(w.message());
@@ -478,11 +474,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     if (!std::isnan(noisePsnr)) b["noise_psnr"] = noisePsnr;
     j["blender"] = b;
     if (previewEstimate) {
-      auto orNull = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
-      j["estimated_psnr"] = orNull(fromPreview.psnr);
-      j["estimated_psnr_low"] = orNull(fromPreview.low);
-      j["estimated_psnr_high"] = orNull(fromPreview.high);
-      j["estimated_psnr_confidence"] = 0.90;
+      toolkit::AddEstimateJson(fromPreview, 0.90, &j);  // EstimatePsnr's interval
       j["estimated_psnr_against"] = "converged";
       j["estimated_psnr_from"] = "preview";
     }
