@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "dcm/option_names.h"
+#include "dcm/preview_target.h"
 #include "dcm/quality_target.h"
 #include "dcm/reconstructor.h"
 #include "dcm/round_schedule.h"
@@ -595,7 +596,24 @@ DCM_API DCMError dcmExecute(DCMReconstructor r) {
       goal.budget = r->budget;
       goal.targetRender = r->targetRender;
       dcm::QualityReport report;
-      st = dcm::ReconstructToQuality(provider, options, goal, &r->result, &report);
+      // A target alone, with a preview of known variance, noise-free exact
+      // samples and rounds that cost: judged by the preview's estimate where it can tell.
+      const bool fromPreview = r->targetPsnr > 0 && !(r->budget > 0) && !r->noisySample &&
+                               !r->previewVariance.empty() &&
+                               dcm::ChooseSchedule(r->roundCost) == dcm::RoundSchedule::kPreview;
+      dcm::ImagePreviewProvider preview(r->width, r->height, r->previewWidth, r->previewHeight, r->previewL,
+                                        r->previewLi, r->previewLc, r->previewVariance);
+      dcm::PreviewScheduleOptions schedule;
+      schedule.maxRounds = r->maxRounds;
+      if (fromPreview && dcm::CanTargetFromPreview(preview, schedule, r->targetPsnr)) {
+        dcm::PreviewTargetStats ladder;
+        st = dcm::ReconstructToTargetFromPreview(provider, preview, options, r->targetPsnr, schedule, &r->result,
+                                                 &report, &ladder);
+        r->schedule = std::move(ladder.last);
+        r->schedule.rounds = ladder.rounds;
+      } else {
+        st = dcm::ReconstructToQuality(provider, options, goal, &r->result, &report);
+      }
       if (st.ok()) r->quality = std::move(report);
     } else if (!r->previewL.empty() && dcm::ChooseSchedule(r->roundCost) == dcm::RoundSchedule::kPreview) {
       dcm::ImagePreviewProvider preview(r->width, r->height, r->previewWidth, r->previewHeight, r->previewL,
@@ -686,6 +704,7 @@ DCM_API double dcmGetStat(DCMReconstructor r, const char* name) {
   if (n == "preview_corrected") return double(r->schedule.correction.pixels);
   if (r->quality) {
     const dcm::QualityReport& q = *r->quality;
+    if (n == "estimate_from_preview") return q.estimateSource == dcm::EstimateSource::kPreview ? 1.0 : 0.0;
     if (n == "estimated_psnr") return q.estimate.psnr;
     if (n == "estimated_psnr_low") return q.estimate.low;
     if (n == "estimated_psnr_high") return q.estimate.high;
@@ -697,6 +716,12 @@ DCM_API double dcmGetStat(DCMReconstructor r, const char* name) {
     if (n == "quality_runs") return double(q.runs);
     if (n == "target_reached") return q.targetReached ? 1.0 : 0.0;
     if (n == "budget_bound") return q.budgetBound ? 1.0 : 0.0;
+  } else if (const dcm::PsnrEstimate& e = r->schedule.correction.estimate; std::isfinite(e.low)) {
+    // Without a goal, the preview correction's estimate against the converged image.
+    if (n == "estimated_psnr") return e.psnr;
+    if (n == "estimated_psnr_low") return e.low;
+    if (n == "estimated_psnr_high") return e.high;
+    if (n == "estimate_against_converged" || n == "estimate_from_preview") return 1.0;
   }
   Guard(r, "dcmGetStat", [&] { SetError(r, DCM_ERROR_INVALID_ARGUMENT, "dcmGetStat: unknown statistic '" + std::string(n) + "'"); });
   return 0.0;

@@ -20,13 +20,6 @@ namespace {
 /// bias of its window); below it, a weight would only let the noise in.
 constexpr double kSignificance = 1.5;
 
-/// Below this display-referred PSNR of the preview's own noise, its estimate
-/// of the result's error is not made: through the encoding's curve and clip,
-/// so noisy a preview errs on the side of error by several dB (chosen on the
-/// tuning set, docs/TUNING.md: the room at 64, 256 and 512 spp, previews of
-/// 20.3, 26.7 and 29.8 dB, estimates 6.4 dB low, 1.2 low and 0.7 high).
-constexpr double kMinPreviewPsnr = 25;
-
 /// Sums of `v` (W x H) over the window of radius r around each pixel,
 /// clipped to the grid: a horizontal then a vertical pass, each summed
 /// afresh per pixel. Running sums would subtract: after one outlier (a
@@ -60,7 +53,37 @@ double DisplayError(float p, double v, float x, double k) {
   return (1 - k) * (1 - k) * (X - A) * (X - B) + k * k * (A - B) * (A - B) / 4;
 }
 
+/// The preview's display variance at a pixel (a mean over the channels) of
+/// value L and own variance v.
+double DisplayNoise(const RGB& L, const RGB& v) {
+  double noise = 0;
+  for (int c = 0; c < 3; ++c) noise += DisplayError(L[c], std::max(double(v[c]), 0.0), L[c], 1.0) / 3;
+  return noise;
+}
+
+bool Usable(const ExactSample& p, const RGB& v) {
+  return IsFinite(p.L) && IsFinite(v) && v.r >= 0 && v.g >= 0 && v.b >= 0;
+}
+
 }  // namespace
+
+double PreviewNoisePsnr(SampleProvider& preview, std::span<const RGB> ownVariance) {
+  const ProviderCapabilities caps = preview.Capabilities();
+  const size_t n = size_t(std::max(caps.width, 0)) * size_t(std::max(caps.height, 0));
+  if (n == 0 || !caps.variance || (!ownVariance.empty() && ownVariance.size() != n))
+    return std::numeric_limits<double>::quiet_NaN();
+  std::vector<Point2i> all(n);
+  for (int y = 0; y < caps.height; ++y)
+    for (int x = 0; x < caps.width; ++x) all[size_t(y) * size_t(caps.width) + size_t(x)] = {x, y};
+  std::vector<ExactSample> p(n);
+  if (!preview.Evaluate(all, SampleRequest{false, true}, p).ok()) return std::numeric_limits<double>::quiet_NaN();
+  double noiseSum = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const RGB& v = ownVariance.empty() ? p[i].variance : ownVariance[i];
+    if (Usable(p[i], p[i].variance)) noiseSum += DisplayNoise(p[i].L, v);
+  }
+  return 10 * std::log10(double(n) / std::max(noiseSum, 1e-30));
+}
 
 Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample, Reconstruction* rec,
                             PreviewCorrectionStats* stats, std::span<const RGB> ownVariance, double exactShare) {
@@ -92,10 +115,7 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample,
       return Status::Error("preview correction: " + s.message());
 
     std::vector<uint8_t> usable(n);
-    for (size_t i = 0; i < n; ++i) {
-      const RGB& v = p[i].variance;
-      usable[i] = IsFinite(p[i].L) && IsFinite(v) && IsFinite(rec->workImage[i]) && v.r >= 0 && v.g >= 0 && v.b >= 0;
-    }
+    for (size_t i = 0; i < n; ++i) usable[i] = Usable(p[i], p[i].variance) && IsFinite(rec->workImage[i]);
     std::vector<double> count(n);
     for (size_t i = 0; i < n; ++i) count[i] = usable[i];
     const std::vector<double> counts = WindowSums(count, W, H, radius);
@@ -145,16 +165,14 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample,
       d.reserve(n);
       double noiseSum = 0;
       for (size_t i = 0; i < n; ++i) {
-        double noise = 0;  // the preview's display variance at i
-        if (usable[i])
-          for (int c = 0; c < 3; ++c) noise += DisplayError(p[i].L[c], own(i, c), p[i].L[c], 1.0) / 3;
+        const double noise = usable[i] ? DisplayNoise(p[i].L, ownVariance.empty() ? p[i].variance : ownVariance[i]) : 0.0;
         noiseSum += noise;
         const SampleReason r = rec->sampleMap[i];
         if (r != SampleReason::kInterpolated) d.push_back((r == SampleReason::kPreviewStandIn ? 1.0 : exactShare) * noise);
         else if (usable[i]) d.push_back(error[i] / 3);
       }
       result.previewPsnr = 10 * std::log10(double(n) / std::max(noiseSum, 1e-30));
-      if (result.previewPsnr >= kMinPreviewPsnr) result.estimate = EstimatePsnr(d, std::vector<double>(d.size(), 1.0));
+      if (result.previewPsnr >= kMinPreviewPsnrForEstimate) result.estimate = EstimatePsnr(d, std::vector<double>(d.size(), 1.0));
     }
     rec->workImage = std::move(corrected);
     rec->image = BoxDownsample(rec->workImage, W, H, downsample, &rec->width, &rec->height);

@@ -11,7 +11,7 @@
 #include <utility>
 
 #include "dcm/downsample.h"
-#include "guide_cache.h"
+#include "planning_provider.h"
 
 namespace dcm {
 
@@ -23,110 +23,6 @@ constexpr std::array<std::pair<std::string_view, RoundSchedule>, 2> kSchedules{{
 double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
-
-/// What the engine sees during planning: the exact provider's guides (asked
-/// once per region and kind), exact samples where they are known, preview
-/// samples elsewhere; it records the pixels asked for that are not known.
-class PlanningProvider : public SampleProvider {
- public:
-  PlanningProvider(SampleProvider& exact, SampleProvider& preview)
-      : exact_(exact), preview_(preview), caps_(exact.Capabilities()) {
-    // Calls come from one thread: the records below need no locks, and the
-    // engine's work between calls is small next to a round of a slow renderer.
-    caps_.threadSafe = false;
-    const size_t n = size_t(caps_.width) * size_t(caps_.height);
-    known_.assign(n, 0);
-    wanted_.assign(n, 0);
-    samples_.resize(n);
-  }
-
-  ProviderCapabilities Capabilities() const override { return caps_; }
-
-  Status Guides(const Bounds2i& region, const GuideRequest& what, GuideImage* out) override {
-    return guides_.Get(exact_, region, what, out);
-  }
-
-  Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what,
-                  std::span<ExactSample> out) override {
-    request_.split |= what.split;
-    request_.variance |= what.variance;
-    missing_.clear();
-    for (size_t i = 0; i < pixels.size(); ++i) {
-      const size_t k = Index(pixels[i]);
-      if (known_[k]) {
-        out[i] = samples_[k];
-      } else {
-        missing_.push_back(i);
-        if (!wanted_[k]) {
-          wanted_[k] = 1;
-          wantedList_.push_back(pixels[i]);
-        }
-      }
-    }
-    if (missing_.empty()) return Status::Ok();
-    std::vector<Point2i> ask(missing_.size());
-    std::vector<ExactSample> got(missing_.size());
-    for (size_t j = 0; j < missing_.size(); ++j) ask[j] = pixels[missing_[j]];
-    Status s = preview_.Evaluate(ask, what, got);
-    if (!s.ok()) return Status::Error("preview samples: " + s.message());
-    for (size_t j = 0; j < missing_.size(); ++j) out[missing_[j]] = got[j];
-    return Status::Ok();
-  }
-
-  /// Pixels asked for in this run that are not known exactly; clears the record.
-  std::vector<Point2i> TakeWanted() {
-    for (const Point2i& p : wantedList_) wanted_[Index(p)] = 0;
-    return std::exchange(wantedList_, {});
-  }
-
-  /// Marks the interpolated pixels of `rec` that a round evaluated as exact
-  /// (SampleReason::kRendered): they were paid for. Their values stay until
-  /// FillRendered(). Returns how many.
-  int64_t MarkRendered(Reconstruction* rec) const {
-    int64_t kept = 0;
-    for (size_t k = 0; k < known_.size(); ++k) {
-      // A non-finite sample stays out, as the engine keeps it out of its neighbours.
-      if (!known_[k] || rec->sampleMap[k] != SampleReason::kInterpolated || !IsFinite(samples_[k].L)) continue;
-      rec->sampleMap[k] = SampleReason::kRendered;
-      ++kept;
-    }
-    rec->stats.byReason[size_t(SampleReason::kRendered)] += kept;
-    rec->stats.exactPixels += kept;
-    return kept;
-  }
-
-  /// Gives the pixels MarkRendered() marked their exact values.
-  void FillRendered(Reconstruction* rec) const {
-    for (size_t k = 0; k < known_.size(); ++k)
-      if (rec->sampleMap[k] == SampleReason::kRendered) rec->workImage[k] = samples_[k].L;
-  }
-
-  /// Evaluates `pixels` with the exact provider in one call and keeps them.
-  Status EvaluateExactly(const std::vector<Point2i>& pixels) {
-    std::vector<ExactSample> got(pixels.size());
-    Status s = exact_.Evaluate(pixels, request_, got);
-    if (!s.ok()) return s;
-    for (size_t i = 0; i < pixels.size(); ++i) {
-      const size_t k = Index(pixels[i]);
-      samples_[k] = got[i];
-      known_[k] = 1;
-    }
-    return Status::Ok();
-  }
-
- private:
-  size_t Index(const Point2i& p) const { return size_t(p.y) * size_t(caps_.width) + size_t(p.x); }
-
-  SampleProvider& exact_;
-  SampleProvider& preview_;
-  ProviderCapabilities caps_;
-  SampleRequest request_;
-  GuideCache guides_;
-  std::vector<uint8_t> known_, wanted_;
-  std::vector<ExactSample> samples_;
-  std::vector<Point2i> wantedList_;
-  std::vector<size_t> missing_;
-};
 
 }  // namespace
 
@@ -175,62 +71,77 @@ Status ReconstructWithPreview(SampleProvider& exact, SampleProvider& preview,
   PreviewScheduleStats stats;
   try {
     PlanningProvider planning(exact, preview);
-    const double total = double(exactCaps.width) * double(exactCaps.height);
-    for (;;) {
-      const auto engineStart = std::chrono::steady_clock::now();
-      Status s = Reconstruct(planning, options, out);
-      stats.timeEngineS += Seconds(engineStart) - out->stats.timeGuidesS;
-      ++stats.engineRuns;
-      if (!s.ok()) return s;
-      std::vector<Point2i> wanted = planning.TakeWanted();
-      const bool small = stats.rounds > 0 && double(wanted.size()) < schedule.minRoundShare * total;
-      if (wanted.empty() || stats.rounds == schedule.maxRounds || small) {
-        stats.previewStandIns = int64_t(wanted.size());
-        // What was not rendered is not exact: the sample map and the counts say so.
-        const int W = out->workWidth;
-        for (const Point2i& p : wanted) {
-          SampleReason& reason = out->sampleMap[size_t(p.y) * size_t(W) + size_t(p.x)];
-          if (reason != SampleReason::kInterpolated && reason != SampleReason::kPreviewStandIn) {
-            --out->stats.byReason[size_t(reason)];
-            --out->stats.exactPixels;
-          }
-          reason = SampleReason::kPreviewStandIn;
-          ++out->stats.byReason[size_t(SampleReason::kPreviewStandIn)];
-        }
-        break;
-      }
-      const auto exactStart = std::chrono::steady_clock::now();
-      s = planning.EvaluateExactly(wanted);
-      stats.timeExactS += Seconds(exactStart);
-      if (!s.ok()) return s;
-      ++stats.rounds;
-      stats.pixelsPerRound.push_back(int64_t(wanted.size()));
-    }
-    // Rendered pixels keep their exact values, but not with noisy samples: the
-    // final run denoised its exact samples against their neighbours, and a raw
-    // one among them is noise (docs/TUNING.md).
-    const int64_t rendered = out->stats.settings.noisy ? 0 : planning.MarkRendered(out);
-    // The correction sees their interpolated values: where the interpolation
-    // missed at a rendered pixel, it missed around it too.
-    if (schedule.correctionRadius > 0 && previewCaps.variance) {
-      const auto start = std::chrono::steady_clock::now();
-      DCM_RETURN_IF_ERROR(CorrectTowardPreview(preview, schedule.correctionRadius, options.downsample, out,
-                                               &stats.correction, schedule.previewOwnVariance,
-                                               schedule.exactVarianceShare));
-      stats.timeEngineS += Seconds(start);
-    }
-    if (rendered > 0) {
-      planning.FillRendered(out);
-      out->image = BoxDownsample(out->workImage, out->workWidth, out->workHeight, options.downsample,
-                                 &out->width, &out->height);
-    }
+    DCM_RETURN_IF_ERROR(PlanAndRender(planning, options, schedule, 0, out, &stats));
+    DCM_RETURN_IF_ERROR(FinishPreviewRun(planning, preview, options, schedule, out, &stats));
   } catch (const std::bad_alloc&) {
     return Status::Error("out of memory while planning rounds on the preview");
   }
-  // The final run's engine time excludes the rounds; the provider time is the rounds'.
-  out->stats.timeProviderS = stats.timeExactS;
-  out->stats.providerCalls = stats.rounds;
   if (scheduleStats) *scheduleStats = std::move(stats);
+  return Status::Ok();
+}
+
+Status PlanAndRender(PlanningProvider& planning, const ReconstructionOptions& options,
+                     const PreviewScheduleOptions& schedule, int roundsBefore, Reconstruction* out,
+                     PreviewScheduleStats* stats) {
+  const ProviderCapabilities caps = planning.Capabilities();
+  const double total = double(caps.width) * double(caps.height);
+  for (int rounds = 0;;) {
+    const auto engineStart = std::chrono::steady_clock::now();
+    Status s = Reconstruct(planning, options, out);
+    stats->timeEngineS += Seconds(engineStart) - out->stats.timeGuidesS;
+    ++stats->engineRuns;
+    if (!s.ok()) return s;
+    std::vector<Point2i> wanted = planning.TakeWanted();
+    const bool small = roundsBefore + rounds > 0 && double(wanted.size()) < schedule.minRoundShare * total;
+    if (wanted.empty() || rounds == schedule.maxRounds || small) {
+      stats->previewStandIns = int64_t(wanted.size());
+      // What was not rendered is not exact: the sample map and the counts say so.
+      const int W = out->workWidth;
+      for (const Point2i& p : wanted) {
+        SampleReason& reason = out->sampleMap[size_t(p.y) * size_t(W) + size_t(p.x)];
+        if (reason != SampleReason::kInterpolated && reason != SampleReason::kPreviewStandIn) {
+          --out->stats.byReason[size_t(reason)];
+          --out->stats.exactPixels;
+        }
+        reason = SampleReason::kPreviewStandIn;
+        ++out->stats.byReason[size_t(SampleReason::kPreviewStandIn)];
+      }
+      break;
+    }
+    const auto exactStart = std::chrono::steady_clock::now();
+    s = planning.EvaluateExactly(wanted);
+    stats->timeExactS += Seconds(exactStart);
+    if (!s.ok()) return s;
+    ++rounds;
+    ++stats->rounds;
+    stats->pixelsPerRound.push_back(int64_t(wanted.size()));
+  }
+  // The final run's engine time excludes the rounds; the provider time is the rounds'.
+  out->stats.timeProviderS = stats->timeExactS;
+  out->stats.providerCalls = stats->rounds;
+  return Status::Ok();
+}
+
+Status FinishPreviewRun(PlanningProvider& planning, SampleProvider& preview, const ReconstructionOptions& options,
+                        const PreviewScheduleOptions& schedule, Reconstruction* out, PreviewScheduleStats* stats) {
+  // Rendered pixels keep their exact values, but not with noisy samples: the
+  // final run denoised its exact samples against their neighbours, and a raw
+  // one among them is noise (docs/TUNING.md).
+  const int64_t rendered = out->stats.settings.noisy ? 0 : planning.MarkRendered(out);
+  // The correction sees their interpolated values: where the interpolation
+  // missed at a rendered pixel, it missed around it too.
+  if (schedule.correctionRadius > 0 && preview.Capabilities().variance) {
+    const auto start = std::chrono::steady_clock::now();
+    DCM_RETURN_IF_ERROR(CorrectTowardPreview(preview, schedule.correctionRadius, options.downsample, out,
+                                             &stats->correction, schedule.previewOwnVariance,
+                                             schedule.exactVarianceShare));
+    stats->timeEngineS += Seconds(start);
+  }
+  if (rendered > 0) {
+    planning.FillRendered(out);
+    out->image = BoxDownsample(out->workImage, out->workWidth, out->workHeight, options.downsample, &out->width,
+                               &out->height);
+  }
   return Status::Ok();
 }
 

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cerrno>
 #include <cmath>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -381,6 +382,45 @@ TEST(CApi, TargetAndBudgetReportTheEstimateAndStayWithinTheBudget) {
   EXPECT_NE(TakeError(r).find("target_psnr"), std::string::npos);
   dcmSetFloat(r, "budget", -0.5f);
   EXPECT_NE(TakeError(r).find("budget"), std::string::npos);
+  dcmReleaseReconstructor(r);
+}
+
+TEST(CApi, ATargetWithAPreviewOfKnownVarianceIsJudgedByThePreview) {
+  // The preview is the truth plus noise of sd 0.01 (its own PSNR about 40 dB,
+  // enough to tell) with that variance; rounds cost: the target is judged by
+  // the preview's estimate, against the converged image, with no validation
+  // pixel, and every pixel rendered is counted once.
+  Scene scene;
+  DCMReconstructor r = Make(scene, 0);
+  const size_t n = size_t(scene.width * scene.height);
+  std::vector<float> preview(3 * n), variance(3 * n, 1e-4f);
+  std::mt19937 rng(11);
+  std::normal_distribution<float> noise(0.f, 0.01f);
+  for (size_t i = 0; i < n; ++i) {
+    scene.Truth(int(i % size_t(scene.width)), int(i / size_t(scene.width)), &preview[3 * i]);
+    for (int c = 0; c < 3; ++c) preview[3 * i + c] += noise(rng);
+  }
+  dcmSetPreview(r, scene.width, scene.height, preview.data(), nullptr, nullptr);
+  dcmSetPreviewVariance(r, variance.data());
+  dcmSetRoundCost(r, 0.5, 0.0, 3);
+  // Without a goal: the preview's estimate is reported all the same.
+  ASSERT_EQ(dcmExecute(r), DCM_ERROR_NONE) << TakeError(r);
+  EXPECT_EQ(dcmGetStat(r, "estimate_from_preview"), 1.0);
+  EXPECT_GT(dcmGetStat(r, "estimated_psnr"), 30.0) << "a ramp and a step: interpolation errs little";
+  scene.evaluated = 0;
+  dcmSetFloat(r, "target_psnr", 35.f);
+  ASSERT_EQ(dcmExecute(r), DCM_ERROR_NONE) << TakeError(r);
+  EXPECT_EQ(dcmGetStat(r, "estimate_from_preview"), 1.0);
+  EXPECT_EQ(dcmGetStat(r, "estimate_against_converged"), 1.0);
+  EXPECT_EQ(dcmGetStat(r, "validation_pixels"), 0.0);
+  EXPECT_EQ(dcmGetStat(r, "target_reached"), 1.0);
+  EXPECT_GE(dcmGetStat(r, "estimated_psnr_low"), 35.0);
+  EXPECT_EQ(double(scene.evaluated.load()), dcmGetStat(r, "exact_pixels"));
+  // With a budget too, the validation search judges (whichever binds first).
+  dcmSetFloat(r, "budget", 0.5f);
+  ASSERT_EQ(dcmExecute(r), DCM_ERROR_NONE) << TakeError(r);
+  EXPECT_EQ(dcmGetStat(r, "estimate_from_preview"), 0.0);
+  EXPECT_GT(dcmGetStat(r, "validation_pixels"), 0.0);
   dcmReleaseReconstructor(r);
 }
 

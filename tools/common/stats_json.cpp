@@ -161,6 +161,7 @@ void AddEstimateMetadata(const PsnrEstimate& e, Metadata* m) {
 void AddQualityJson(const QualityReport& r, double targetPsnr, double budget, nlohmann::json* j) {
   auto orNull = [](double v) { return v > 0 ? nlohmann::json(v) : nlohmann::json(nullptr); };
   AddEstimateJson(r.estimate, r.confidence, j);
+  (*j)["estimated_psnr_from"] = r.estimateSource == EstimateSource::kPreview ? "preview" : "validation";
   if (r.againstConverged) {
     // Noisy samples of known variance: the estimate is against the converged image.
     (*j)["estimated_psnr_against"] = "converged";

@@ -42,6 +42,7 @@
 #include "dcm/noise_estimate.h"
 #include "dcm/pipe/pipe_provider.h"
 #include "dcm/pipe/scratch_folder.h"
+#include "dcm/preview_target.h"
 #include "dcm/quality_preview.h"
 #include "dcm/reconstructor.h"
 #include "dcm/round_schedule.h"
@@ -69,6 +70,8 @@ struct BlenderFlags {
   /// auto where the preview's halves say the noise matters (kNoisyPsnr), on, off
   /// (one render per pixel).
   std::string variance = "auto";
+  /// What judges --target-psnr: auto (the preview where it can tell), preview, validation.
+  std::string estimateFrom = "auto";
   PipeFlags pipe;  ///< --provider-timeout, --provider-startup-timeout; engine; EXR format
 };
 
@@ -351,6 +354,8 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   const bool haveGoal = QualityGoalOf(f.pipe.engine, &goal);
   std::optional<QualityReport> quality;
   QualityRoundStats qrounds;
+  PreviewTargetStats ptarget;
+  bool targetFromPreview = false;
   double previewS = 0, goalS = 0;
   Status st;
   if (schedule == RoundSchedule::kPreview) {
@@ -372,8 +377,29 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     if (samples > 0 && previewSamples > 0) so.exactVarianceShare = std::min(1.0, previewSamples / samples);
     so.maxRounds = f.rounds.maxRounds;
     so.correctionRadius = f.rounds.previewCorrection;
-    so.minRoundShare = haveGoal ? 0 : f.rounds.minRoundShare;  // the search validates what each run asks for
-    if (st.ok() && haveGoal) {
+    so.minRoundShare = f.rounds.minRoundShare;
+    // A target alone is judged by the preview's estimate where the preview can tell.
+    const double target = f.pipe.engine.targetPsnr.value_or(0);
+    if (st.ok() && target > 0 && !f.pipe.engine.budget && f.estimateFrom != "validation") {
+      std::string why;
+      if (so.correctionRadius < 1) why = "--preview-correction 0: the correction makes the estimate";
+      else if (options.downsample != 1) why = "--downsample: the preview estimates at final resolution only";
+      targetFromPreview = why.empty() && CanTargetFromPreview(*preview, so, target, &why);
+      if (!targetFromPreview && f.estimateFrom == "preview")
+        return Fail("--estimate-from preview: " + why, kExitUsage);
+      if (f.pipe.engine.verbose)
+        std::cerr << "blender: --target-psnr judged by "
+                  << (targetFromPreview ? std::string("the preview's estimate") : "validation pixels: " + why) << "\n";
+    }
+    if (targetFromPreview) {
+      QualityReport report;
+      const auto tq = Clock::now();
+      st = ReconstructToTargetFromPreview(timed, *preview, options, target, so, &rec, &report, &ptarget);
+      goalS = Since(tq);
+      if (st.ok()) quality = std::move(report);
+      sched = ptarget.last;
+    } else if (st.ok() && haveGoal) {
+      so.minRoundShare = 0;  // the search validates what each run asks for
       // Each run of the search in two rounds at most: its validation pixels go
       // with its first; pixels left at their preview value after one round
       // carry errors few validation pixels see (docs/QUALITY.md).
@@ -400,6 +426,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   for (const auto& r : timed.rounds) roundsS += r.seconds;
   // With a goal: the search's time but its rounds (engine runs, validation, the cache).
   const double engineS = schedule != RoundSchedule::kPreview ? stats_.timeEngineS
+                         : targetFromPreview                  ? ptarget.timeEngineS
                          : quality                            ? goalS - qrounds.timeExactS
                                                               : sched.timeEngineS;
   const std::string method = options.fullEvaluation ? "full" : f.pipe.engine.method;
@@ -452,7 +479,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     for (const auto& r : timed.rounds) rounds.push_back({{"pixels", r.pixels}, {"seconds", r.seconds}});
     b["rounds"] = rounds;
     b["preview_stand_ins"] = sched.previewStandIns;
-    if (schedule == RoundSchedule::kPreview && !quality) {  // the search's runs each make their own
+    if (schedule == RoundSchedule::kPreview && (!quality || targetFromPreview)) {  // the search's runs each make their own
       b["preview_corrected"] = sched.correction.pixels;
       b["preview_correction_weight"] = sched.correction.meanWeight;
       if (std::isfinite(sched.correction.previewPsnr)) b["preview_psnr"] = sched.correction.previewPsnr;
@@ -480,7 +507,17 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     }
     if (quality) {
       toolkit::AddQualityJson(*quality, f.pipe.engine.targetPsnr.value_or(0), f.pipe.engine.budget.value_or(0), &j);
-      if (schedule == RoundSchedule::kPreview) j["quality"]["searches"] = qrounds.passes;
+      if (targetFromPreview) {
+        nlohmann::json ladder = nlohmann::json::array();
+        for (size_t k = 0; k < ptarget.thresholds.size(); ++k)
+          ladder.push_back({{"threshold", ptarget.thresholds[k]},
+                            {"psnr", ptarget.estimates[k].psnr},
+                            {"low", ptarget.estimates[k].low},
+                            {"high", ptarget.estimates[k].high}});
+        j["quality"]["ladder"] = ladder;
+      } else if (schedule == RoundSchedule::kPreview) {
+        j["quality"]["searches"] = qrounds.passes;
+      }
     }
     if (Status w = toolkit::WriteJson(stats, j); !w.ok()) return Fail(w.message());
   }
@@ -569,6 +606,13 @@ Registration reg("blender", "Render a .blend with Cycles at the pixels DCM asks 
                                    "gives the engine their variance: auto (where the preview's halves say their "
                                    "noise costs less than 42 dB PSNR), on, or off (one render each, no variance)")
                        ->check(CLI::IsMember({"auto", "on", "off"}))
+                       ->capture_default_str();
+                   app->add_option("--estimate-from", f->estimateFrom,
+                                   "what judges --target-psnr: the preview's estimate at every pixel (against the "
+                                   "converged image; needs the preview's variance), validation pixels rendered "
+                                   "exactly, or auto (the preview where it can tell: its own noise under 25 dB "
+                                   "and no --budget)")
+                       ->check(CLI::IsMember({"auto", "preview", "validation"}))
                        ->capture_default_str();
                    app->add_option("--render-threads", f->renderThreads, "Cycles threads (0: Blender's choice)")
                        ->transform(Integer(0, kMaxThreads));

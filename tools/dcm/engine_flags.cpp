@@ -1,5 +1,6 @@
 #include "engine_flags.h"
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
@@ -297,18 +298,27 @@ std::string QualityLine(const QualityReport& r, const EngineFlags& f) {
   std::string target;
   if (f.targetPsnr) target = "; --target-psnr " + TargetName(r, f) + (r.targetReached ? " reached" : " NOT reached");
   if (r.budgetBound) target += "; --budget " + G(*f.budget) + " bound";
+  char from[64];
+  if (r.estimateSource == EstimateSource::kPreview) std::snprintf(from, sizeof from, "from the preview");
+  else
+    std::snprintf(from, sizeof from, "validation %.2f %%",
+                  r.totalPixels ? 100.0 * double(r.validationExactPixels) / double(r.totalPixels) : 0.0);
   std::snprintf(buf, sizeof buf,
                 "estimated PSNR %.2f dB (%.0f %% interval %.2f to %.2f%s), %.2f %% exact pixels in %d runs "
-                "(validation %.2f %%), threshold %s",
-                e.psnr, 100 * r.confidence, e.low, e.high, target.c_str(), 100 * r.exactFraction(), r.runs,
-                r.totalPixels ? 100.0 * double(r.validationExactPixels) / double(r.totalPixels) : 0.0,
+                "(%s), threshold %s",
+                e.psnr, 100 * r.confidence, e.low, e.high, target.c_str(), 100 * r.exactFraction(), r.runs, from,
                 r.threshold < 0 ? "none (full evaluation)" : G(r.threshold).c_str());
   if (!r.againstConverged) return buf;
   const PsnrEstimate& n = r.renderEstimate;
   char noise[160];
-  std::snprintf(noise, sizeof noise, "; against the converged image, the full render's own estimated PSNR %.2f dB (%.2f to %.2f)",
-                n.psnr, n.low, n.high);
-  return buf + std::string(noise);
+  std::snprintf(noise, sizeof noise, "; against the converged image, the full render's own estimated PSNR %.2f dB",
+                n.psnr);
+  std::string line = buf + std::string(noise);
+  if (std::isfinite(n.low) && std::isfinite(n.high)) {
+    std::snprintf(noise, sizeof noise, " (%.2f to %.2f)", n.low, n.high);
+    line += noise;
+  }
+  return line;
 }
 
 std::string QualityWarning(const QualityReport& r, const EngineFlags& f) {

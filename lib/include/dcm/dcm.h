@@ -46,8 +46,11 @@ extern "C" {
  *  their twins "noisy_elementary_block", "contrast_threshold_supersampled",
  *  "contrast_metric_supersampled", "directions_supersampled" and
  *  "thin_objects_supersampled" are gone (a value set serves every regime).
- *  Version 5 adds dcmSetPreviewVariance(). Version 6 adds DCM_REASON_RENDERED. */
-#define DCM_C_API_VERSION 6
+ *  Version 5 adds dcmSetPreviewVariance(). Version 6 adds DCM_REASON_RENDERED.
+ *  Version 7: "target_psnr" with a preview of known variance is judged by the
+ *  preview's estimate (the statistic "estimate_from_preview"), and a
+ *  preview-planned run without a goal reports that estimate. */
+#define DCM_C_API_VERSION 7
 
 /** A reconstructor: options, guides, the sample callback and the last result. */
 typedef struct DCMReconstructorImpl* DCMReconstructor;
@@ -320,8 +323,16 @@ DCM_API const uint8_t* dcmGetSampleMap(DCMReconstructor r, int* width, int* heig
  *  reports variance, and the estimate is against the converged image),
  *  "estimated_render_psnr", "estimated_render_psnr_low",
  *  "estimated_render_psnr_high" (the full render's own PSNR against the
- *  converged image; NaN without variance), and "exact_pixels" counts every
- *  pixel evaluated over the runs.
+ *  converged image; NaN without variance), "estimate_from_preview" (1: the
+ *  target was judged by the preview's estimate, dcm/preview_target.h: with
+ *  "target_psnr" alone, a preview at the image size with its variance
+ *  (dcmSetPreviewVariance), rounds that cost (dcmSetRoundCost) and noise-free
+ *  samples, where the preview's own noise costs less than 25 dB; against the
+ *  converged image, no validation pixels), and "exact_pixels" counts every
+ *  pixel evaluated over the runs. Without a goal, a preview-planned run whose
+ *  preview carries its variance reports "estimated_psnr" (_low, _high) from the
+ *  preview, with "estimate_against_converged" and "estimate_from_preview" 1
+ *  (since API version 7).
  *  0 and an error for an unknown name or before a result. */
 DCM_API double dcmGetStat(DCMReconstructor r, const char* name);
 

@@ -16,6 +16,12 @@
 
 namespace dcm {
 
+/// Below this display-referred PSNR of the preview's own noise, its estimate
+/// of the result's error is not made: through the encoding's curve and clip,
+/// so noisy a preview errs on the side of error by several dB (chosen on the
+/// tuning set, docs/TUNING.md).
+inline constexpr double kMinPreviewPsnrForEstimate = 25;
+
 /// What a preview correction did.
 struct PreviewCorrectionStats {
   int64_t pixels = 0;       ///< interpolated working pixels that moved (weight > 0 in a channel)
@@ -39,6 +45,12 @@ struct PreviewCorrectionStats {
   /// from its variance (NaN with downsample > 1).
   double previewPsnr = std::numeric_limits<double>::quiet_NaN();
 };
+
+/// The display-referred PSNR of `preview`'s own noise against the converged
+/// image (PreviewCorrectionStats::previewPsnr) before any correction, from
+/// `ownVariance` (empty: the preview's variance); NaN where the preview has
+/// no variance or cannot be read.
+double PreviewNoisePsnr(SampleProvider& preview, std::span<const RGB> ownVariance = {});
 
 /// Corrects the interpolated pixels (SampleReason::kInterpolated) of `rec`
 /// toward `preview`, which must give every working pixel's L and the variance

@@ -77,6 +77,12 @@ struct LevelEstimate {
   PsnrEstimate estimate;
 };
 
+/// Where an estimate of the result's PSNR comes from.
+enum class EstimateSource : uint8_t {
+  kValidation,  ///< exactly evaluated validation pixels (ReconstructToQuality)
+  kPreview,     ///< the preview at every pixel (ReconstructToTargetFromPreview, dcm/preview_target.h)
+};
+
 /// What ReconstructToQuality delivered and what it cost.
 struct QualityReport {
   /// Of the result: with a target, from a last draw of validation pixels that
@@ -84,6 +90,7 @@ struct QualityReport {
   /// Against the converged image where `againstConverged`, else against the
   /// full render (at the samples the provider gives).
   PsnrEstimate estimate;
+  EstimateSource estimateSource = EstimateSource::kValidation;
   /// The samples carry their variance: `estimate` is against the converged
   /// image (the noise of the exact values taken out) and `renderEstimate` is
   /// filled (docs/QUALITY.md, "Noise").

@@ -1,0 +1,59 @@
+// A PSNR target for renderers whose rounds cost a latency, judged by the
+// preview's own estimate of the result's error (PreviewCorrectionStats::
+// estimate) instead of validation pixels: the contrast threshold steps down a
+// ladder from coarser than the default, each step a preview-planned run that
+// renders only the pixels no earlier step rendered, until the estimate's
+// lower bound reaches the target.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "dcm/quality_target.h"
+#include "dcm/round_schedule.h"
+
+namespace dcm {
+
+/// What the steps of ReconstructToTargetFromPreview cost and estimated.
+struct PreviewTargetStats {
+  std::vector<double> thresholds;        ///< per run: its contrast threshold
+  std::vector<PsnrEstimate> estimates;   ///< per run: the preview's estimate of its result
+  int rounds = 0;                        ///< calls to the exact provider over all runs
+  std::vector<int64_t> pixelsPerRound;   ///< pixels evaluated in each call
+  int64_t renderedPixels = 0;            ///< distinct working pixels the exact provider evaluated
+  double timeEngineS = 0;                ///< engine runs and corrections of every run
+  double timeExactS = 0;                 ///< in the exact provider's Evaluate()
+  PreviewScheduleStats last;             ///< the run whose result was kept
+};
+
+/// Whether ReconstructToTargetFromPreview can judge `targetPsnr` with this
+/// preview: its own noise costs less than kMinPreviewPsnrForEstimate (else
+/// the estimate is not made), and the exact samples' own noise
+/// (`schedule.exactVarianceShare` of the preview's) leaves at least 0.5 dB
+/// between the target and what every pixel rendered exactly would reach. On
+/// false, `why` (if given) says which.
+bool CanTargetFromPreview(SampleProvider& preview, const PreviewScheduleOptions& schedule, double targetPsnr,
+                          std::string* why = nullptr);
+
+/// Reconstructs `exact`'s image at the coarsest threshold of a ladder whose
+/// result, as the preview correction estimates it against the converged
+/// image, reaches `targetPsnr` at the estimate's lower bound (the one-sided
+/// 95 % bound). The ladder starts at three times the options' threshold (unset: the
+/// regime's default) and halves it per run, at most 7 runs; it stops early
+/// where the estimate stops rising. Each run is ReconstructWithPreview with
+/// `schedule` (which needs the preview's variance, and its own variance and
+/// the exact share for the estimate), planned on the preview and on every
+/// exact sample earlier runs rendered: a pixel is rendered once, and what an
+/// earlier run rendered that this one interpolates keeps its exact value.
+/// `report` is that of ReconstructToQuality (estimate against the converged
+/// image, from the preview: `estimateSource` kPreview, no validation pixels;
+/// exactPixels every pixel rendered, as the result's stats.exactPixels; its
+/// byReason and sample map are the last run's). A target not reached is no error:
+/// `report->targetReached` says so and the result is the last run's.
+Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& preview,
+                                      const ReconstructionOptions& options, double targetPsnr,
+                                      const PreviewScheduleOptions& schedule, Reconstruction* out,
+                                      QualityReport* report, PreviewTargetStats* stats = nullptr);
+
+}  // namespace dcm

@@ -1,0 +1,140 @@
+// The provider a preview-planned run plans on (round_schedule.cpp) and the two
+// halves of such a run, shared with the target search on the preview's
+// estimate (preview_target.cpp), whose runs keep one planner across thresholds.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include "dcm/reconstructor.h"
+#include "dcm/round_schedule.h"
+#include "dcm/sample_provider.h"
+#include "guide_cache.h"
+
+namespace dcm {
+
+/// What the engine sees during planning: the exact provider's guides (asked
+/// once per region and kind), exact samples where they are known, preview
+/// samples elsewhere; it records the pixels asked for that are not known.
+class PlanningProvider : public SampleProvider {
+ public:
+  PlanningProvider(SampleProvider& exact, SampleProvider& preview)
+      : exact_(exact), preview_(preview), caps_(exact.Capabilities()) {
+    // Calls come from one thread: the records below need no locks, and the
+    // engine's work between calls is small next to a round of a slow renderer.
+    caps_.threadSafe = false;
+    const size_t n = size_t(caps_.width) * size_t(caps_.height);
+    known_.assign(n, 0);
+    wanted_.assign(n, 0);
+    samples_.resize(n);
+  }
+
+  ProviderCapabilities Capabilities() const override { return caps_; }
+
+  Status Guides(const Bounds2i& region, const GuideRequest& what, GuideImage* out) override {
+    return guides_.Get(exact_, region, what, out);
+  }
+
+  Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what,
+                  std::span<ExactSample> out) override {
+    request_.split |= what.split;
+    request_.variance |= what.variance;
+    missing_.clear();
+    for (size_t i = 0; i < pixels.size(); ++i) {
+      const size_t k = Index(pixels[i]);
+      if (known_[k]) {
+        out[i] = samples_[k];
+      } else {
+        missing_.push_back(i);
+        if (!wanted_[k]) {
+          wanted_[k] = 1;
+          wantedList_.push_back(pixels[i]);
+        }
+      }
+    }
+    if (missing_.empty()) return Status::Ok();
+    std::vector<Point2i> ask(missing_.size());
+    std::vector<ExactSample> got(missing_.size());
+    for (size_t j = 0; j < missing_.size(); ++j) ask[j] = pixels[missing_[j]];
+    Status s = preview_.Evaluate(ask, what, got);
+    if (!s.ok()) return Status::Error("preview samples: " + s.message());
+    for (size_t j = 0; j < missing_.size(); ++j) out[missing_[j]] = got[j];
+    return Status::Ok();
+  }
+
+  /// Pixels asked for in this run that are not known exactly; clears the record.
+  std::vector<Point2i> TakeWanted() {
+    for (const Point2i& p : wantedList_) wanted_[Index(p)] = 0;
+    return std::exchange(wantedList_, {});
+  }
+
+  /// Marks the interpolated pixels of `rec` that a round evaluated as exact
+  /// (SampleReason::kRendered): they were paid for. Their values stay until
+  /// FillRendered(). Returns how many.
+  int64_t MarkRendered(Reconstruction* rec) const {
+    int64_t kept = 0;
+    for (size_t k = 0; k < known_.size(); ++k) {
+      // A non-finite sample stays out, as the engine keeps it out of its neighbours.
+      if (!known_[k] || rec->sampleMap[k] != SampleReason::kInterpolated || !IsFinite(samples_[k].L)) continue;
+      rec->sampleMap[k] = SampleReason::kRendered;
+      ++kept;
+    }
+    rec->stats.byReason[size_t(SampleReason::kRendered)] += kept;
+    rec->stats.exactPixels += kept;
+    return kept;
+  }
+
+  /// Gives the pixels MarkRendered() marked their exact values.
+  void FillRendered(Reconstruction* rec) const {
+    for (size_t k = 0; k < known_.size(); ++k)
+      if (rec->sampleMap[k] == SampleReason::kRendered) rec->workImage[k] = samples_[k].L;
+  }
+
+  /// Working pixels evaluated exactly so far.
+  int64_t KnownCount() const { return known_.size() - std::count(known_.begin(), known_.end(), uint8_t(0)); }
+
+  /// Evaluates `pixels` with the exact provider in one call and keeps them.
+  Status EvaluateExactly(const std::vector<Point2i>& pixels) {
+    std::vector<ExactSample> got(pixels.size());
+    Status s = exact_.Evaluate(pixels, request_, got);
+    if (!s.ok()) return s;
+    for (size_t i = 0; i < pixels.size(); ++i) {
+      const size_t k = Index(pixels[i]);
+      samples_[k] = got[i];
+      known_[k] = 1;
+    }
+    return Status::Ok();
+  }
+
+ private:
+  size_t Index(const Point2i& p) const { return size_t(p.y) * size_t(caps_.width) + size_t(p.x); }
+
+  SampleProvider& exact_;
+  SampleProvider& preview_;
+  ProviderCapabilities caps_;
+  SampleRequest request_;
+  GuideCache guides_;
+  std::vector<uint8_t> known_, wanted_;
+  std::vector<ExactSample> samples_;
+  std::vector<Point2i> wantedList_;
+  std::vector<size_t> missing_;
+};
+
+/// Runs the engine on `planning` and evaluates what it asks for that is not
+/// known, one call per round, until nothing is asked, `schedule.maxRounds`
+/// calls were made, or a round would evaluate fewer than
+/// `schedule.minRoundShare` of the pixels (not the first of all: `roundsBefore`
+/// calls made on `planning` by earlier runs); what is still asked becomes a
+/// preview stand-in. Counts into `stats` (rounds, pixels, stand-ins, times).
+Status PlanAndRender(PlanningProvider& planning, const ReconstructionOptions& options,
+                     const PreviewScheduleOptions& schedule, int roundsBefore, Reconstruction* out,
+                     PreviewScheduleStats* stats);
+
+/// After PlanAndRender: the rendered pixels kept (not with noisy samples), the
+/// interpolated ones corrected toward `preview` where it carries a variance,
+/// then the rendered values filled in.
+Status FinishPreviewRun(PlanningProvider& planning, SampleProvider& preview, const ReconstructionOptions& options,
+                        const PreviewScheduleOptions& schedule, Reconstruction* out, PreviewScheduleStats* stats);
+
+}  // namespace dcm

@@ -1,0 +1,140 @@
+// A PSNR target judged by the preview's estimate: the ladder stops at the
+// first threshold whose estimated lower bound reaches the target, renders
+// each pixel once, and refuses a preview that cannot tell.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "dcm/preview_target.h"
+#include "run_helpers.h"
+
+namespace dcm::testing {
+namespace {
+
+constexpr int M = 128;
+
+/// Counts what the exact provider is asked for: each pixel at most once.
+class CountingProvider : public SampleProvider {
+ public:
+  explicit CountingProvider(SampleProvider& inner) : inner_(inner), asked_(size_t(M) * M, 0) {}
+  ProviderCapabilities Capabilities() const override { return inner_.Capabilities(); }
+  Status Guides(const Bounds2i& r, const GuideRequest& w, GuideImage* out) override { return inner_.Guides(r, w, out); }
+  Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what, std::span<ExactSample> out) override {
+    ++calls;
+    for (const Point2i& p : pixels) maxAsked = std::max(maxAsked, int(++asked_[size_t(p.y) * M + size_t(p.x)]));
+    pixelsAsked += int64_t(pixels.size());
+    return inner_.Evaluate(pixels, what, out);
+  }
+  int calls = 0, maxAsked = 0;
+  int64_t pixelsAsked = 0;
+
+ private:
+  SampleProvider& inner_;
+  std::vector<uint8_t> asked_;
+};
+
+/// The truth plus Gaussian noise of sd `sd`, with that variance.
+ImagePreviewProvider NoisyPreview(const std::vector<RGB>& truth, float sd, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> noise(0.f, sd);
+  std::vector<RGB> L = truth, var(truth.size(), RGB::Gray(sd * sd));
+  for (RGB& v : L) v = {v.r + noise(rng), v.g + noise(rng), v.b + noise(rng)};
+  return ImagePreviewProvider(M, M, M, M, std::move(L), {}, {}, std::move(var));
+}
+
+ReconstructionOptions Options() {
+  ReconstructionOptions o;
+  o.textureSplit = false;
+  return o;
+}
+
+TEST(PreviewTarget, TheTargetIsReachedAndEstimatedHonestlyRenderingEachPixelOnce) {
+  // The analytic furnished scene, its preview the truth plus noise of sd
+  // 0.01 (its own PSNR about 40 dB), exact samples noise-free. 36 dB is
+  // reached at the ladder's first run (about 40.6 dB true), 42 after a few.
+  AnalyticProvider truth(M, M, FurnishedScene(M, M));
+  const std::vector<RGB> ref = truth.FullRender();
+  double lastFraction = 0;
+  for (double target : {36.0, 42.0}) {
+    ImagePreviewProvider preview = NoisyPreview(ref, 0.01f, 3);
+    PreviewScheduleOptions schedule;
+    ASSERT_TRUE(CanTargetFromPreview(preview, schedule, target));
+    CountingProvider exact(truth);
+    Reconstruction r;
+    QualityReport report;
+    PreviewTargetStats stats;
+    const Status s = ReconstructToTargetFromPreview(exact, preview, Options(), target, schedule, &r, &report, &stats);
+    ASSERT_TRUE(s.ok()) << s.message();
+    const double psnr = DisplayPsnr(r.image, ref);
+    ASSERT_TRUE(report.targetReached) << target << " dB: estimated " << report.estimate.low;
+    EXPECT_EQ(report.estimateSource, EstimateSource::kPreview);
+    EXPECT_GE(report.estimate.low, target);
+    // The bounds: the truth at least the target less 0.5 dB, the
+    // estimate within 1.5 dB of it.
+    EXPECT_GE(psnr, target - 0.5) << "estimated " << report.estimate.psnr;
+    EXPECT_NEAR(report.estimate.psnr, psnr, 1.5);
+    // Each pixel rendered once, and every one counted in the cost.
+    EXPECT_EQ(exact.maxAsked, 1);
+    EXPECT_EQ(exact.pixelsAsked, report.exactPixels);
+    EXPECT_EQ(exact.calls, stats.rounds);
+    EXPECT_EQ(r.stats.exactPixels, report.exactPixels);
+    // The ladder steps down, each run finer than the one before, and stops
+    // at the first whose bound reaches the target.
+    for (size_t k = 1; k < stats.thresholds.size(); ++k) {
+      EXPECT_LT(stats.thresholds[k], stats.thresholds[k - 1]);
+      EXPECT_LT(stats.estimates[k - 1].low, target) << "run " << k - 1 << " had reached it";
+    }
+    EXPECT_EQ(report.threshold, stats.thresholds.back());
+    // A higher target costs at least as many exact pixels.
+    EXPECT_GE(report.exactFraction(), lastFraction) << target << " dB";
+    lastFraction = report.exactFraction();
+  }
+}
+
+TEST(PreviewTarget, ATargetTheLadderCannotReachIsReportedNotReached) {
+  // 80 dB on a scene whose interpolation errs well above it: every run of
+  // the ladder is made, and the result says the target is missed.
+  AnalyticProvider truth(M, M, FurnishedScene(M, M));
+  const std::vector<RGB> ref = truth.FullRender();
+  ImagePreviewProvider preview = NoisyPreview(ref, 0.01f, 4);
+  Reconstruction r;
+  QualityReport report;
+  PreviewTargetStats stats;
+  ASSERT_TRUE(ReconstructToTargetFromPreview(truth, preview, Options(), 80, {}, &r, &report, &stats).ok());
+  EXPECT_FALSE(report.targetReached);
+  EXPECT_LT(report.estimate.low, 80);
+  EXPECT_GE(stats.thresholds.size(), 3u) << "the ladder stops only at its end or a plateau";
+  EXPECT_EQ(r.image.size(), ref.size());
+}
+
+TEST(PreviewTarget, APreviewThatCannotTellIsRefusedWithTheReason) {
+  AnalyticProvider truth(M, M, FurnishedScene(M, M));
+  const std::vector<RGB> ref = truth.FullRender();
+  std::string why;
+  // sd 0.2: the preview's own PSNR about 15 dB, below the 25 the estimate needs.
+  ImagePreviewProvider noisy = NoisyPreview(ref, 0.2f, 5);
+  EXPECT_FALSE(CanTargetFromPreview(noisy, {}, 30, &why));
+  EXPECT_NE(why.find("too noisy"), std::string::npos) << why;
+  // Exact samples with half the preview's variance (about 40 + 3 dB every
+  // pixel exact): 45 dB is beyond what the render itself reaches.
+  ImagePreviewProvider clean = NoisyPreview(ref, 0.01f, 5);
+  PreviewScheduleOptions schedule;
+  schedule.exactVarianceShare = 0.5;
+  EXPECT_FALSE(CanTargetFromPreview(clean, schedule, 45, &why));
+  EXPECT_NE(why.find("render's own noise"), std::string::npos) << why;
+  EXPECT_TRUE(CanTargetFromPreview(clean, schedule, 35, &why)) << why;
+  // Out of range and without a preview variance: errors naming what.
+  Reconstruction r;
+  QualityReport report;
+  EXPECT_FALSE(ReconstructToTargetFromPreview(truth, clean, Options(), 0, {}, &r, &report).ok());
+  ImagePreviewProvider noVariance(M, M, M, M, ref);
+  const Status s = ReconstructToTargetFromPreview(truth, noVariance, Options(), 30, {}, &r, &report);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("variance"), std::string::npos) << s.message();
+}
+
+}  // namespace
+}  // namespace dcm::testing
