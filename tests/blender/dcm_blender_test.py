@@ -99,7 +99,7 @@ def variance(dcm, blender, src, tmp):
                         ("uncorrected", ["--variance", "on", "--preview-correction", "0"])):
         out, stats, smap = (os.path.join(tmp, name + e) for e in (".exr", ".json", ".png"))
         code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--sample-map", smap, "--blender", blender,
-                                 "--max-rounds", "8", "--min-round-share", "0"] + flags)
+                                 "--max-rounds", "8", "--min-round-share", "0", "--schedule", "preview"] + flags)
         assert code == 0, se
         j = json.load(open(stats))
         b = j["blender"]
@@ -219,7 +219,8 @@ def preview_target(dcm, blender, src, tmp):
     runs = {}
     for target in (30.0, 34.0):
         code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--blender", blender, "--samples", "64",
-                                 "--preview-samples", "16", "--target-psnr", str(target), "-v"])
+                                 "--preview-samples", "16", "--target-psnr", str(target), "--schedule", "preview",
+                                 "-v"])
         assert code == 0, se
         assert "judged by the preview's estimate" in se, se
         j = json.load(open(stats))
@@ -245,12 +246,13 @@ def preview_target(dcm, blender, src, tmp):
     assert runs[34.0][1]["exact_fraction"] >= runs[30.0][1]["exact_fraction"], runs
     # A target beyond the render's own noise is judged by validation pixels instead, and -v says why.
     code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--blender", blender, "--samples", "64",
-                             "--preview-samples", "16", "--target-psnr", "60", "--max-rounds", "1", "-v"])
+                             "--preview-samples", "16", "--target-psnr", "60", "--max-rounds", "1",
+                             "--schedule", "preview", "-v"])
     assert code == 0 and "validation pixels: the render's own noise" in se, se
     assert json.load(open(stats))["estimated_psnr_from"] == "validation"
     # Asked for explicitly where it cannot tell: a usage error naming the flag.
     code, so, se = run(dcm, [blend, "-o", out, "--blender", blender, "--samples", "64", "--preview-samples", "16",
-                             "--target-psnr", "60", "--estimate-from", "preview"])
+                             "--target-psnr", "60", "--estimate-from", "preview", "--schedule", "preview"])
     assert code == 2 and "--estimate-from preview" in se, (code, se)
     assert no_blender_left(blend)
 

@@ -320,6 +320,12 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   RoundSchedule schedule = RoundSchedule::kLevels;
   if (Status st = ScheduleFor(f.rounds, provider->roundCost(), provider->hasPreview(), &schedule); !st.ok())
     return Fail("'" + f.scene + "': " + st.message());
+  if (f.estimateFrom == "preview" && (schedule != RoundSchedule::kPreview || !f.pipe.engine.targetPsnr))
+    return Fail("--estimate-from preview: judges --target-psnr with the preview schedule (here " +
+                    std::string(f.pipe.engine.targetPsnr ? "schedule " + std::string(ToString(schedule))
+                                                         : "no --target-psnr") +
+                    ")",
+                kExitUsage);
   if (options.fullEvaluation) {
     // The baseline: every pixel in one render call.
     schedule = RoundSchedule::kLevels;
