@@ -605,7 +605,7 @@ DCM_API DCMError dcmExecute(DCMReconstructor r) {
                                         r->previewLi, r->previewLc, r->previewVariance);
       dcm::PreviewScheduleOptions schedule;
       schedule.maxRounds = r->maxRounds;
-      if (fromPreview && dcm::CanTargetFromPreview(preview, schedule, r->targetPsnr)) {
+      if (fromPreview && dcm::CanTargetFromPreview(preview, schedule)) {
         dcm::PreviewTargetStats ladder;
         st = dcm::ReconstructToTargetFromPreview(provider, preview, options, r->targetPsnr, schedule, &r->result,
                                                  &report, &ladder);

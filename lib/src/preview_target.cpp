@@ -34,26 +34,14 @@ std::string Db(double v) {
 
 }  // namespace
 
-bool CanTargetFromPreview(SampleProvider& preview, const PreviewScheduleOptions& schedule, double targetPsnr,
-                          std::string* why) {
+bool CanTargetFromPreview(SampleProvider& preview, const PreviewScheduleOptions& schedule, std::string* why) {
   const double own = PreviewNoisePsnr(preview, schedule.previewOwnVariance);
-  if (!std::isfinite(own) || own < kMinPreviewPsnrForEstimate) {
-    if (why)
-      *why = std::isfinite(own) ? "the preview's own noise costs " + Db(own) + ", below " +
-                                      Db(kMinPreviewPsnrForEstimate) + ": too noisy to estimate from"
-                                : "the preview carries no variance";
-    return false;
-  }
-  // Every pixel exact: each keeps exactVarianceShare of the preview's noise.
-  const double floor =
-      schedule.exactVarianceShare > 0 ? own - 10 * std::log10(schedule.exactVarianceShare) : HUGE_VAL;
-  if (targetPsnr > floor - kFloorMarginDb) {
-    if (why)
-      *why = "the render's own noise (about " + Db(floor) + " against the converged image) leaves no room for " +
-             Db(targetPsnr);
-    return false;
-  }
-  return true;
+  if (std::isfinite(own) && own >= kMinPreviewPsnrForEstimate) return true;
+  if (why)
+    *why = std::isfinite(own) ? "the preview's own noise costs " + Db(own) + ", below " +
+                                    Db(kMinPreviewPsnrForEstimate) + ": too noisy to estimate from"
+                              : "the preview carries no variance";
+  return false;
 }
 
 Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& preview,
@@ -81,13 +69,19 @@ Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& pre
   PreviewTargetStats& s = stats ? *stats : local;
   s = PreviewTargetStats{};
   try {
+    // Every pixel exact: each keeps exactVarianceShare of the preview's noise.
+    const double own = PreviewNoisePsnr(preview, schedule.previewOwnVariance);
+    s.renderPsnr = schedule.exactVarianceShare > 0 ? own - 10 * std::log10(schedule.exactVarianceShare) : HUGE_VAL;
+    s.beyondRender = !(targetPsnr <= s.renderPsnr - kFloorMarginDb);
     PlanningProvider planning(exact, preview);
     ReconstructionOptions o = options;
-    double threshold = kStartFactor * double(ResolveSettings(options, caps).contrastThreshold);
+    const double defaultThreshold = double(ResolveSettings(options, caps).contrastThreshold);
+    double threshold = s.beyondRender ? defaultThreshold : kStartFactor * defaultThreshold;
+    const int maxRuns = s.beyondRender ? 1 : kMaxRuns;
     Reconstruction best;
     bool reached = false;
     int flat = 0;
-    for (int run = 0; run < kMaxRuns && !reached; ++run, threshold *= kStep) {
+    for (int run = 0; run < maxRuns && !reached; ++run, threshold *= kStep) {
       o.contrastThreshold = float(threshold);
       PreviewScheduleStats runStats;
       Reconstruction rec;
@@ -120,11 +114,7 @@ Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& pre
     r.estimate = s.estimates.back();
     r.estimateSource = EstimateSource::kPreview;
     r.againstConverged = true;
-    // The full render's own: every pixel at the exact samples' share of the preview's noise.
-    const double own = s.last.correction.previewPsnr;
-    const double render =
-        schedule.exactVarianceShare > 0 ? own - 10 * std::log10(schedule.exactVarianceShare) : HUGE_VAL;
-    r.renderEstimate = {render, NAN, NAN};
+    r.renderEstimate = {s.renderPsnr, NAN, NAN};
     r.targetPsnr = targetPsnr;
     r.exactPixels = s.renderedPixels;
     r.totalPixels = int64_t(caps.width) * int64_t(caps.height);

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "dcm/preview_correction.h"
 #include "dcm/preview_target.h"
 #include "run_helpers.h"
 
@@ -61,7 +62,7 @@ TEST(PreviewTarget, TheTargetIsReachedAndEstimatedHonestlyRenderingEachPixelOnce
   for (double target : {36.0, 42.0}) {
     ImagePreviewProvider preview = NoisyPreview(ref, 0.01f, 3);
     PreviewScheduleOptions schedule;
-    ASSERT_TRUE(CanTargetFromPreview(preview, schedule, target));
+    ASSERT_TRUE(CanTargetFromPreview(preview, schedule));
     CountingProvider exact(truth);
     Reconstruction r;
     QualityReport report;
@@ -110,22 +111,42 @@ TEST(PreviewTarget, ATargetTheLadderCannotReachIsReportedNotReached) {
   EXPECT_EQ(r.image.size(), ref.size());
 }
 
+TEST(PreviewTarget, ATargetBeyondTheRendersOwnNoiseIsNotSearchedFor) {
+  // Exact samples with half the preview's variance (sd 0.01: about 40 + 3 dB
+  // with every pixel exact): 45 dB is beyond what the render itself reaches.
+  // One run at the default threshold, reported not reached, with the limit.
+  AnalyticProvider truth(M, M, FurnishedScene(M, M));
+  const std::vector<RGB> ref = truth.FullRender();
+  ImagePreviewProvider preview = NoisyPreview(ref, 0.01f, 6);
+  PreviewScheduleOptions schedule;
+  schedule.exactVarianceShare = 0.5;
+  Reconstruction r;
+  QualityReport report;
+  PreviewTargetStats stats;
+  ASSERT_TRUE(ReconstructToTargetFromPreview(truth, preview, Options(), 45, schedule, &r, &report, &stats).ok());
+  EXPECT_TRUE(stats.beyondRender);
+  EXPECT_NEAR(stats.renderPsnr, PreviewNoisePsnr(preview) + 10 * std::log10(2.0), 1e-9);
+  EXPECT_LT(stats.renderPsnr, 45 + 0.5);
+  ASSERT_EQ(stats.thresholds.size(), 1u);
+  EXPECT_EQ(stats.thresholds[0], double(ResolveSettings(Options(), truth.Capabilities()).contrastThreshold));
+  EXPECT_FALSE(report.targetReached);
+  EXPECT_EQ(report.renderEstimate.psnr, stats.renderPsnr);
+  // 35 dB leaves room: the ladder runs, from its coarse start.
+  ASSERT_TRUE(ReconstructToTargetFromPreview(truth, preview, Options(), 35, schedule, &r, &report, &stats).ok());
+  EXPECT_FALSE(stats.beyondRender);
+  EXPECT_GT(stats.thresholds[0], double(ResolveSettings(Options(), truth.Capabilities()).contrastThreshold));
+}
+
 TEST(PreviewTarget, APreviewThatCannotTellIsRefusedWithTheReason) {
   AnalyticProvider truth(M, M, FurnishedScene(M, M));
   const std::vector<RGB> ref = truth.FullRender();
   std::string why;
   // sd 0.2: the preview's own PSNR about 15 dB, below the 25 the estimate needs.
   ImagePreviewProvider noisy = NoisyPreview(ref, 0.2f, 5);
-  EXPECT_FALSE(CanTargetFromPreview(noisy, {}, 30, &why));
+  EXPECT_FALSE(CanTargetFromPreview(noisy, {}, &why));
   EXPECT_NE(why.find("too noisy"), std::string::npos) << why;
-  // Exact samples with half the preview's variance (about 40 + 3 dB every
-  // pixel exact): 45 dB is beyond what the render itself reaches.
   ImagePreviewProvider clean = NoisyPreview(ref, 0.01f, 5);
-  PreviewScheduleOptions schedule;
-  schedule.exactVarianceShare = 0.5;
-  EXPECT_FALSE(CanTargetFromPreview(clean, schedule, 45, &why));
-  EXPECT_NE(why.find("render's own noise"), std::string::npos) << why;
-  EXPECT_TRUE(CanTargetFromPreview(clean, schedule, 35, &why)) << why;
+  EXPECT_TRUE(CanTargetFromPreview(clean, {}, &why)) << why;
   // Out of range and without a preview variance: errors naming what.
   Reconstruction r;
   QualityReport report;

@@ -25,6 +25,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <limits>
 #include <memory>
@@ -390,7 +391,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       std::string why;
       if (so.correctionRadius < 1) why = "--preview-correction 0: the correction makes the estimate";
       else if (options.downsample != 1) why = "--downsample: the preview estimates at final resolution only";
-      targetFromPreview = why.empty() && CanTargetFromPreview(*preview, so, target, &why);
+      targetFromPreview = why.empty() && CanTargetFromPreview(*preview, so, &why);
       if (!targetFromPreview && f.estimateFrom == "preview")
         return Fail("--estimate-from preview: " + why, kExitUsage);
       if (f.pipe.engine.verbose)
@@ -404,6 +405,11 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       goalS = Since(tq);
       if (st.ok()) quality = std::move(report);
       sched = ptarget.last;
+      if (st.ok() && ptarget.beyondRender)
+        std::cerr << "dcm " << cmd << ": warning: --target-psnr " << target << ": beyond what these samples give: the "
+                  << "render itself is about " << std::fixed << std::setprecision(2) << ptarget.renderPsnr
+                  << std::defaultfloat << " dB from the converged image (from the preview); reconstructed at the "
+                  << "default threshold. More --samples raise it, more exact pixels do not\n";
     } else if (st.ok() && haveGoal) {
       so.minRoundShare = 0;  // the search validates what each run asks for
       // Each run of the search in two rounds at most: its validation pixels go

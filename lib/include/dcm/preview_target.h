@@ -25,15 +25,19 @@ struct PreviewTargetStats {
   double timeEngineS = 0;                ///< engine runs and corrections of every run
   double timeExactS = 0;                 ///< in the exact provider's Evaluate()
   PreviewScheduleStats last;             ///< the run whose result was kept
+  /// The target lies within 0.5 dB of what every pixel rendered exactly
+  /// would reach, or beyond it (the render's own noise): one run at the
+  /// options' threshold was made, and the target is reported not reached.
+  bool beyondRender = false;
+  /// That limit: the full render's own PSNR against the converged image, as
+  /// the preview estimates it (+inf with noise-free exact samples).
+  double renderPsnr = 0;
 };
 
-/// Whether ReconstructToTargetFromPreview can judge `targetPsnr` with this
+/// Whether ReconstructToTargetFromPreview can judge a target with this
 /// preview: its own noise costs less than kMinPreviewPsnrForEstimate (else
-/// the estimate is not made), and the exact samples' own noise
-/// (`schedule.exactVarianceShare` of the preview's) leaves at least 0.5 dB
-/// between the target and what every pixel rendered exactly would reach. On
-/// false, `why` (if given) says which.
-bool CanTargetFromPreview(SampleProvider& preview, const PreviewScheduleOptions& schedule, double targetPsnr,
+/// the estimate is not made). On false, `why` (if given) says so.
+bool CanTargetFromPreview(SampleProvider& preview, const PreviewScheduleOptions& schedule,
                           std::string* why = nullptr);
 
 /// Reconstructs `exact`'s image at the coarsest threshold of a ladder whose
@@ -50,7 +54,12 @@ bool CanTargetFromPreview(SampleProvider& preview, const PreviewScheduleOptions&
 /// image, from the preview: `estimateSource` kPreview, no validation pixels;
 /// exactPixels every pixel rendered, as the result's stats.exactPixels; its
 /// byReason and sample map are the last run's). A target not reached is no error:
-/// `report->targetReached` says so and the result is the last run's.
+/// `report->targetReached` says so and the result is the last run's. A
+/// target the render's own noise leaves no room for (the exact samples keep
+/// `schedule.exactVarianceShare` of the preview's noise: what every pixel
+/// rendered would reach, less 0.5 dB) is not searched for: one run at the
+/// options' threshold, `stats->beyondRender`, reported not reached (more
+/// samples are the remedy, not more exact pixels).
 Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& preview,
                                       const ReconstructionOptions& options, double targetPsnr,
                                       const PreviewScheduleOptions& schedule, Reconstruction* out,
