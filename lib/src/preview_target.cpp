@@ -44,6 +44,11 @@ bool CanTargetFromPreview(SampleProvider& preview, const PreviewScheduleOptions&
   return false;
 }
 
+double RenderPsnrFromPreview(SampleProvider& preview, const PreviewScheduleOptions& schedule) {
+  const double own = PreviewNoisePsnr(preview, schedule.previewOwnVariance);
+  return schedule.exactVarianceShare > 0 ? own - 10 * std::log10(schedule.exactVarianceShare) : HUGE_VAL;
+}
+
 Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& preview,
                                       const ReconstructionOptions& options, double targetPsnr,
                                       const PreviewScheduleOptions& schedule, Reconstruction* out,
@@ -69,9 +74,7 @@ Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& pre
   PreviewTargetStats& s = stats ? *stats : local;
   s = PreviewTargetStats{};
   try {
-    // Every pixel exact: each keeps exactVarianceShare of the preview's noise.
-    const double own = PreviewNoisePsnr(preview, schedule.previewOwnVariance);
-    s.renderPsnr = schedule.exactVarianceShare > 0 ? own - 10 * std::log10(schedule.exactVarianceShare) : HUGE_VAL;
+    s.renderPsnr = RenderPsnrFromPreview(preview, schedule);
     s.beyondRender = !(targetPsnr <= s.renderPsnr - kFloorMarginDb);
     PlanningProvider planning(exact, preview);
     ReconstructionOptions o = options;

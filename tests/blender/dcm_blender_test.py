@@ -252,6 +252,14 @@ def preview_target(dcm, blender, src, tmp):
     j = json.load(open(stats))
     assert j["estimated_psnr_from"] == "preview" and not j["quality"]["target_reached"], j["quality"]
     assert len(j["quality"]["ladder"]) == 1 and j["estimated_render_psnr"] < 59.5, j
+    # With the exact samples' variance the engine denoises them and may pass the render's own
+    # noise: validation pixels judge, and -v says why.
+    code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--blender", blender, "--samples", "64",
+                             "--preview-samples", "16", "--target-psnr", "60", "--schedule", "preview",
+                             "--variance", "on", "--max-rounds", "1", "-v"])
+    assert code == 0 and "validation pixels: the render's own noise" in se, se
+    assert "denoised exact samples may pass" in se, se
+    assert json.load(open(stats))["estimated_psnr_from"] == "validation"
     # Asked for explicitly where it cannot tell (a 4-sample preview, about 23 dB): a usage error
     # naming the flag; without the preview schedule too.
     for flags in (["--preview-samples", "4", "--schedule", "preview"], ["--schedule", "levels"]):

@@ -40,6 +40,13 @@ struct PreviewTargetStats {
 bool CanTargetFromPreview(SampleProvider& preview, const PreviewScheduleOptions& schedule,
                           std::string* why = nullptr);
 
+/// The full render's own display-referred PSNR against the converged image,
+/// as the preview tells it: every pixel exact, each with
+/// `schedule.exactVarianceShare` of the preview's noise (+inf at share 0, NaN
+/// without the preview's variance). Raw exact samples cannot beat it; the
+/// engine's denoising of noisy samples (ResolvedSettings::noisy) can.
+double RenderPsnrFromPreview(SampleProvider& preview, const PreviewScheduleOptions& schedule);
+
 /// Reconstructs `exact`'s image at the coarsest threshold of a ladder whose
 /// result, as the preview correction estimates it against the converged
 /// image, reaches `targetPsnr` at the estimate's lower bound (the one-sided
