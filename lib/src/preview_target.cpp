@@ -23,8 +23,6 @@ constexpr int kMaxRuns = 7;
 /// Two runs in a row that each raise the estimate by less than this have
 /// reached what the threshold can give (the exact samples' noise, stand-ins).
 constexpr double kPlateauDb = 0.1;
-/// The target must stay this far below what every pixel rendered would reach.
-constexpr double kFloorMarginDb = 0.5;
 
 std::string Db(double v) {
   char buf[32];
@@ -75,7 +73,7 @@ Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& pre
   s = PreviewTargetStats{};
   try {
     s.renderPsnr = RenderPsnrFromPreview(preview, schedule);
-    s.beyondRender = !(targetPsnr <= s.renderPsnr - kFloorMarginDb);
+    s.beyondRender = !(targetPsnr <= s.renderPsnr - kRenderNoiseMarginDb);
     PlanningProvider planning(exact, preview);
     ReconstructionOptions o = options;
     const double defaultThreshold = double(ResolveSettings(options, caps).contrastThreshold);

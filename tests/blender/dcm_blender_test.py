@@ -261,8 +261,9 @@ def preview_target(dcm, blender, src, tmp):
     assert "denoised exact samples may pass" in se, se
     assert json.load(open(stats))["estimated_psnr_from"] == "validation"
     # Asked for explicitly where it cannot tell (a 4-sample preview, about 23 dB): a usage error
-    # naming the flag; without the preview schedule too.
-    for flags in (["--preview-samples", "4", "--schedule", "preview"], ["--schedule", "levels"]):
+    # naming the flag; without the preview schedule or with a budget too.
+    for flags in (["--preview-samples", "4", "--schedule", "preview"], ["--schedule", "levels"],
+                  ["--schedule", "preview", "--budget", "0.3"]):
         code, so, se = run(dcm, [blend, "-o", out, "--blender", blender, "--samples", "64", "--target-psnr", "30",
                                  "--estimate-from", "preview"] + flags)
         assert code == 2 and "--estimate-from preview" in se, (flags, code, se)

@@ -321,10 +321,12 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   RoundSchedule schedule = RoundSchedule::kLevels;
   if (Status st = ScheduleFor(f.rounds, provider->roundCost(), provider->hasPreview(), &schedule); !st.ok())
     return Fail("'" + f.scene + "': " + st.message());
-  if (f.estimateFrom == "preview" && (schedule != RoundSchedule::kPreview || !f.pipe.engine.targetPsnr))
-    return Fail("--estimate-from preview: judges --target-psnr with the preview schedule (here " +
-                    std::string(f.pipe.engine.targetPsnr ? "schedule " + std::string(ToString(schedule))
-                                                         : "no --target-psnr") +
+  if (f.estimateFrom == "preview" &&
+      (schedule != RoundSchedule::kPreview || !f.pipe.engine.targetPsnr || f.pipe.engine.budget))
+    return Fail("--estimate-from preview: judges --target-psnr alone with the preview schedule (here " +
+                    std::string(!f.pipe.engine.targetPsnr ? "no --target-psnr"
+                                : f.pipe.engine.budget    ? "with --budget"
+                                                          : "schedule " + std::string(ToString(schedule))) +
                     ")",
                 kExitUsage);
   if (options.fullEvaluation) {
@@ -395,7 +397,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       // The render's own noise bounds raw exact samples; the engine's denoising
       // of noisy ones can pass it, which only validation pixels tell.
       const double renderPsnr = targetFromPreview && useVariance ? RenderPsnrFromPreview(*preview, so) : HUGE_VAL;
-      if (target > renderPsnr - 0.5) {
+      if (target > renderPsnr - kRenderNoiseMarginDb) {
         targetFromPreview = false;
         char line[160];
         std::snprintf(line, sizeof line, "the render's own noise (about %.2f dB against the converged image), which "

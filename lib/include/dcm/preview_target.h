@@ -40,6 +40,10 @@ struct PreviewTargetStats {
 bool CanTargetFromPreview(SampleProvider& preview, const PreviewScheduleOptions& schedule,
                           std::string* why = nullptr);
 
+/// A target must stay this far below RenderPsnrFromPreview() for raw exact
+/// samples to reach it.
+inline constexpr double kRenderNoiseMarginDb = 0.5;
+
 /// The full render's own display-referred PSNR against the converged image,
 /// as the preview tells it: every pixel exact, each with
 /// `schedule.exactVarianceShare` of the preview's noise (+inf at share 0, NaN
