@@ -90,6 +90,14 @@ s.samples = 4
 s.max_rounds = 2
 s.output = os.path.join(work, "kept.exr")
 
+# A target replaces the threshold on the command line (the panel greys the threshold out).
+import dcm_blender.addon as addon_module  # noqa: E402
+s.threshold, s.target_psnr = 0.2, 30.0
+os.makedirs(os.path.join(work, "build-check"), exist_ok=True)
+cmd, _ = addon_module._build(bpy.context, os.path.join(work, "build-check"))
+check(cmd[cmd.index("--target-psnr") + 1] == "30.0" and "--threshold" not in cmd, "a target, no threshold: %s" % cmd)
+s.threshold, s.target_psnr = 0.0, 0.0
+
 # A saved file: rendered as it is.
 check(bpy.ops.render.dcm_render() == {"FINISHED"}, "Render with DCM finishes")
 img = bpy.data.images.get("DCM Result")

@@ -25,6 +25,8 @@ for pair in (["--samples", "64"], ["--preview-samples", "8"], ["--method", "pape
     check(i >= 0 and cmd[i:i + 2] == pair, "flag %s" % pair)
 check("--full" not in cmd and "--method" not in runner.command_line("d", "s", "o"), "defaults add no flags")
 check("--samples" not in runner.command_line("d", "s", "o"), "samples 0: the scene's")
+t = runner.command_line("d", "s", "o", target_psnr=40)
+check(t[t.index("--target-psnr") + 1] == "40.0" and "--threshold" not in t, "a target instead of a threshold: %s" % t)
 check("--preview-correction" not in runner.command_line("d", "s", "o") and
       runner.command_line("d", "s", "o", preview_correction=False)[-2:] == ["--preview-correction", "0"],
       "the preview correction: dcm's default, or off")

@@ -47,6 +47,10 @@ class DCMSettings(bpy.types.PropertyGroup):
     threshold: FloatProperty(name="Threshold", default=0.0, min=0.0, max=1.0, precision=3,
                              description="Contrast threshold (0: the method's default); lower: more exact pixels, "
                                          "closer to the full render")
+    target_psnr: FloatProperty(name="Target PSNR", default=0.0, min=0.0, max=99.0, precision=1, unit="NONE",
+                               description="Reach this PSNR (dB) against the converged image instead of a "
+                                           "threshold (0: off; judged by the preview where it can tell, "
+                                           "docs/QUALITY.md)")
     samples: IntProperty(name="Samples", description="Cycles samples of the exact pixels (0: the scene's)",
                          default=0, min=0, max=1 << 20)
     preview_samples: IntProperty(name="Preview Samples", default=0, min=0, max=1 << 20,
@@ -107,7 +111,8 @@ def _build(context, workdir):
         stats=os.path.join(workdir, "stats.json"),
         sample_map=os.path.join(workdir, "sample_map.png") if s.sample_map else None,
         samples=s.samples, preview_samples=s.preview_samples, method=s.method, full=s.full,
-        threshold=s.threshold if s.threshold > 0 and not s.full else None,
+        threshold=s.threshold if s.threshold > 0 and s.target_psnr <= 0 and not s.full else None,
+        target_psnr=s.target_psnr if s.target_psnr > 0 and not s.full else None,
         schedule=s.schedule, max_rounds=s.max_rounds, preview_correction=s.preview_correction,
         view_layer=context.view_layer.name, frame=context.scene.frame_current, extra=s.extra)
     return cmd, out
@@ -141,6 +146,10 @@ def _finish(operator, context, run, out, workdir):
         wall = st.get("blender", {}).get("wall_s")
         summary = "DCM: %.1f %% of the pixels rendered%s" % (
             100.0 * st["exact_fraction"], " in %.1f s" % wall if wall is not None else "")
+        if st.get("estimated_psnr") is not None:
+            summary += ", estimated PSNR %.1f dB" % st["estimated_psnr"]
+        if st.get("quality", {}).get("target_reached") is False:
+            summary += " (target not reached)"
     except (OSError, ValueError, KeyError):
         pass
     operator.report({"INFO"}, summary)
@@ -241,7 +250,10 @@ class RENDER_PT_dcm(bpy.types.Panel):
         layout = self.layout
         layout.use_property_split = True
         layout.prop(s, "method")
-        layout.prop(s, "threshold")
+        layout.prop(s, "target_psnr")
+        row = layout.row()
+        row.active = s.target_psnr <= 0  # a target chooses the threshold
+        row.prop(s, "threshold")
         layout.prop(s, "samples")
         layout.prop(s, "preview_samples")
         layout.prop(s, "full")

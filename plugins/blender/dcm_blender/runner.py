@@ -13,7 +13,7 @@ _PROGRESS = re.compile(r"^(?P<stage>.*?)\s+(?P<percent>\d{1,3})% \((?P<seconds>[
 
 
 def command_line(dcm, scene_file, output, *, blender=None, stats=None, samples=0, preview_samples=0,
-                 method="dcm", full=False, threshold=None, schedule="auto", max_rounds=3,
+                 method="dcm", full=False, threshold=None, target_psnr=None, schedule="auto", max_rounds=3,
                  preview_correction=True, view_layer=None, frame=None, sample_map=None, extra=""):
     """The `dcm blender` command for one render of `scene_file` into `output`."""
     cmd = [dcm, "blender", scene_file, "-o", output]
@@ -33,6 +33,8 @@ def command_line(dcm, scene_file, output, *, blender=None, stats=None, samples=0
         cmd += ["--full"]
     if threshold is not None:
         cmd += ["--threshold", repr(float(threshold))]
+    if target_psnr is not None:
+        cmd += ["--target-psnr", repr(float(target_psnr))]
     cmd += ["--schedule", schedule, "--max-rounds", str(int(max_rounds))]
     if not preview_correction:
         cmd += ["--preview-correction", "0"]
