@@ -601,19 +601,21 @@ DCM_API DCMError dcmExecute(DCMReconstructor r) {
       const bool fromPreview = r->targetPsnr > 0 && !(r->budget > 0) && !r->noisySample &&
                                !r->previewVariance.empty() &&
                                dcm::ChooseSchedule(r->roundCost) == dcm::RoundSchedule::kPreview;
-      dcm::ImagePreviewProvider preview(r->width, r->height, r->previewWidth, r->previewHeight, r->previewL,
-                                        r->previewLi, r->previewLc, r->previewVariance);
-      dcm::PreviewScheduleOptions schedule;
-      schedule.maxRounds = r->maxRounds;
-      if (fromPreview && dcm::CanTargetFromPreview(preview, schedule)) {
-        dcm::PreviewTargetStats ladder;
-        st = dcm::ReconstructToTargetFromPreview(provider, preview, options, r->targetPsnr, schedule, &r->result,
-                                                 &report, &ladder);
-        r->schedule = std::move(ladder.last);
-        r->schedule.rounds = ladder.rounds;
-      } else {
-        st = dcm::ReconstructToQuality(provider, options, goal, &r->result, &report);
+      bool judged = false;
+      if (fromPreview) {
+        dcm::ImagePreviewProvider preview(r->width, r->height, r->previewWidth, r->previewHeight, r->previewL,
+                                          r->previewLi, r->previewLc, r->previewVariance);
+        dcm::PreviewScheduleOptions schedule;
+        schedule.maxRounds = r->maxRounds;
+        if ((judged = dcm::CanTargetFromPreview(preview, schedule))) {
+          dcm::PreviewTargetStats ladder;
+          st = dcm::ReconstructToTargetFromPreview(provider, preview, options, r->targetPsnr, schedule, &r->result,
+                                                   &report, &ladder);
+          r->schedule = std::move(ladder.last);
+          r->schedule.rounds = ladder.rounds;
+        }
       }
+      if (!judged) st = dcm::ReconstructToQuality(provider, options, goal, &r->result, &report);
       if (st.ok()) r->quality = std::move(report);
     } else if (!r->previewL.empty() && dcm::ChooseSchedule(r->roundCost) == dcm::RoundSchedule::kPreview) {
       dcm::ImagePreviewProvider preview(r->width, r->height, r->previewWidth, r->previewHeight, r->previewL,

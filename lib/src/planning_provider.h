@@ -121,6 +121,12 @@ class PlanningProvider : public SampleProvider {
   std::vector<size_t> missing_;
 };
 
+/// The schedule's options in range, and a preview of the image's size that
+/// splits the radiance where the provider does (ReconstructWithPreview's
+/// preconditions); the message names what is wrong.
+Status CheckPreviewSchedule(SampleProvider& exact, SampleProvider& preview, const ReconstructionOptions& options,
+                            const PreviewScheduleOptions& schedule);
+
 /// Runs the engine on `planning` and evaluates what it asks for that is not
 /// known, one call per round, until nothing is asked, `schedule.maxRounds`
 /// calls were made, or a round would evaluate fewer than

@@ -53,20 +53,14 @@ Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& pre
                                       QualityReport* report, PreviewTargetStats* stats) {
   if (!(targetPsnr > 0 && targetPsnr <= 99))
     return Status::Error("--target-psnr: " + std::to_string(targetPsnr) + " dB is outside (0, 99]");
-  if (schedule.maxRounds < 1)
-    return Status::Error("preview schedule: maxRounds must be at least 1 (is " + std::to_string(schedule.maxRounds) +
-                         ")");
+  DCM_RETURN_IF_ERROR(CheckPreviewSchedule(exact, preview, options, schedule));
   if (schedule.correctionRadius < 1)
     return Status::Error("target from the preview: the preview correction is off, and it makes the estimate");
   if (options.downsample != 1)
     return Status::Error("target from the preview: the preview estimates at final resolution only (downsample 1)");
   const ProviderCapabilities caps = exact.Capabilities();
-  const ProviderCapabilities previewCaps = preview.Capabilities();
-  if (previewCaps.width != caps.width || previewCaps.height != caps.height)
-    return Status::Error("preview schedule: the preview is " + std::to_string(previewCaps.width) + "x" +
-                         std::to_string(previewCaps.height) + ", the image " + std::to_string(caps.width) + "x" +
-                         std::to_string(caps.height));
-  if (!previewCaps.variance) return Status::Error("target from the preview: the preview carries no variance");
+  if (!preview.Capabilities().variance)
+    return Status::Error("target from the preview: the preview carries no variance");
 
   PreviewTargetStats local;
   PreviewTargetStats& s = stats ? *stats : local;

@@ -48,10 +48,8 @@ RoundSchedule ChooseSchedule(const RoundCost& cost, double latencySamplesThresho
                                                                    : RoundSchedule::kLevels;
 }
 
-Status ReconstructWithPreview(SampleProvider& exact, SampleProvider& preview,
-                              const ReconstructionOptions& options,
-                              const PreviewScheduleOptions& schedule, Reconstruction* out,
-                              PreviewScheduleStats* scheduleStats) {
+Status CheckPreviewSchedule(SampleProvider& exact, SampleProvider& preview, const ReconstructionOptions& options,
+                            const PreviewScheduleOptions& schedule) {
   if (schedule.maxRounds < 1)
     return Status::Error("preview schedule: maxRounds must be at least 1 (is " +
                          std::to_string(schedule.maxRounds) + ")");
@@ -68,6 +66,14 @@ Status ReconstructWithPreview(SampleProvider& exact, SampleProvider& preview,
   if (exactCaps.splitRadiance && exactCaps.texture && options.textureSplit && !previewCaps.splitRadiance)
     return Status::Error("preview schedule: the provider splits the radiance and the preview does not");
 
+  return Status::Ok();
+}
+
+Status ReconstructWithPreview(SampleProvider& exact, SampleProvider& preview,
+                              const ReconstructionOptions& options,
+                              const PreviewScheduleOptions& schedule, Reconstruction* out,
+                              PreviewScheduleStats* scheduleStats) {
+  DCM_RETURN_IF_ERROR(CheckPreviewSchedule(exact, preview, options, schedule));
   PreviewScheduleStats stats;
   try {
     PlanningProvider planning(exact, preview);
