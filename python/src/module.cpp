@@ -10,6 +10,7 @@
 
 #include <chrono>
 #include <climits>
+#include <cstdio>
 #include <exception>
 #include <memory>
 #include <optional>
@@ -19,7 +20,9 @@
 
 #include "common/stats_json.h"
 #include "dcm/option_names.h"
+#include "dcm/quality_target.h"
 #include "dcm/reconstructor.h"
+#include "engine_flags.h"
 #include "reconstruct_exr.h"
 
 namespace py = pybind11;
@@ -132,6 +135,64 @@ Settings ParseOptions(const py::dict& kwargs) {
   return s;
 }
 
+/// target_psnr and budget (dcm/quality_target.h): a PSNR in (0, 99] dB or
+/// "render", a share of the pixels in (0, 1]; None: not asked.
+struct Goal {
+  std::optional<double> targetPsnr, budget;  ///< as cli::EngineFlags (cli::kTargetRender: "render")
+  bool any() const { return targetPsnr || budget; }
+};
+
+/// Reads and checks target_psnr and budget. With either, the threshold is the
+/// goal's to choose: contrast_threshold and full_evaluation raise ValueError,
+/// as --threshold and --full do with the flags.
+Goal ParseGoal(py::handle target, py::handle budget, const py::dict& kwargs) {
+  Goal g;
+  if (!target.is_none()) {
+    if (py::isinstance<py::str>(target)) {
+      if (target.cast<std::string>() != "render")
+        throw py::value_error("target_psnr: a PSNR in dB or \"render\", got '" + target.cast<std::string>() + "'");
+      g.targetPsnr = cli::kTargetRender;
+    } else if (py::isinstance<py::float_>(target) || (py::isinstance<py::int_>(target) && !py::isinstance<py::bool_>(target))) {
+      const double t = target.cast<double>();
+      if (!(t > 0 && t <= 99)) throw py::value_error("target_psnr: must be in (0, 99] dB, got " + std::string(py::str(target)));
+      g.targetPsnr = t;
+    } else {
+      throw py::type_error("target_psnr: expected a float or \"render\", got " + TypeName(target));
+    }
+  }
+  if (!budget.is_none()) {
+    if (py::isinstance<py::bool_>(budget) || !(py::isinstance<py::float_>(budget) || py::isinstance<py::int_>(budget)))
+      throw py::type_error("budget: expected a float, got " + TypeName(budget));
+    const double b = budget.cast<double>();
+    if (!(b > 0 && b <= 1)) throw py::value_error("budget: must be a share of the pixels in (0, 1], got " + std::string(py::str(budget)));
+    g.budget = b;
+  }
+  if (g.any()) {
+    const char* goal = g.targetPsnr ? "target_psnr" : "budget";
+    for (const char* fixed : {"contrast_threshold", "full_evaluation"})
+      if (kwargs.contains(fixed) && !kwargs[fixed].is_none() && py::bool_(kwargs[fixed]))
+        throw py::value_error(std::string(goal) + ": not with " + fixed + " (the goal chooses the threshold)");
+  }
+  return g;
+}
+
+/// The warning of a target not reached, empty when it was (or none was asked).
+std::string GoalWarning(const QualityReport& r, const Goal& g) {
+  if (!g.targetPsnr || r.targetReached) return "";
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "target_psnr %.4g: not reached%s; estimated %.2f dB (lower bound %.2f) at %.2f %% exact pixels",
+                r.targetPsnr, r.budgetBound ? " within the budget" : "", r.estimate.psnr, r.estimate.low,
+                100 * r.exactFraction());
+  return buf;
+}
+
+/// Issues each of `warnings` as a RuntimeWarning.
+void Warn(const nlohmann::json& warnings) {
+  const py::object warnFn = py::module_::import("warnings").attr("warn");
+  for (const auto& w : warnings)
+    warnFn(w.get<std::string>(), py::reinterpret_borrow<py::object>(PyExc_RuntimeWarning), 2);
+}
+
 /// File names from a str or os.PathLike, or an iterable of them.
 std::vector<std::string> StringList(py::handle value, const char* what) {
   if (value.is_none()) return {};
@@ -213,8 +274,10 @@ Result MakeResult(const Reconstruction& r, const nlohmann::json& stats) {
 /// `dcm reconstruct` (ToAovOptions, AovProvider::Open, ReconstructWholeExr).
 Result ReconstructExr(py::object inputs, const std::string& preset, py::object map, py::object texture,
                       const std::string& layer, py::object samples, py::object secondRender, bool estimateVariance,
-                      std::optional<float> highlightLevel, py::object reference, bool warn, py::kwargs kwargs) {
+                      std::optional<float> highlightLevel, py::object reference, py::object targetPsnr,
+                      py::object budget, bool warn, py::kwargs kwargs) {
   const Settings s = ParseOptions(kwargs);
+  const Goal goal = ParseGoal(targetPsnr, budget, kwargs);
   cli::aov_common::AovFlags f;
   f.inputs = StringList(inputs, "inputs");
   if (f.inputs.empty()) throw py::value_error("no input files (EXR AOVs)");
@@ -231,6 +294,8 @@ Result ReconstructExr(py::object inputs, const std::string& preset, py::object m
   cli::EngineFlags engine;
   engine.method = s.method;
   engine.quiet = true;
+  engine.targetPsnr = goal.targetPsnr;
+  engine.budget = goal.budget;
 
   aov::AovOptions aovOptions;
   Status st = cli::aov_common::ToAovOptions(f, !f.samples.empty(), s.options.textureSplit, &aovOptions);
@@ -250,11 +315,9 @@ Result ReconstructExr(py::object inputs, const std::string& preset, py::object m
     if (usage) throw py::value_error(st.message());
     throw Error(st.message());
   }
-  if (warn) {
-    const py::object warnFn = py::module_::import("warnings").attr("warn");
-    for (const auto& w : run.stats["warnings"])
-      warnFn(w.get<std::string>(), py::reinterpret_borrow<py::object>(PyExc_RuntimeWarning), 2);
-  }
+  if (run.quality)
+    if (const std::string w = GoalWarning(*run.quality, goal); !w.empty()) run.stats["warnings"].push_back(w);
+  if (warn) Warn(run.stats["warnings"]);
   return MakeResult(run.result, run.stats);
 }
 
@@ -401,8 +464,14 @@ class PythonProvider final : public SampleProvider {
 
 /// dcm.reconstruct: the engine on a PythonProvider.
 Result ReconstructPython(int width, int height, py::object guides, py::object evaluate, bool split, bool variance,
-                         bool hardShadowsGuided, py::kwargs kwargs) {
+                         bool hardShadowsGuided, py::object targetPsnr, py::object budget, bool warn,
+                         py::kwargs kwargs) {
   Settings s = ParseOptions(kwargs);
+  const Goal g = ParseGoal(targetPsnr, budget, kwargs);
+  QualityGoal goal;
+  if (g.targetPsnr && *g.targetPsnr == cli::kTargetRender) goal.targetRender = true;
+  else if (g.targetPsnr) goal.targetPsnr = *g.targetPsnr;
+  goal.budget = g.budget.value_or(0);
   if (!s.batchSizeSet) s.options.batchSize = INT_MAX;  // one call per round: Python's overhead is per call
   constexpr int kMaxSide = 1 << 17;
   if (width < 1 || height < 1 || width > kMaxSide || height > kMaxSide)
@@ -415,17 +484,25 @@ Result ReconstructPython(int width, int height, py::object guides, py::object ev
     provider.SetGuides(guides.cast<py::dict>());
   }
   Reconstruction r;
+  QualityReport report;
   Status st;
   double wall = 0;
   {
     py::gil_scoped_release release;
     const auto t0 = std::chrono::steady_clock::now();
-    st = Reconstruct(provider, s.options, &r);
+    st = g.any() ? ReconstructToQuality(provider, s.options, goal, &r, &report) : Reconstruct(provider, s.options, &r);
     wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   if (provider.error()) std::rethrow_exception(provider.error());
   Check(st);
-  return MakeResult(r, toolkit::RunToJson(r, s.method, s.options, wall));
+  nlohmann::json stats = toolkit::RunToJson(r, s.method, s.options, wall);
+  stats["warnings"] = toolkit::SampleWarnings(r.stats);
+  if (g.any()) {
+    toolkit::AddQualityJson(report, g.targetPsnr.value_or(0), g.budget.value_or(0), &stats);
+    if (const std::string w = GoalWarning(report, g); !w.empty()) stats["warnings"].push_back(w);
+  }
+  if (warn) Warn(stats["warnings"]);
+  return MakeResult(r, stats);
 }
 
 }  // namespace
@@ -457,7 +534,8 @@ PYBIND11_MODULE(_dcm, m) {
         py::arg("map") = py::none(), py::arg("texture") = py::none(), py::arg("layer") = "",
         py::arg("samples") = py::none(), py::arg("second_render") = py::none(),
         py::arg("estimate_variance") = false, py::arg("highlight_level") = py::none(),
-        py::arg("reference") = py::none(), py::arg("warn") = true,
+        py::arg("reference") = py::none(), py::arg("target_psnr") = py::none(), py::arg("budget") = py::none(),
+        py::arg("warn") = true,
         R"(What `dcm reconstruct` does, in-process: reconstructs the image of EXR AOVs.
 
 inputs: an EXR file name, or a list of them (one multilayer EXR or several of one size).
@@ -466,7 +544,10 @@ map: {"ROLE": "EXPR"} or ["ROLE=EXPR", ...] (--map); texture: {"SHADER": "FILE"}
 ["SHADER=FILE"] or "MAP.json" (--texture); layer (--layer); samples (--samples, the
 sparse round trip); second_render (--second-render); estimate_variance
 (--estimate-variance); highlight_level (--highlight-level); reference (--reference).
-warn: the provider's warnings (also in stats["warnings"]) as RuntimeWarning.
+target_psnr: a PSNR in dB, or "render" (--target-psnr); budget: the largest share of
+exact pixels (--budget); with either, stats["estimated_psnr"] and stats["quality"].
+warn: the provider's warnings and a target not reached (also in stats["warnings"]) as
+RuntimeWarning.
 **options: engine options by their C API names (method="paper", contrast_threshold=0.1,
 elementary_block=8, texture_split=False, ...).
 
@@ -476,7 +557,8 @@ the engine), ValueError (option names and values), TypeError.)");
 
   m.def("reconstruct", &ReconstructPython, py::arg("width"), py::arg("height"), py::kw_only(),
         py::arg("guides") = py::none(), py::arg("evaluate"), py::arg("split") = false,
-        py::arg("variance") = false, py::arg("hard_shadows_guided") = false,
+        py::arg("variance") = false, py::arg("hard_shadows_guided") = false, py::arg("target_psnr") = py::none(),
+        py::arg("budget") = py::none(), py::arg("warn") = true,
         R"(Reconstructs a width x height image whose exact pixels come from a Python function.
 
 guides: {"id": (H, W) ints, "shader": (H, W) ints, "tau": (H, W, 3) floats,
@@ -490,6 +572,12 @@ split: evaluate returns "Li" and "Lc" (L = Li * tau + Lc; "L" may be left out),
 used with a "tau" guide. variance: evaluate returns "var", the variance of its
 estimate of L (a noisy renderer). hard_shadows_guided: every hard shadow shows in
 the guides (DCM_SAMPLE_HARD_SHADOWS_GUIDED).
+target_psnr: refine until the estimated PSNR (display-referred, against the full
+render; with variance=True against the converged image) reaches it, or "render";
+budget: at most this share of exact pixels (validation pixels included); with both,
+whichever binds first. evaluate is then called for each pixel at most once across the
+search; stats["estimated_psnr"] and stats["quality"] report it. A target not reached
+is a RuntimeWarning (warn=False: only in stats["warnings"]).
 **options: engine options by their C API names; batch_size defaults to one call per round.
 
 Returns a Result (.image, .sample_map, .stats).)");

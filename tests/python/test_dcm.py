@@ -11,6 +11,7 @@ import subprocess
 import sys
 import tempfile
 import unittest
+import warnings
 
 import numpy as np
 import OpenImageIO as oiio
@@ -99,6 +100,13 @@ class ReconstructExr(unittest.TestCase):
             dcm.reconstruct_exr(self.aovs, preset="generic", min_block=None)
         self.assertIn("min_block", str(e.exception))
 
+    def test_target_bit_identical_to_the_command(self):
+        image, stats = self.command("target", "--target-psnr", "45")
+        result = dcm.reconstruct_exr(self.aovs, preset="generic", target_psnr=45)
+        self.check_same(result, image, stats)
+        self.assertEqual(result.stats["quality"]["target_psnr"], 45)
+        self.assertIn("estimated_psnr", result.stats)
+
     def test_missing_file_names_it(self):
         missing = os.path.join(self.tmp.name, "no-such-render.exr")
         with self.assertRaises(dcm.Error) as e:
@@ -137,6 +145,25 @@ def two_regions(width, height):
     truth[..., 1] = np.where(left, 0.2 + 0.3 * y / height, 0.6)
     truth[..., 2] = np.where(left, 0.3, 0.2)
     return ids, truth
+
+
+def display_psnr(image, truth):
+    """The stats' PSNR: sRGB of each channel clipped to [0, 1], peak 1 (tools/common/metrics.cpp)."""
+    def srgb(v):
+        v = np.clip(v, 0, 1)
+        return np.where(v <= 0.0031308, 12.92 * v, 1.055 * np.power(v, 1 / 2.4) - 0.055)
+    return 10 * np.log10(1 / np.mean((srgb(image.astype(np.float64)) - srgb(truth.astype(np.float64))) ** 2))
+
+
+def highlights(width, height):
+    """two_regions' edge, shaded, with 40 soft highlights (sigma 4 px) that no guide shows."""
+    y, x = np.mgrid[0:height, 0:width].astype(np.float32)
+    left = x < 0.4 * width + 0.3 * y
+    ids = np.where(left, 1, 2).astype(np.uint32)
+    image = np.where(left, 0.2 + 0.4 * x / width, 0.5)[..., None] * np.array([1, 0.8, 0.6], np.float32)
+    for cx, cy in np.random.default_rng(7).uniform(0, 1, (40, 2)) * [width, height]:
+        image += 0.8 * np.exp(-((x - cx) ** 2 + (y - cy) ** 2) / (2 * 4.0 ** 2))[..., None]
+    return ids, image.astype(np.float32)
 
 
 class PythonProvider(unittest.TestCase):
@@ -206,8 +233,67 @@ class PythonProvider(unittest.TestCase):
         # the bounds of test_two_regions hold (tau <= 0.9 scales Li's error).
         self.check_interpolated(r.image, truth, ids)
 
+    def run_goal(self, ids, truth, **goal):
+        """dcm.reconstruct to a goal; asserts that no pixel is evaluated twice across the search."""
+        height, width = ids.shape
+        seen = []
+
+        def evaluate(xy):
+            seen.append(xy.copy())
+            return truth[xy[:, 1], xy[:, 0]]
+
+        r = dcm.reconstruct(width, height, guides={"id": ids}, evaluate=evaluate, **goal)
+        evaluated = np.concatenate(seen)
+        self.assertEqual(len({(int(x), int(y)) for x, y in evaluated}), len(evaluated))
+        self.assertEqual(len(evaluated), r.stats["exact_pixels"])
+        return r
+
+    def test_target_and_budget(self):
+        ids, truth = highlights(256, 192)
+        plain = self.run_goal(ids, truth)
+        # The default threshold misses most highlights: the target has work to do.
+        self.assertLess(display_psnr(plain.image, truth), 35)
+
+        r = self.run_goal(ids, truth, target_psnr=40)
+        q = r.stats["quality"]
+        self.assertTrue(q["target_reached"])
+        self.assertEqual(q["target_psnr"], 40)
+        self.assertGreaterEqual(r.stats["estimated_psnr_low"], 40)
+        # Issue #22's tolerance for the truth of a reached target: T - 0.5 dB.
+        self.assertGreaterEqual(display_psnr(r.image, truth), 39.5)
+
+        r = self.run_goal(ids, truth, budget=0.03)
+        self.assertLessEqual(r.stats["exact_pixels"], 0.03 * 256 * 192)  # never exceeded, validation included
+        self.assertTrue(r.stats["quality"]["budget_bound"])
+
+        # A target the budget cannot reach: a RuntimeWarning naming it, the best reached returned.
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            r = self.run_goal(ids, truth, target_psnr=60, budget=0.03)
+        self.assertFalse(r.stats["quality"]["target_reached"])
+        self.assertLessEqual(r.stats["exact_pixels"], 0.03 * 256 * 192)
+        self.assertTrue(any("target_psnr 60: not reached" in str(w.message) for w in caught), caught)
+        self.assertTrue(any("target_psnr 60" in w for w in r.stats["warnings"]))
+
     def test_errors(self):
         ids, truth = two_regions(32, 32)
+
+        def exact(xy):
+            return truth[xy[:, 1], xy[:, 0]]
+
+        for goal, error, text in [({"target_psnr": 0}, ValueError, "target_psnr: must be in (0, 99]"),
+                                  ({"target_psnr": 100}, ValueError, "target_psnr: must be in (0, 99]"),
+                                  ({"target_psnr": "best"}, ValueError, "target_psnr"),
+                                  ({"budget": 1.5}, ValueError, "budget: must be a share"),
+                                  ({"budget": "5%"}, TypeError, "budget"),
+                                  ({"target_psnr": 40, "contrast_threshold": 0.1}, ValueError,
+                                   "target_psnr: not with contrast_threshold"),
+                                  ({"budget": 0.1, "full_evaluation": True}, ValueError,
+                                   "budget: not with full_evaluation"),
+                                  ({"target_psnr": "render"}, dcm.Error, "variance")]:
+            with self.assertRaises(error, msg=str(goal)) as e:
+                dcm.reconstruct(32, 32, evaluate=exact, **goal)
+            self.assertIn(text, str(e.exception))
 
         def wrong_shape(xy):
             return np.zeros((len(xy), 4), np.float32)
