@@ -46,11 +46,19 @@ std::vector<double> WindowSums(const std::vector<double>& v, int W, int H, int r
 /// their mean: (A - B)^2 / 4 for equal halves A, B): with A, B, X the
 /// encodings, E[(X - A)(X - B)] = (X - E A)(X - E B) where x does not depend
 /// on their noise, plus k^2 the display variance of p, (A - B)^2 / 4.
+/// Where x moves with the halves' noise (x = L_i tau + L_c with the preview's
+/// own tau), x_A, x_B = x + D, x - D are x made with each half's tau (D = L_i
+/// times the half-difference of tau that goes with +s), and the cross-fit
+/// 1/2 [(X_A - B)^2 + (X_B - A)^2] - (A - B)^2 / 2 - (X_A - X_B)^2 / 4 is
+/// unbiased instead (it is the product above at D = 0); x + k (p - x) adds
+/// 2 k (1 - k) times the covariance of x and p, (X_A - X_B)(A - B) / 4.
 /// Negative values are part of an unbiased sum.
-double DisplayError(float p, double v, float x, double k) {
+double DisplayError(float p, double v, float x, double k, double D = 0) {
   const double s = std::sqrt(std::max(v, 0.0));
-  const double A = SrgbEncode(float(p + s)), B = SrgbEncode(float(p - s)), X = SrgbEncode(x);
-  return (1 - k) * (1 - k) * (X - A) * (X - B) + k * k * (A - B) * (A - B) / 4;
+  const double A = SrgbEncode(float(p + s)), B = SrgbEncode(float(p - s));
+  const double XA = SrgbEncode(float(x + D)), XB = SrgbEncode(float(x - D));
+  const double cross = ((XA - B) * (XA - B) + (XB - A) * (XB - A)) / 2 - (A - B) * (A - B) / 2 - (XA - XB) * (XA - XB) / 4;
+  return (1 - k) * (1 - k) * cross + k * k * (A - B) * (A - B) / 4 + k * (1 - k) * (XA - XB) * (A - B) / 2;
 }
 
 /// The preview's display variance at a pixel (a mean over the channels) of
@@ -86,7 +94,8 @@ double PreviewNoisePsnr(SampleProvider& preview, std::span<const RGB> ownVarianc
 }
 
 Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample, Reconstruction* rec,
-                            PreviewCorrectionStats* stats, std::span<const RGB> ownVariance, double exactShare) {
+                            PreviewCorrectionStats* stats, std::span<const RGB> ownVariance, double exactShare,
+                            std::span<const RGB> textureCovariance) {
   if (radius < 0) return Status::Error("preview correction: radius " + std::to_string(radius) + " is negative");
   if (downsample < 1)
     return Status::Error("preview correction: downsample " + std::to_string(downsample) + " is below 1");
@@ -106,12 +115,18 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample,
   if (!ownVariance.empty() && ownVariance.size() != n)
     return Status::Error("preview correction: " + std::to_string(ownVariance.size()) +
                          " own variances for " + std::to_string(n) + " working pixels");
+  if (!textureCovariance.empty() && textureCovariance.size() != n)
+    return Status::Error("preview correction: " + std::to_string(textureCovariance.size()) +
+                         " texture covariances for " + std::to_string(n) + " working pixels");
+  // D = L_i dtau needs the preview's L_i (the interpolation's own is not kept;
+  // the preview's is as good an estimate of it for D, a small term).
+  const bool shared = !textureCovariance.empty() && caps.splitRadiance;
   try {
     std::vector<Point2i> all(n);
     for (int y = 0; y < H; ++y)
       for (int x = 0; x < W; ++x) all[size_t(y) * size_t(W) + size_t(x)] = {x, y};
     std::vector<ExactSample> p(n);
-    if (Status s = preview.Evaluate(all, SampleRequest{false, true}, p); !s.ok())
+    if (Status s = preview.Evaluate(all, SampleRequest{shared, true}, p); !s.ok())
       return Status::Error("preview correction: " + s.message());
 
     std::vector<uint8_t> usable(n);
@@ -151,7 +166,14 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample,
           const double bias2 = se[i] / m;
           const double sdE = std::sqrt(std::max(se2[i] / m - bias2 * bias2, 0.0));
           const double k = bias2 > 0 && bias2 > kSignificance * sdE / std::sqrt(m) ? bias2 / (bias2 + meanV) : 0.0;
-          if (!error.empty()) error[i] += DisplayError(p[i].L[c], own(i, c), rec->workImage[i][c], k);
+          if (!error.empty()) {
+            // The half-difference of tau that goes with +s: cov(tau, L) / s.
+            const double s = std::sqrt(std::max(own(i, c), 0.0));
+            const double D = shared && s > 0 && std::isfinite(p[i].Li[c]) && std::isfinite(textureCovariance[i][c])
+                                 ? double(p[i].Li[c]) * double(textureCovariance[i][c]) / s
+                                 : 0.0;
+            error[i] += DisplayError(p[i].L[c], own(i, c), rec->workImage[i][c], k, D);
+          }
           if (k <= 0) continue;
           corrected[i][c] = float(double(rec->workImage[i][c]) + k * (double(p[i].L[c]) - double(rec->workImage[i][c])));
           moved[i] = 1;

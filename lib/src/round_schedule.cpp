@@ -140,7 +140,10 @@ Status FinishPreviewRun(PlanningProvider& planning, SampleProvider& preview, con
     const auto start = std::chrono::steady_clock::now();
     DCM_RETURN_IF_ERROR(CorrectTowardPreview(preview, schedule.correctionRadius, options.downsample, out,
                                              &stats->correction, schedule.previewOwnVariance,
-                                             schedule.exactVarianceShare));
+                                             schedule.exactVarianceShare,
+                                             out->stats.settings.split ? std::span<const RGB>(
+                                                                             schedule.previewTextureCovariance)
+                                                                       : std::span<const RGB>()));
     stats->timeEngineS += Seconds(start);
   }
   if (rendered > 0) {

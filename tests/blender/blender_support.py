@@ -75,11 +75,13 @@ class Child:
         rec = self._read("<f4", 9 * len(xs)).reshape(-1, 9)
         return rec[:, 0:3], rec[:, 3:6], rec[:, 6:9]
 
-    def preview(self, x0, y0, x1, y1):
-        line = self._ask(b"preview %d %d %d %d L\n" % (x0, y0, x1, y1))
+    def preview(self, x0, y0, x1, y1, what="L"):
+        """The preview's records [n, 3 * parts] (L; split: L_i, L_c; variance; texcov)."""
+        line = self._ask(b"preview %d %d %d %d %s\n" % (x0, y0, x1, y1, what.encode()))
         n = (x1 - x0) * (y1 - y0)
         assert line.split() == ["samples", str(n)], line
-        return self._read("<f4", 3 * n).reshape(n, 3)
+        parts = 1 + 2 * ("split" in what) + ("variance" in what) + ("texcov" in what)
+        return self._read("<f4", 3 * parts * n).reshape(n, 3 * parts)
 
     def quit(self):
         self.p.stdin.write(b"quit\n")

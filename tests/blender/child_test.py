@@ -82,6 +82,24 @@ def main():
         assert child.quit() == 0, "the child did not exit cleanly (or the scene was not restored)"
         assert hashlib.sha256(open(blend, "rb").read()).hexdigest() == digest, "the .blend changed"
 
+        # With halves the texture guide is the mean of the two guide renders' DiffCol, and the
+        # preview carries its covariance with L, (tau_A - tau_B)(L_A - L_B) nA nB / N^2, as the
+        # variance (L_A - L_B)^2 nA nB / N^2 (16 samples: 8 + 8).
+        keep_h = os.path.join(tmp, "renders_halves")
+        child = bs.Child(blender, src, blend, ["--variance-halves", "--keep-renders", keep_h])
+        assert "texture_covariance" in child.caps and "variance" in child.caps, child.caps
+        tau = child.guides()[2].reshape(-1, 3)
+        rec = child.preview(0, 0, w, h, "L,split,variance,texcov")
+        assert child.quit() == 0
+        halves = [np.load(f) for f in sorted(glob.glob(os.path.join(keep_h, "*_guides.npz")))]
+        assert len(halves) == 2, os.listdir(keep_h)
+        rgb = lambda d, name: np.stack([d[name + "." + c] for c in "RGB"], -1).reshape(-1, 3)
+        (ta, tb), (la, lb) = ([rgb(d, name) for d in halves] for name in ("DiffCol", "Combined"))
+        assert np.allclose(tau, (ta + tb) / 2, atol=1e-6)
+        assert np.allclose(rec[:, 9:12], (la - lb) ** 2 / 4, rtol=1e-5, atol=1e-9)
+        assert np.allclose(rec[:, 12:15], (ta - tb) * (la - lb) / 4, rtol=1e-5, atol=1e-9)
+        assert (rec[:, 12:15] != 0).any(), "no pixel where the halves' tau and L co-vary: a flat scene"
+
         # A masked pixel stops after a few samples (adaptive sampling on its
         # all-zero samples); a requested pixel takes every sample. At 64 spp:
         # Cycles judges convergence every 16 samples.

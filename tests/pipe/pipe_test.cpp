@@ -217,6 +217,45 @@ TEST(PipeProvider, PreviewPlannedRoundsAreOneEvalEach) {
   EXPECT_TRUE(p->Finish().ok());
 }
 
+TEST(PipeProvider, APreviewCarriesTheCovarianceOfItsTextureGuideWhereAnnounced) {
+  // A child whose preview records end with `texcov` when asked (capability
+  // texture_covariance): pixel k has L = k, L_i = 1, L_c = 0, variance 0.5 and
+  // texcov 0.25 k in every channel.
+  const std::string child = std::string(DCM_PYTHON3) + R"( -c "
+import struct, sys
+print('dcm-pipe 1 width=2 height=1 caps=texture,split,variance,preview,texture_covariance', flush=True)
+for line in sys.stdin:
+    t = line.split()
+    if t and t[0] == 'preview':
+        what = t[5].split(',')
+        out = sys.stdout.buffer
+        out.write(b'samples 2\n')
+        for k in range(2):
+            rec = [k] * 3 + [1] * 3 + [0] * 3 + [0.5] * 3 + ([0.25 * k] * 3 if 'texcov' in what else [])
+            out.write(struct.pack('<%df' % len(rec), *rec))
+        out.flush()
+    elif t and t[0] == 'quit':
+        break
+")";
+  std::unique_ptr<dcm::pipe::PipeProvider> p;
+  ASSERT_TRUE(Start(child, &p).ok());
+  std::unique_ptr<dcm::SampleProvider> preview;
+  std::vector<dcm::RGB> own, cov;
+  ASSERT_TRUE(p->FetchPreview({true, true}, &preview, 0, &own, &cov).ok());
+  ASSERT_EQ(cov.size(), 2u);
+  EXPECT_EQ(cov[1].g, 0.25f);
+  EXPECT_EQ(own[1].b, 0.5f);
+  std::vector<dcm::ExactSample> s(1);
+  const dcm::Point2i one{1, 0};
+  ASSERT_TRUE(preview->Evaluate({&one, 1}, {true, true}, s).ok());
+  EXPECT_EQ(s[0].L.r, 1.f);
+  EXPECT_EQ(s[0].Li.r, 1.f);
+  // Without the split (no texture guide to share) it is not asked for.
+  ASSERT_TRUE(p->FetchPreview({false, true}, &preview, 0, &own, &cov).ok());
+  EXPECT_TRUE(cov.empty());
+  EXPECT_TRUE(p->Finish().ok());
+}
+
 /// Starts `command` and drives it through guides and one batch; returns the
 /// first error.
 dcm::Status Drive(const std::string& command, double timeout = 60) {

@@ -378,7 +378,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     const bool previewVariance = useVariance || (f.rounds.previewCorrection > 0 && provider->Capabilities().variance);
     PreviewScheduleOptions so;
     st = provider->FetchPreview({options.textureSplit && caps.splitRadiance, previewVariance}, &preview, poolRadius,
-                                &so.previewOwnVariance);
+                                &so.previewOwnVariance, &so.previewTextureCovariance);
     previewS = Since(tp);
     // An exact pixel's noise, against the converged image: the preview's at its samples.
     const double samples = keys.count("samples") ? std::atof(keys.at("samples").c_str()) : 0.0;

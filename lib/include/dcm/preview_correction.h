@@ -67,8 +67,13 @@ double PreviewNoisePsnr(SampleProvider& preview, std::span<const RGB> ownVarianc
 /// of the preview, from two halves of its samples, for the estimate; empty:
 /// the preview's. `exactShare`: the exact samples' variance as a share of the
 /// preview's (PreviewScheduleOptions::exactVarianceShare).
+/// `textureCovariance` (empty, or one per working pixel): where `rec` used the
+/// texture split with the preview's own texture guide, each channel's
+/// covariance of the preview's estimates of tau and of L
+/// (PreviewScheduleOptions::previewTextureCovariance); the estimate takes
+/// out what the interpolation shares with the preview's noise through tau.
 Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample, Reconstruction* rec,
                             PreviewCorrectionStats* stats = nullptr, std::span<const RGB> ownVariance = {},
-                            double exactShare = 0);
+                            double exactShare = 0, std::span<const RGB> textureCovariance = {});
 
 }  // namespace dcm

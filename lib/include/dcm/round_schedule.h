@@ -67,6 +67,13 @@ struct PreviewScheduleOptions {
   /// samples over the exact ones'), for the estimate: an exact pixel's error
   /// against the converged image. 0: exact samples count as noise-free.
   double exactVarianceShare = 0;
+  /// Where the texture guide comes from the preview's own samples (Blender's
+  /// DiffCol of the same renders), the covariance of the preview's estimates
+  /// of tau and of L per working pixel and channel, from its two halves: an
+  /// interpolated pixel L_i tau + L_c shares the preview's noise through tau,
+  /// and the estimate takes that out (CorrectTowardPreview). Empty: the
+  /// texture guide is independent of the preview's noise.
+  std::vector<RGB> previewTextureCovariance;
 };
 
 /// What a preview-planned reconstruction did.

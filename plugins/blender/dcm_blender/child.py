@@ -79,7 +79,7 @@ class Protocol:
         self.out.flush()
 
 
-def _records(what, L, Li, Lc, var=None):
+def _records(what, L, Li, Lc, var=None, texcov=None):
     parts = [L]
     if "split" in what:
         parts += [Li, Lc]
@@ -87,6 +87,10 @@ def _records(what, L, Li, Lc, var=None):
         if var is None:
             raise ValueError("eval: variance asked for, and not announced")
         parts.append(var)
+    if "texcov" in what:
+        if texcov is None:
+            raise ValueError("texcov asked for, and not announced")
+        parts.append(texcov)
     return np.concatenate(parts, axis=1).astype("<f4").tobytes()
 
 
@@ -122,7 +126,7 @@ def serve(proto, session):
             n = (x1 - x0) * (y1 - y0)
             # A preview of one sample has no halves: its variance unknown (NaN, which dcm takes as none).
             flat = [g[k][sl].reshape(n, 3) if k in g else np.full((n, 3), np.nan, np.float32)
-                    for k in ("L", "Li", "Lc", "var")]
+                    for k in ("L", "Li", "Lc", "var", "texcov")]
             proto.send("samples %d" % n, _records(t[5].split(","), *flat))
         else:
             raise ValueError("unknown request '%s'" % line[:60])
@@ -160,7 +164,7 @@ def main(argv):
         # view_layer (percent-encoded: names have spaces) and guides_seconds are for `dcm blender`.
         proto.send("dcm-pipe 1 width=%d height=%d caps=%s name=blender-cycles round_latency=%.4g sample_cost=%.4g "
                    "view_layer=%s guides_seconds=%.3f samples=%d preview_samples=%d seeds=%s%s"
-                   % (session.width, session.height, CAPS + (",variance" if session.halves else ""), latency, per_sample,
+                   % (session.width, session.height, CAPS + (",variance,texture_covariance" if session.halves else ""), latency, per_sample,
                       urllib.parse.quote(session.layer.name, safe=""), session.render_seconds[0][1],
                       session.samples, session.preview_samples,
                       ",".join(str(s) for s in session.seeds),

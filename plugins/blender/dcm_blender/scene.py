@@ -428,6 +428,10 @@ class Session:
                 # g["var"]: the preview's own, which dcm weighs while it plans on the preview.
                 a, b = self._rgb(pls[0], "Combined"), self._rgb(pls[1], "Combined")
                 g["var"] = ((a - b) ** 2 * (counts[0] * counts[1] / float(ps) ** 2)).astype(np.float32)
+                # The texture guide is these renders' DiffCol: the covariance of its
+                # estimate and the preview's, which dcm's estimate of its error takes out.
+                ta, tb = self._rgb(pls[0], "DiffCol"), self._rgb(pls[1], "DiffCol")
+                g["texcov"] = ((ta - tb) * (a - b) * (counts[0] * counts[1] / float(ps) ** 2)).astype(np.float32)
                 self.noise_psnr = _noise_psnr(g["var"] * (ps / float(self.samples)), g["L"])
             self._guides = g
         return self._guides

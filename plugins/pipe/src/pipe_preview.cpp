@@ -12,9 +12,10 @@
 namespace dcm::pipe {
 
 Status PipeProvider::FetchPreview(const SampleRequest& what, std::unique_ptr<SampleProvider>* out,
-                                  int varianceRadius, std::vector<RGB>* ownVariance) {
+                                  int varianceRadius, std::vector<RGB>* ownVariance,
+                                  std::vector<RGB>* textureCovariance) {
   std::vector<ExactSample> s;
-  DCM_RETURN_IF_ERROR(Preview(Bounds2i{{0, 0}, {caps_.width, caps_.height}}, what, &s));
+  DCM_RETURN_IF_ERROR(Preview(Bounds2i{{0, 0}, {caps_.width, caps_.height}}, what, &s, textureCovariance));
   const bool split = what.split && caps_.splitRadiance;
   const bool variance = what.variance && caps_.variance;
   std::vector<RGB> L(s.size()), Li, Lc, var;

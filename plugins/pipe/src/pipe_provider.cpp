@@ -217,6 +217,7 @@ Status PipeProvider::Handshake() {
         else if (c == "variance") caps_.variance = true;
         else if (c == "hard_shadows_guided") caps_.hardShadowsGuided = true;
         else if (c == "preview") preview_ = true;
+        else if (c == "texture_covariance") textureCovariance_ = true;
         // Unknown capabilities are ignored (newer providers).
       }
     } else if (key == "name") {
@@ -335,7 +336,7 @@ Status PipeProvider::Evaluate(std::span<const Point2i> pixels, const SampleReque
 }
 
 Status PipeProvider::ReadSamples(const std::string& request, const std::vector<char>& message, size_t n, bool split,
-                                 bool variance, ExactSample* out) {
+                                 bool variance, ExactSample* out, RGB* textureCovariance) {
   const auto deadline =
       Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.timeoutSeconds));
   Status written = child_->Write(message.data(), message.size(), deadline);
@@ -350,7 +351,7 @@ Status PipeProvider::ReadSamples(const std::string& request, const std::vector<c
     return Fail("answered 'samples " + std::to_string(count) + "' to '" + request + "', which asks for " +
                 std::to_string(n) + " pixels");
   }
-  const size_t perPixel = 3 + (split ? 6 : 0) + (variance ? 3 : 0);
+  const size_t perPixel = 3 + (split ? 6 : 0) + (variance ? 3 : 0) + (textureCovariance ? 3 : 0);
   std::vector<float> f(n * perPixel);
   if (!ReadPayload(*child_, f.data(), f.size() * 4, request, options_.timeoutSeconds, &failure).ok())
     return Fail(failure);
@@ -365,11 +366,16 @@ Status PipeProvider::ReadSamples(const std::string& request, const std::vector<c
       const float* v = p + (split ? 9 : 3);
       out[i].variance = {v[0], v[1], v[2]};
     }
+    if (textureCovariance) {
+      const float* c = p + perPixel - 3;
+      textureCovariance[i] = {c[0], c[1], c[2]};
+    }
   }
   return Status::Ok();
 }
 
-Status PipeProvider::Preview(const Bounds2i& region, const SampleRequest& what, std::vector<ExactSample>* out) {
+Status PipeProvider::Preview(const Bounds2i& region, const SampleRequest& what, std::vector<ExactSample>* out,
+                             std::vector<RGB>* textureCovariance) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!broken_.ok()) return broken_;
   if (finished_) return Status::Error(Prefix() + ": preview requested after Finish()");
@@ -379,13 +385,16 @@ Status PipeProvider::Preview(const Bounds2i& region, const SampleRequest& what, 
     return Status::Error(Prefix() + ": preview region outside the image");
   const bool split = what.split && caps_.splitRadiance;
   const bool variance = what.variance && caps_.variance;
+  const bool texcov = textureCovariance && split && textureCovariance_;
   const std::string request = "preview " + std::to_string(region.min.x) + " " + std::to_string(region.min.y) + " " +
                               std::to_string(region.max.x) + " " + std::to_string(region.max.y) + " L" +
-                              (split ? ",split" : "") + (variance ? ",variance" : "");
+                              (split ? ",split" : "") + (variance ? ",variance" : "") + (texcov ? ",texcov" : "");
   const std::string line = request + "\n";
   const size_t n = size_t(region.area());
   out->assign(n, ExactSample{});
-  return ReadSamples(request, std::vector<char>(line.begin(), line.end()), n, split, variance, out->data());
+  if (textureCovariance) textureCovariance->assign(texcov ? n : 0, RGB{});
+  return ReadSamples(request, std::vector<char>(line.begin(), line.end()), n, split, variance, out->data(),
+                     texcov ? textureCovariance->data() : nullptr);
 }
 
 Status PipeProvider::Finish() {

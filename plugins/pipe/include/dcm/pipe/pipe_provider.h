@@ -78,7 +78,11 @@ class PipeProvider final : public SampleProvider {
   /// Asks the child for the preview samples of every pixel of `region`
   /// ("preview" request), row-major, with the preview's variance where
   /// `what.variance` and the child announced `variance`. Only when hasPreview().
-  Status Preview(const Bounds2i& region, const SampleRequest& what, std::vector<ExactSample>* out);
+  /// `textureCovariance`, when given and the child announced
+  /// `texture_covariance`: each pixel's covariance of the preview's estimates
+  /// of the texture guide and of L (empty otherwise).
+  Status Preview(const Bounds2i& region, const SampleRequest& what, std::vector<ExactSample>* out,
+                 std::vector<RGB>* textureCovariance = nullptr);
 
   /// The child's preview of the whole image, fetched in one request, as a
   /// provider of stand-in samples for ReconstructWithPreview(); with
@@ -86,8 +90,10 @@ class PipeProvider final : public SampleProvider {
   /// same surface (object and shader IDs) within `varianceRadius` pixels
   /// (dcm::SurfaceWindowMean; 0: each pixel's own). `ownVariance`, when
   /// given: each pixel's own variance before the pooling (empty without).
+  /// `textureCovariance`, when given: as Preview() with `what.split`
+  /// (PreviewScheduleOptions::previewTextureCovariance).
   Status FetchPreview(const SampleRequest& what, std::unique_ptr<SampleProvider>* out, int varianceRadius = 0,
-                      std::vector<RGB>* ownVariance = nullptr);
+                      std::vector<RGB>* ownVariance = nullptr, std::vector<RGB>* textureCovariance = nullptr);
 
   /// Sends "quit", closes the child's stdin and waits for it to exit. An exit
   /// status other than 0 (or a signal) is an error. Idempotent: returns the
@@ -115,14 +121,16 @@ class PipeProvider final : public SampleProvider {
   PipeOptions options_;
   std::unique_ptr<ChildProcess> child_;
   /// Sends `request` with `payload`, reads the answer 'samples N' and its
-  /// records of the parts of `split`/`variance` into `out` (n of them).
+  /// records of the parts of `split`/`variance` into `out` (n of them), and
+  /// with `textureCovariance` the part `texcov` into it.
   Status ReadSamples(const std::string& request, const std::vector<char>& message, size_t n, bool split,
-                     bool variance, ExactSample* out);
+                     bool variance, ExactSample* out, RGB* textureCovariance = nullptr);
 
   ProviderCapabilities caps_;
   RoundCost cost_;
   std::map<std::string, std::string> keys_;
   bool preview_ = false;
+  bool textureCovariance_ = false;  ///< capability `texture_covariance`
   int64_t evalRequests_ = 0;
   int childVersion_ = 0;
   std::mutex mutex_;
