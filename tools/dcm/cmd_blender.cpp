@@ -58,6 +58,11 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
+/// The goal without --threshold, --target-psnr or --budget: 40 dB of
+/// display-referred PSNR against the converged image (the bar of the speed-ups
+/// in docs/BLENDER.md), where the preview can judge it (docs/QUALITY.md).
+constexpr double kDefaultTargetPsnr = 40;
+
 struct BlenderFlags {
   std::string scene, output, stats, sampleMap;
   std::string blender = "blender";
@@ -75,6 +80,9 @@ struct BlenderFlags {
   std::string estimateFrom = "auto";
   PipeFlags pipe;  ///< --provider-timeout, --provider-startup-timeout; engine; EXR format
 };
+
+/// "40": the default goal as a flag value.
+std::string DefaultTarget() { return std::to_string(int(kDefaultTargetPsnr)); }
 
 /// Undoes the child's percent-encoding of a handshake value.
 std::string PercentDecoded(const std::string& s) {
@@ -361,6 +369,10 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   // --target-psnr / --budget: the quality search, each run planned on the preview.
   QualityGoal goal;
   const bool haveGoal = QualityGoalOf(f.pipe.engine, &goal);
+  // Without a goal or a threshold, dcm's own method aims at kDefaultTargetPsnr
+  // where the preview can judge it; the published methods keep their threshold.
+  const bool defaultGoal = !haveGoal && !f.pipe.engine.threshold && !options.fullEvaluation &&
+                           f.pipe.engine.method == "dcm" && f.estimateFrom != "validation";
   std::optional<QualityReport> quality;
   QualityRoundStats qrounds;
   PreviewTargetStats ptarget;
@@ -388,7 +400,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     so.correctionRadius = f.rounds.previewCorrection;
     so.minRoundShare = f.rounds.minRoundShare;
     // A target alone is judged by the preview's estimate where the preview can tell.
-    const double target = f.pipe.engine.targetPsnr.value_or(0);
+    const double target = f.pipe.engine.targetPsnr.value_or(defaultGoal ? kDefaultTargetPsnr : 0);
     if (st.ok() && target > 0 && !f.pipe.engine.budget && f.estimateFrom != "validation") {
       std::string why;
       if (so.correctionRadius < 1) why = "--preview-correction 0: the correction makes the estimate";
@@ -406,7 +418,14 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       }
       if (!targetFromPreview && f.estimateFrom == "preview")
         return Fail("--estimate-from preview: " + why, kExitUsage);
-      if (f.pipe.engine.verbose)
+      if (f.pipe.engine.verbose && defaultGoal)
+        std::cerr << "blender: "
+                  << (targetFromPreview ? "the default goal, --target-psnr " + DefaultTarget() +
+                                              " judged by the preview's estimate"
+                                        : "the default threshold: the preview cannot judge the default goal "
+                                          "(--target-psnr " + DefaultTarget() + "): " + why)
+                  << "\n";
+      else if (f.pipe.engine.verbose)
         std::cerr << "blender: --target-psnr judged by "
                   << (targetFromPreview ? std::string("the preview's estimate") : "validation pixels: " + why) << "\n";
     }
@@ -417,7 +436,12 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       goalS = Since(tq);
       if (st.ok()) quality = std::move(report);
       sched = ptarget.last;
-      if (st.ok() && ptarget.beyondRender)
+      if (st.ok() && ptarget.beyondRender && defaultGoal && f.pipe.engine.verbose)
+        std::cerr << "blender: the default threshold: the render itself is about " << std::fixed
+                  << std::setprecision(2) << ptarget.renderPsnr << std::defaultfloat
+                  << " dB from the converged image, too close to the default goal (--target-psnr " << DefaultTarget()
+                  << ") to search for it\n";
+      else if (st.ok() && ptarget.beyondRender && !defaultGoal)
         std::cerr << "dcm " << cmd << ": warning: --target-psnr " << target << ": beyond what these samples give: the "
                   << "render itself is about " << std::fixed << std::setprecision(2) << ptarget.renderPsnr
                   << std::defaultfloat << " dB from the converged image (from the preview); reconstructed at the "
@@ -454,6 +478,9 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
                          : quality                            ? goalS - qrounds.timeExactS
                                                               : sched.timeEngineS;
   const std::string method = options.fullEvaluation ? "full" : f.pipe.engine.method;
+  // The reports name the goal the run had, the default's too.
+  EngineFlags engine = f.pipe.engine;
+  if (defaultGoal && targetFromPreview) engine.targetPsnr = kDefaultTargetPsnr;
 
   // Blender's own layout: <view layer>.Combined.R/G/B/A.
   toolkit::OutputImage image;
@@ -530,7 +557,8 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       j["estimated_psnr_from"] = "preview";
     }
     if (quality) {
-      toolkit::AddQualityJson(*quality, f.pipe.engine.targetPsnr.value_or(0), f.pipe.engine.budget.value_or(0), &j);
+      toolkit::AddQualityJson(*quality, engine.targetPsnr.value_or(0), engine.budget.value_or(0), &j);
+      j["quality"]["target_default"] = defaultGoal && targetFromPreview;
       if (targetFromPreview) {
         nlohmann::json ladder = nlohmann::json::array();
         for (size_t k = 0; k < ptarget.thresholds.size(); ++k)
@@ -567,10 +595,11 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
                 "%.2f; the preview's own %.2f dB)\n",
                 fromPreview.psnr, fromPreview.low, fromPreview.high, sched.correction.previewPsnr);
   if (quality) {
-    std::printf("  quality        %s\n", QualityLine(*quality, f.pipe.engine).c_str());
-    if (f.pipe.engine.verbose) std::cerr << QualityLine(*quality, f.pipe.engine) << "\n";
-    if (const std::string w = QualityWarning(*quality, f.pipe.engine); !w.empty())
-      std::cerr << "dcm " << cmd << ": warning: " << w << "\n";
+    std::printf("  quality        %s%s\n", QualityLine(*quality, engine).c_str(), defaultGoal ? " (the default goal)" : "");
+    if (f.pipe.engine.verbose) std::cerr << QualityLine(*quality, engine) << "\n";
+    // Where the render's own noise stops the default goal, -v has said so: no warning for what was not asked.
+    if (const std::string w = QualityWarning(*quality, engine); !w.empty() && !(defaultGoal && ptarget.beyondRender))
+      std::cerr << "dcm " << cmd << ": warning: " << w << (defaultGoal ? " (the default goal)" : "") << "\n";
   }
   for (const auto& w : toolkit::SampleWarnings(stats_)) std::cerr << "dcm " << cmd << ": warning: " << w << "\n";
   return kExitOk;
@@ -635,7 +664,8 @@ Registration reg("blender", "Render a .blend with Cycles at the pixels DCM asks 
                                    "what judges --target-psnr: the preview's estimate at every pixel (against the "
                                    "converged image; needs the preview's variance), validation pixels rendered "
                                    "exactly, or auto (the preview where it can tell: its own noise under 25 dB "
-                                   "and no --budget)")
+                                   "and no --budget). Without --target-psnr, --threshold or --budget the goal is "
+                                   "--target-psnr 40 where the preview can judge it, else the default threshold")
                        ->check(CLI::IsMember({"auto", "preview", "validation"}))
                        ->capture_default_str();
                    app->add_option("--render-threads", f->renderThreads, "Cycles threads (0: Blender's choice)")

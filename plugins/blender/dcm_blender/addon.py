@@ -45,11 +45,12 @@ class DCMSettings(bpy.types.PropertyGroup):
         ("paper", "Paper", "Scheel et al. 2001 as written"),
         ("guo", "Guo", "Guo 1998")])
     threshold: FloatProperty(name="Threshold", default=0.0, min=0.0, max=1.0, precision=3,
-                             description="Contrast threshold (0: the method's default); lower: more exact pixels, "
-                                         "closer to the full render")
+                             description="Contrast threshold instead of a target (0: dcm's default goal, 40 dB "
+                                         "where the preview can judge it, else the method's threshold); lower: "
+                                         "more exact pixels, closer to the full render")
     target_psnr: FloatProperty(name="Target PSNR", default=0.0, min=0.0, max=99.0, precision=1, unit="NONE",
                                description="Reach this PSNR (dB) against the converged image instead of a "
-                                           "threshold (0: off; judged by the preview where it can tell, "
+                                           "threshold (0: dcm's default, 40 dB where the preview can judge it; "
                                            "docs/QUALITY.md)")
     samples: IntProperty(name="Samples", description="Cycles samples of the exact pixels (0: the scene's)",
                          default=0, min=0, max=1 << 20)
