@@ -19,20 +19,10 @@ import os
 import subprocess
 import sys
 
-import numpy as np
 
 SRC = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(SRC, "tests/blender"))
 import blender_support as bs  # noqa: E402
-
-
-def srgb(v):
-    v = np.clip(v, 0, 1)
-    return np.where(v <= 0.0031308, 12.92 * v, 1.055 * np.power(v, 1 / 2.4) - 0.055)
-
-
-def mse(a, b):
-    return float(np.mean((srgb(a.astype(np.float64)) - srgb(b.astype(np.float64))) ** 2))
 
 
 def main():
@@ -49,7 +39,7 @@ def main():
     blend = bs.make_scene(a.blender, SRC, a.out, res=a.res)
     conv = bs.render_full(a.blender, SRC, blend, a.out, 1024, 7)
     conv2 = bs.render_full(a.blender, SRC, blend, a.out, 1024, 8)
-    ref_noise = mse(conv, conv2) / 2  # each 1024-sample render's own squared error, on average
+    ref_noise = bs.display_mse(conv, conv2) / 2  # each 1024-sample render's own squared error, on average
     print("| threshold | texture split | exact | estimate [90 % interval] | true | estimate - true |")
     print("|---|---|---:|---|---:|---:|")
     for t in a.thresholds.split(","):
@@ -60,7 +50,7 @@ def main():
                    "--schedule", "preview", "--threshold", t, "-q"] + ([] if split else ["--no-texture-split"])
             subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
             j = json.load(open(name + ".json"))
-            true = -10 * math.log10(mse(bs.read_exr(name + ".exr")[0], conv) - ref_noise)
+            true = -10 * math.log10(bs.display_mse(bs.read_exr(name + ".exr")[0], conv) - ref_noise)
             est = j.get("estimated_psnr")
             if est is None:
                 row = "none (the preview's own %.2f dB)" % j["blender"].get("preview_psnr", float("nan"))

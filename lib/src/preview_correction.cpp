@@ -47,14 +47,16 @@ std::vector<double> WindowSums(const std::vector<double>& v, int W, int H, int r
 /// encodings, E[(X - A)(X - B)] = (X - E A)(X - E B) where x does not depend
 /// on their noise, plus k^2 the display variance of p, (A - B)^2 / 4.
 /// Where x moves with the halves' noise (x = L_i tau + L_c with the preview's
-/// own tau), x_A, x_B = x + D, x - D are x made with each half's tau (D = L_i
-/// times the half-difference of tau that goes with +s), and the cross-fit
+/// own tau: `cov`, the covariance of x and p, is L_i cov(tau, L)), x_A, x_B =
+/// x + D, x - D are x made with each half's tau (D = cov / s, the
+/// half-difference that goes with +s), and the cross-fit
 /// 1/2 [(X_A - B)^2 + (X_B - A)^2] - (A - B)^2 / 2 - (X_A - X_B)^2 / 4 is
 /// unbiased instead (it is the product above at D = 0); x + k (p - x) adds
-/// 2 k (1 - k) times the covariance of x and p, (X_A - X_B)(A - B) / 4.
+/// 2 k (1 - k) times that covariance, (X_A - X_B)(A - B) / 4.
 /// Negative values are part of an unbiased sum.
-double DisplayError(float p, double v, float x, double k, double D = 0) {
+double DisplayError(float p, double v, float x, double k, double cov = 0) {
   const double s = std::sqrt(std::max(v, 0.0));
+  const double D = s > 0 && std::isfinite(cov) ? cov / s : 0.0;
   const double A = SrgbEncode(float(p + s)), B = SrgbEncode(float(p - s));
   const double XA = SrgbEncode(float(x + D)), XB = SrgbEncode(float(x - D));
   const double cross = ((XA - B) * (XA - B) + (XB - A) * (XB - A)) / 2 - (A - B) * (A - B) / 2 - (XA - XB) * (XA - XB) / 4;
@@ -166,14 +168,9 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample,
           const double bias2 = se[i] / m;
           const double sdE = std::sqrt(std::max(se2[i] / m - bias2 * bias2, 0.0));
           const double k = bias2 > 0 && bias2 > kSignificance * sdE / std::sqrt(m) ? bias2 / (bias2 + meanV) : 0.0;
-          if (!error.empty()) {
-            // The half-difference of tau that goes with +s: cov(tau, L) / s.
-            const double s = std::sqrt(std::max(own(i, c), 0.0));
-            const double D = shared && s > 0 && std::isfinite(p[i].Li[c]) && std::isfinite(textureCovariance[i][c])
-                                 ? double(p[i].Li[c]) * double(textureCovariance[i][c]) / s
-                                 : 0.0;
-            error[i] += DisplayError(p[i].L[c], own(i, c), rec->workImage[i][c], k, D);
-          }
+          if (!error.empty())
+            error[i] += DisplayError(p[i].L[c], own(i, c), rec->workImage[i][c], k,
+                                     shared ? double(p[i].Li[c]) * double(textureCovariance[i][c]) : 0.0);
           if (k <= 0) continue;
           corrected[i][c] = float(double(rec->workImage[i][c]) + k * (double(p[i].L[c]) - double(rec->workImage[i][c])));
           moved[i] = 1;

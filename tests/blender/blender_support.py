@@ -15,6 +15,14 @@ def make_scene(blender, src, tmp, res="64x48", samples=16):
     return out
 
 
+def display_mse(a, b):
+    """Mean squared difference of a and b [..., 3+] on sRGB-encoded values clipped to [0, 1], as the
+    stats' PSNR measures it (tools/common/metrics.h)."""
+    enc = lambda x: np.clip(np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(np.maximum(x, 0), 1 / 2.4) - 0.055),
+                            0, 1)
+    return float(np.mean((enc(a[..., :3].astype(np.float64)) - enc(b[..., :3].astype(np.float64))) ** 2))
+
+
 def read_exr(path, layer="ViewLayer.Combined."):
     import OpenImageIO as oiio
     inp = oiio.ImageInput.open(path)

@@ -162,10 +162,8 @@ def variance(dcm, blender, src, tmp):
 
 
 def display_psnr(a, b):
-    """PSNR of a against b on sRGB-encoded values clipped to [0, 1], as the stats' (tools/common/metrics.h)."""
-    enc = lambda x: np.clip(np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(np.maximum(x, 0), 1 / 2.4) - 0.055),
-                            0, 1)
-    return 10 * np.log10(1 / np.mean((enc(a[..., :3]) - enc(b[..., :3])) ** 2))
+    """PSNR of a against b as the stats' (blender_support.display_mse)."""
+    return 10 * np.log10(1 / bs.display_mse(a, b))
 
 
 def quality(dcm, blender, src, tmp):
