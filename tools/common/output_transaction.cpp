@@ -22,7 +22,7 @@ namespace fs = std::filesystem;
 
 // The temporaries the signal handlers remove: a fixed table of C strings,
 // since a handler may neither allocate nor lock. A slot's path is complete
-// before its state says so (release/acquire).
+// before its state says so.
 constexpr int kSlots = 128;
 struct Slot {
   std::atomic<int> used{0};
@@ -42,6 +42,28 @@ constexpr int kFolderSlot = 3;
 constexpr int kIdle = 0, kCommitting = 1, kDying = 2;
 std::atomic<int> g_state{kIdle};
 std::atomic<int> g_deferred{0};
+std::atomic<int> g_creating{0};  // threads inside a CreationScope
+
+/// Removes a temporary file and the private folder it is made in
+/// (async-signal-safe). A writer in another thread may open the file by name
+/// again after the unlink; once the folder is gone it cannot, so the pair is
+/// repeated until the folder goes.
+void RemoveTemporary(const char* file) {
+  char folder[PATH_MAX];
+  const size_t n = std::strlen(file);
+  if (n >= sizeof folder) return;
+  std::memcpy(folder, file, n + 1);
+  char* slash = std::strrchr(folder, '/');
+  if (slash == nullptr || slash == folder) {
+    ::unlink(file);
+    return;
+  }
+  *slash = '\0';
+  for (int attempt = 0; attempt < 100000; ++attempt) {
+    ::unlink(file);
+    if (::rmdir(folder) == 0 || errno != ENOTEMPTY) return;
+  }
+}
 
 void OnSignal(int sig) {
   int state = kIdle;
@@ -49,14 +71,19 @@ void OnSignal(int sig) {
     g_deferred.store(sig);
     return;
   }
+  // Files or folders being made in other threads: a few system calls away.
+  for (int i = 0; i < 100000 && g_creating.load() > 0; ++i) {
+    const struct timespec pause {0, 10000};
+    ::nanosleep(&pause, nullptr);
+  }
   for (auto& slot : g_slots)
-    if (slot.used.load(std::memory_order_acquire) == 1) ::unlink(slot.path);
+    if (slot.used.load() == 1) RemoveTemporary(slot.path);
   // The folders made for the outputs, now empty: one pass per folder removes
   // a chain of them whatever their order in the table.
   for (int pass = 0; pass < kSlots; ++pass) {
     bool any = false;
     for (auto& slot : g_slots)
-      if (slot.used.load(std::memory_order_acquire) == kFolderSlot) any |= ::rmdir(slot.path) == 0;
+      if (slot.used.load() == kFolderSlot) any |= ::rmdir(slot.path) == 0;
     if (!any) break;
   }
   if (auto hook = g_hook.load()) hook();
@@ -75,7 +102,7 @@ int Register(const std::string& path, int kind = 1) {
     // 2 = being filled: the handler skips it until it holds the whole path.
     if (g_slots[i].used.compare_exchange_strong(expected, 2, std::memory_order_acquire)) {
       std::memcpy(g_slots[i].path, path.c_str(), path.size() + 1);
-      g_slots[i].used.store(kind, std::memory_order_release);
+      g_slots[i].used.store(kind);
       return i;
     }
   }
@@ -101,6 +128,29 @@ class BlockSignals {
 
  private:
   sigset_t old_{};
+};
+
+/// The scope in which a thread registers and makes a temporary or a folder.
+/// A handler waits until no thread is in one, and a thread does not enter one
+/// once a handler runs (the counter is raised before the state is read, the
+/// state before the counter: one of the two always sees the other); the
+/// cleanup signals are blocked inside, so the handler never waits for its
+/// own thread.
+class CreationScope {
+ public:
+  CreationScope() {
+    g_creating.fetch_add(1);
+    if (g_state.load() == kDying) {
+      g_creating.fetch_sub(1);
+      for (;;) ::pause();  // the handler's thread ends the process
+    }
+  }
+  ~CreationScope() { g_creating.fetch_sub(1); }
+  CreationScope(const CreationScope&) = delete;
+  CreationScope& operator=(const CreationScope&) = delete;
+
+ private:
+  BlockSignals block_;
 };
 
 std::string Errno(const std::string& path, const std::string& what = "") {
@@ -137,38 +187,51 @@ Status Resolve(const std::string& path, std::string* target, bool* writeThrough)
   return Status::Ok();
 }
 
-/// Creates the temporary file for `target` exclusively: in its folder (the
-/// system's temporary folder when written through), ".STEM.dcmtmpXXXXXX.EXT"
-/// with the stem shortened to keep the name within NAME_MAX.
-Status CreateTemporary(const std::string& target, bool writeThrough, std::string* tmp, int* fd) {
+/// Creates the temporary file for `target` exclusively, in a private folder
+/// made exclusively next to it (in the system's temporary folder when written
+/// through): ".STEM.dcmtmpXXXXXX/NAME", NAME being the output's own name (a
+/// device's: "dcm.EXT"), so that the extension OpenImageIO reads is kept. Its
+/// `slot` is taken before anything exists, so that no signal finds it
+/// unregistered.
+Status CreateTemporary(const std::string& target, bool writeThrough, std::string* tmp, int* fd, int* slot) {
   const fs::path p(target);
-  const std::string ext = p.extension().string();
   std::error_code ec;
-  const fs::path folder = writeThrough ? fs::temp_directory_path(ec) : p.parent_path();
+  const fs::path parent = writeThrough ? fs::temp_directory_path(ec) : p.parent_path();
   if (ec) return Status::Error("cannot write '" + target + "': no temporary folder: " + ec.message());
-  constexpr size_t kRandom = 6;
-  const std::string marker = ".dcmtmp";
-  const size_t fixed = 1 + marker.size() + kRandom + ext.size();
-  if (fixed > NAME_MAX)
-    return Status::Error("cannot write '" + target + "': the extension '" + ext + "' is too long");
-  std::string stem = writeThrough ? std::string("dcm") : p.stem().string();
-  if (stem.size() > NAME_MAX - fixed) stem.resize(NAME_MAX - fixed);
+  const std::string name = writeThrough ? "dcm" + p.extension().string() : p.filename().string();
+  if (name.size() > NAME_MAX)
+    return Status::Error("cannot write '" + target + "': the extension '" + p.extension().string() + "' is too long");
+  constexpr size_t kRandom = 6, kStem = 40;  // the stem only helps a person tell whose folder it is
+  std::string stem = p.stem().string();
+  if (stem.size() > kStem) stem.resize(kStem);
   static const char kChars[] = "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789";
   thread_local std::mt19937_64 rng{std::random_device{}() ^ (uint64_t(::getpid()) << 32)};
   for (int attempt = 0; attempt < 100; ++attempt) {
-    std::string name(1, '.');
-    name.append(stem).append(marker);
-    for (size_t i = 0; i < kRandom; ++i) name.push_back(kChars[rng() % (sizeof(kChars) - 1)]);
-    name.append(ext);
-    const std::string candidate = (folder / name).string();
+    std::string folderName = "." + stem + ".dcmtmp";
+    for (size_t i = 0; i < kRandom; ++i) folderName.push_back(kChars[rng() % (sizeof(kChars) - 1)]);
+    const std::string folder = (parent / folderName).string();
+    const std::string candidate = folder + "/" + name;
+    CreationScope scope;
+    const int s = Register(candidate);
+    if (::mkdir(folder.c_str(), 0700) != 0) {
+      const int error = errno;
+      Release(s);
+      errno = error;
+      if (errno == EEXIST) continue;
+      return Status::Error(Errno(target, "cannot create a temporary folder next to it: "));
+    }
     // 0666: the output gets the permissions the umask allows, as any new file.
     const int f = ::open(candidate.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
-    if (f >= 0) {
-      *tmp = candidate;
-      *fd = f;
-      return Status::Ok();
+    if (f < 0) {
+      const Status error = Status::Error(Errno(target, "cannot create a temporary file next to it: "));
+      RemoveTemporary(candidate.c_str());
+      Release(s);
+      return error;
     }
-    if (errno != EEXIST) return Status::Error(Errno(target, "cannot create a temporary file in its folder: "));
+    *tmp = candidate;
+    *fd = f;
+    *slot = s;
+    return Status::Ok();
   }
   return Status::Error("cannot write '" + target + "': no free temporary name in its folder");
 }
@@ -213,11 +276,10 @@ Status Finish(const OutputTransaction::Pending& p) {
   Status st;
   if (p.writeThrough) {
     st = WriteThrough(p.temporary, p.destination);
-    ::unlink(p.temporary.c_str());
   } else if (::rename(p.temporary.c_str(), p.destination.c_str()) != 0) {
     st = Status::Error(Errno(p.destination));
-    ::unlink(p.temporary.c_str());
   }
+  RemoveTemporary(p.temporary.c_str());  // after a rename, the folder
   Release(p.slot);
   return st;
 }
@@ -246,11 +308,10 @@ Status WriteAtomically(const std::string& path, const std::function<Status(const
   OutputTransaction::Pending p;
   DCM_RETURN_IF_ERROR(Resolve(path, &p.destination, &p.writeThrough));
   int fd = -1;
-  DCM_RETURN_IF_ERROR(CreateTemporary(p.destination, p.writeThrough, &p.temporary, &fd));
-  p.slot = Register(p.temporary);
+  DCM_RETURN_IF_ERROR(CreateTemporary(p.destination, p.writeThrough, &p.temporary, &fd, &p.slot));
   auto abandon = [&](Status st) {
     ::close(fd);
-    ::unlink(p.temporary.c_str());
+    RemoveTemporary(p.temporary.c_str());
     Release(p.slot);
     return st;
   };
@@ -285,7 +346,7 @@ OutputTransaction::~OutputTransaction() {
   if (g_active == this) g_active = nullptr;
   if (!committed_) {
     for (const auto& p : pending_) {
-      ::unlink(p.temporary.c_str());
+      RemoveTemporary(p.temporary.c_str());
       Release(p.slot);
     }
   }
@@ -299,6 +360,7 @@ Status OutputTransaction::MakeFolder(const std::string& folder) {
     missing.push_back(p);
     if (p == p.parent_path()) break;
   }
+  CreationScope scope;
   for (const auto& p : missing) folders_.push_back({p.string(), Register(p.string(), kFolderSlot)});
   fs::create_directories(folder, ec);
   if (ec) return Status::Error("cannot create the folder '" + folder + "': " + ec.message());
@@ -330,7 +392,7 @@ Status OutputTransaction::Commit() {
     for (const auto& p : pending_) {
       if (p.writeThrough) continue;
       if (!failed.ok()) {
-        ::unlink(p.temporary.c_str());
+        RemoveTemporary(p.temporary.c_str());
         Release(p.slot);
         continue;
       }
@@ -347,7 +409,7 @@ Status OutputTransaction::Commit() {
   for (const auto& p : pending_) {
     if (!p.writeThrough) continue;
     if (!failed.ok()) {
-      ::unlink(p.temporary.c_str());
+      RemoveTemporary(p.temporary.c_str());
       Release(p.slot);
       continue;
     }

@@ -26,9 +26,9 @@ void InstallSignalCleanup();
 void SetSignalHook(void (*hook)());
 
 /// Writes `path` atomically: `write(tmpPath)` writes a temporary file created
-/// exclusively (O_EXCL|O_NOFOLLOW, a random name within NAME_MAX that keeps
-/// the extension, since OpenImageIO picks the format from it) in the folder
-/// of `path`, which then replaces `path` by rename(2), at once or, within an
+/// exclusively (O_EXCL|O_NOFOLLOW) under the name of `path`, since OpenImageIO
+/// picks the format from its extension, in a folder of its own made with a
+/// random name in the folder of `path`; the file then replaces `path` by rename(2), at once or, within an
 /// OutputTransaction, at its Commit(). A symbolic link as `path` is followed
 /// (its target is replaced, the link stays). A character device or a FIFO
 /// (/dev/null, /dev/stdout), and any existing file under /dev or /proc, is
