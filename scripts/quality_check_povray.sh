@@ -4,7 +4,7 @@
 #
 #   scripts/quality_check_povray.sh DCM FULL.exr OUTDIR
 #
-# FULL.exr: every pass merged, as examples/povray/run.sh writes OUT/full.exr.
+# FULL.exr: every pass merged, as scripts/povray_passes.sh OUT writes OUT/full.exr.
 set -eu
 D=$1 F=$2 O=$3
 mkdir -p "$O"

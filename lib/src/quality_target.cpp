@@ -47,6 +47,14 @@ constexpr int kMaxSearchDraws = 4;
 constexpr double kPlateauDb = 0.5, kPlateauGrowth = 1.25;
 /// The share of the budget left that a run of the descent may spend.
 constexpr double kDescentShare = 0.6;
+/// The pixels a run of the descent may reach: `used` and the share of the rest.
+int64_t ShareOfWhatIsLeft(int64_t used, int64_t limit) {
+  return used + int64_t(kDescentShare * double(limit - used));
+}
+/// Where the budget left allows only a step of the threshold above this
+/// factor, the descent stops: the run would add less than the validation's
+/// uncertainty.
+constexpr double kLastBudgetStep = 0.97;
 /// Bisections between the last run within the budget and the one beyond.
 constexpr int kBudgetBisections = 3;
 /// At most this many confirming draws (and runs after the first).
@@ -703,11 +711,15 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   for (;;) {
     // A run of the descent after the first may spend only part of what is
     // left: one the budget refuses leaves the rest to the bisection below.
-    if (limit > 0 && best) {
-      const int64_t used = cache.Distinct();
-      cache.SetLimit(used + int64_t(kDescentShare * double(limit - used)));
-    }
+    const bool shared = limit > 0 && best;
+    if (shared) cache.SetLimit(ShareOfWhatIsLeft(cache.Distinct(), limit));
     DCM_RETURN_IF_ERROR(runAt(t, &tried));
+    if (!tried && shared) {
+      // Refused by the share, not by the budget: the same run with all that is
+      // left asks for the same pixels first, so nothing spent is lost.
+      cache.SetLimit(limit);
+      DCM_RETURN_IF_ERROR(runAt(t, &tried));
+    }
     if (!tried) {
       refused = t;
       break;
@@ -742,22 +754,37 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
       continue;
     }
     // Secants in log threshold: of the lower bound, the step that reaches the
-    // target; of the log exact pixels, the step that fills the budget. The
-    // smaller step of the two.
-    double toTarget = target > 0 ? kDefaultStep : 0, toBudget = limit > 0 ? kDefaultStep : 0;
+    // target; of the log exact pixels, the step that spends the share of the
+    // budget a run may. The smaller step of the two.
+    double toTarget = target > 0 ? kDefaultStep : 0, toBudget = 0;
     const double used = double(cache.Distinct());
     if (lastT > 0) {
       const double dlogT = std::log(t) - std::log(lastT);
       if (toTarget > 0 && std::isfinite(low) && std::isfinite(lastLow) && low > lastLow)
         toTarget = std::exp((target - low) * dlogT / (low - lastLow));
-      if (toBudget > 0 && used > lastUsed)
-        toBudget = std::exp((std::log(double(limit)) - std::log(used)) * dlogT / (std::log(used) - std::log(lastUsed)));
     }
-    const double step = std::max(toTarget, toBudget);
+    if (limit > 0) {
+      // The pixels as a power of the threshold, t^-alpha: alpha from the last
+      // two runs, 1 before a second (cautious: a run refused costs pixels).
+      double alpha = 1;
+      if (lastT > 0 && used > lastUsed)
+        alpha = std::clamp((std::log(used) - std::log(lastUsed)) / (std::log(lastT) - std::log(t)), 0.2, 4.0);
+      toBudget = std::pow(double(ShareOfWhatIsLeft(int64_t(used), limit)) / used, -1 / alpha);
+    }
     lastT = t;
     lastLow = low;
     lastUsed = used;
-    t = std::max(kMinThreshold, t * std::clamp(step, kMinStep, kMaxStep));
+    if (toBudget > kMaxStep) {
+      // The budget binds before the smallest step worth a run: a step to its
+      // share, or none where what is left buys almost nothing.
+      if (toBudget > kLastBudgetStep) {
+        report->budgetBound = true;
+        break;
+      }
+      t *= toBudget;
+      continue;
+    }
+    t = std::max(kMinThreshold, t * std::clamp(std::max(toTarget, toBudget), kMinStep, kMaxStep));
   }
   cache.SetLimit(limit);
   if (!best) {
@@ -811,10 +838,7 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
     v.AppendAll(fresh);
     if (meets(*best) || !searchMet || confirmation + 1 >= kMaxConfirmations) break;
     const double next = best->threshold <= kMinThreshold ? -1 : std::max(kMinThreshold, best->threshold * kDefaultStep);
-    if (limit > 0) {
-      const int64_t used = cache.Distinct();
-      cache.SetLimit(used + int64_t(kDescentShare * double(limit - used)));
-    }
+    if (limit > 0) cache.SetLimit(ShareOfWhatIsLeft(cache.Distinct(), limit));
     DCM_RETURN_IF_ERROR(runAt(next, &tried));
     cache.SetLimit(limit);
     if (!tried) {
