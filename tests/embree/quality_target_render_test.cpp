@@ -4,13 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <utility>
 #include <vector>
 
 #include "common/metrics.h"
 #include "dcm/quality_target.h"
+#include "threshold_sweep.h"
 #include "test_scenes.h"
 
 namespace dcm::embree {
@@ -82,18 +82,6 @@ TEST(QualityTargetRender, HeldOutSceneMeetsItsTargetAndNeverExceedsItsBudget) {
     sweep.push_back({rec.stats.exactFraction(), toolkit::Compare(rec.image, full.image, rec.width, rec.height).psnr});
   }
   std::sort(sweep.begin(), sweep.end());
-  // The sweep's PSNR at fraction f, interpolated in log fraction (as scripts/quality_check.py).
-  auto sweepAt = [&](double f) {
-    if (f <= sweep.front().first) return sweep.front().second;
-    for (size_t i = 1; i < sweep.size(); ++i)
-      if (f <= sweep[i].first) {
-        const auto [f0, p0] = sweep[i - 1];
-        const auto [f1, p1] = sweep[i];
-        const double u = f1 > f0 ? (std::log(f) - std::log(f0)) / (std::log(f1) - std::log(f0)) : 1.0;
-        return p0 + u * (p1 - p0);
-      }
-    return sweep.back().second;
-  };
   for (double budget : {0.05, 0.12}) {
     QualityGoal goal;
     goal.budget = budget;
@@ -103,7 +91,7 @@ TEST(QualityTargetRender, HeldOutSceneMeetsItsTargetAndNeverExceedsItsBudget) {
     ASSERT_TRUE(st.ok()) << st.message();
     const double truth = toolkit::Compare(rec.image, full.image, rec.width, rec.height).psnr;
     std::printf("budget %.2f: exact %.2f %%, estimate %.2f dB, true %.2f dB, sweep at that fraction %.2f dB\n", budget,
-                100 * report.exactFraction(), report.estimate.psnr, truth, sweepAt(report.exactFraction()));
+                100 * report.exactFraction(), report.estimate.psnr, truth, dcm::testing::SweepPsnrAt(sweep, report.exactFraction()));
     // Never exceeded: the budget counts every pixel evaluated, validation included.
     EXPECT_LE(report.exactPixels, int64_t(budget * double(report.totalPixels)));
     EXPECT_EQ(rec.stats.exactPixels, report.exactPixels);

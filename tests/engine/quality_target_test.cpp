@@ -13,6 +13,7 @@
 #include "dcm/quality_target.h"
 #include "noisy_provider.h"
 #include "run_helpers.h"
+#include "threshold_sweep.h"
 
 namespace dcm::testing {
 namespace {
@@ -174,22 +175,12 @@ TEST(QualityTarget, BudgetBuysWhatTheThresholdSweepBuysAtTheSameFraction) {
     sweep.push_back({rec.stats.exactFraction(), DisplayPsnr(rec.image, full)});
   }
   std::sort(sweep.begin(), sweep.end());
-  auto sweepAt = [&](double f) {
-    for (size_t i = 1; i < sweep.size(); ++i)
-      if (f <= sweep[i].first) {
-        const auto [f0, p0] = sweep[i - 1];
-        const auto [f1, p1] = sweep[i];
-        if (f <= f0) return p0;
-        return p0 + (std::log(f) - std::log(f0)) / (std::log(f1) - std::log(f0)) * (p1 - p0);
-      }
-    return sweep.back().second;
-  };
   for (double budget : {0.03, 0.05, 0.08, 0.12, 0.2}) {
     AnalyticProvider provider(N, N, FurnishedScene(N, N));
     QualityGoal goal;
     goal.budget = budget;
     const Outcome r = RunGoal(provider, ReconstructionOptions{}, goal);
-    const double frontier = sweepAt(r.report.exactFraction());
+    const double frontier = SweepPsnrAt(sweep, r.report.exactFraction());
     std::printf("  the sweep at %.2f %%: %.2f dB\n", 100 * r.report.exactFraction(), frontier);
     EXPECT_GE(r.truePsnr, frontier - kTolerance) << "budget " << budget;
     // Spent: what is left buys less than the smallest step of the threshold.
