@@ -51,9 +51,8 @@ constexpr double kDescentShare = 0.6;
 int64_t ShareOfWhatIsLeft(int64_t used, int64_t limit) {
   return used + int64_t(kDescentShare * double(limit - used));
 }
-/// Where the budget left allows only a step of the threshold above this
-/// factor, the descent stops: the run would add less than the validation's
-/// uncertainty.
+/// Where what is left of the budget allows only a step of the threshold above
+/// this factor, the descent stops: such a step buys a few pixels for a run.
 constexpr double kLastBudgetStep = 0.97;
 /// Bisections between the last run within the budget and the one beyond.
 constexpr int kBudgetBisections = 3;
@@ -781,7 +780,7 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
         report->budgetBound = true;
         break;
       }
-      t *= toBudget;
+      t *= std::min(std::max(toTarget, toBudget), kLastBudgetStep);
       continue;
     }
     t = std::max(kMinThreshold, t * std::clamp(std::max(toTarget, toBudget), kMinStep, kMaxStep));
