@@ -199,8 +199,7 @@ Status CreateTemporary(const std::string& target, bool writeThrough, std::string
   const fs::path parent = writeThrough ? fs::temp_directory_path(ec) : p.parent_path();
   if (ec) return Status::Error("cannot write '" + target + "': no temporary folder: " + ec.message());
   const std::string name = writeThrough ? "dcm" + p.extension().string() : p.filename().string();
-  if (name.size() > NAME_MAX)
-    return Status::Error("cannot write '" + target + "': the extension '" + p.extension().string() + "' is too long");
+  if (name.size() > NAME_MAX) return Status::Error("cannot write '" + target + "': its name is too long");
   constexpr size_t kRandom = 6, kStem = 40;  // the stem only helps a person tell whose folder it is
   std::string stem = p.stem().string();
   if (stem.size() > kStem) stem.resize(kStem);
@@ -279,7 +278,7 @@ Status Finish(const OutputTransaction::Pending& p) {
   } else if (::rename(p.temporary.c_str(), p.destination.c_str()) != 0) {
     st = Status::Error(Errno(p.destination));
   }
-  RemoveTemporary(p.temporary.c_str());  // after a rename, the folder
+  RemoveTemporary(p.temporary.c_str());  // after a rename, only its folder is left
   Release(p.slot);
   return st;
 }
