@@ -172,7 +172,7 @@ TEST(HostileOutput, SpecialAndLongOutputNames) {
   EXPECT_TRUE(S_ISCHR(st.st_mode)) << devNull << " is no longer a character device";
   EXPECT_TRUE(fs::is_regular_file(dir / "out.exr"));
 
-  // A name of 250 characters: its temporary file must stay within NAME_MAX (255).
+  // A name of 250 characters: its temporary's folder must stay within NAME_MAX (255).
   const std::string longName = std::string(246, 'n') + ".exr";
   r = RunDcm(dir.path(), {"reconstruct", "in.exr", "-o", longName, "--quiet"});
   EXPECT_TRUE(r.exited && r.code == 0) << r.Describe();
