@@ -152,6 +152,14 @@ def variance(dcm, blender, src, tmp):
         if has:
             assert j["estimated_psnr_against"] == "converged" and j["estimated_psnr_from"] == "preview", j
             assert j["estimated_psnr_low"] <= j["estimated_psnr"], j
+    # --target-psnr render aims at the full render's own error, which only the variance tells: it
+    # goes to the engine whatever auto would decide.
+    out, stats = os.path.join(tmp, "render.exr"), os.path.join(tmp, "render.json")
+    code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--blender", blender, "--target-psnr", "render"])
+    assert code == 0, se
+    j = json.load(open(stats))
+    assert j["blender"]["variance"] == "halves" and j["settings"]["noisy"], (j["blender"], j["settings"])
+    assert j["quality"]["target_render"] and j["estimated_render_psnr"] > 0, j
     print("%.1f %% exact; %.0f %% of them differ between the seeds; %d denoised; auto: noise %.1f dB, %s; first "
           "round %d pixels (%d with an exact preview); with it, the preview's own PSNR %.1f dB, estimate %s"
           % (100 * is_exact.mean(), 100 * differ, runs["on"][2]["denoised_samples"],
@@ -325,6 +333,8 @@ def errors(dcm, blender, src, tmp):
     refused([blend, "-o", os.path.join(tmp, "no-such-dir", "out.exr"), "--blender", blender], "no-such-dir")
     refused([blend, "-o", out, "--blender", blender, "--target-psnr", "40", "--full"],
             "--target-psnr: not with --full", code=2)
+    refused([blend, "-o", out, "--blender", blender, "--target-psnr", "render", "--variance", "off"],
+            "--target-psnr render", "--variance off", code=2)
     # A scene set to Eevee: the child says why it cannot render it.
     eevee = os.path.join(tmp, "eevee.blend")
     subprocess.run([blender, "-b", blend, "--python-expr",

@@ -207,7 +207,7 @@ class TimedProvider final : public SampleProvider {
 /// halves alone: one degree of freedom per channel, often near 0 or several
 /// times the truth) over the exact pixels known so far on the same surface
 /// (equal object and shader IDs) within one noisy elementary block
-/// (dcm::SurfaceWindowMean): a lattice corner then pools the corners around
+/// (dcm::SurfaceWindowRelativeMean): a lattice corner then pools the corners around
 /// it, and a pixel on an edge its neighbours along the edge.
 /// `use` false: the samples go to the engine without variance.
 class PooledVarianceProvider final : public SampleProvider {
@@ -232,11 +232,15 @@ class PooledVarianceProvider final : public SampleProvider {
       objectId_ = std::move(g.objectId);
       shaderId_ = std::move(g.shaderId);
       raw_.assign(n, RGB::Gray(std::numeric_limits<float>::quiet_NaN()));
+      value_ = raw_;
     }
-    for (size_t i = 0; i < pixels.size(); ++i)
-      raw_[size_t(pixels[i].y) * size_t(caps_.width) + size_t(pixels[i].x)] = out[i].variance;
+    for (size_t i = 0; i < pixels.size(); ++i) {
+      const size_t k = size_t(pixels[i].y) * size_t(caps_.width) + size_t(pixels[i].x);
+      raw_[k] = out[i].variance;
+      value_[k] = out[i].L;
+    }
     const std::vector<RGB> pooled =
-        SurfaceWindowMean(raw_, caps_.width, caps_.height, objectId_, shaderId_, radius_, pixels);
+        SurfaceWindowRelativeMean(raw_, value_, caps_.width, caps_.height, objectId_, shaderId_, radius_, pixels);
     for (size_t i = 0; i < pixels.size(); ++i) out[i].variance = pooled[i];
     return Status::Ok();
   }
@@ -245,7 +249,8 @@ class PooledVarianceProvider final : public SampleProvider {
   SampleProvider& p_;
   ProviderCapabilities caps_;
   int radius_;
-  std::vector<RGB> raw_;  ///< the child's per-pixel variance; NaN: not rendered
+  std::vector<RGB> raw_;    ///< the child's per-pixel variance; NaN: not rendered
+  std::vector<RGB> value_;  ///< the rendered pixels' values; NaN: not rendered
   std::vector<uint32_t> objectId_, shaderId_;
 };
 
@@ -260,6 +265,8 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   ReconstructionOptions options;
   if (Status st = ToOptions(f.pipe.engine, &options); !st.ok()) return Fail(st.message(), kExitUsage);
   if (Status st = toolkit::CheckExrFormat(f.pipe.exr); !st.ok()) return Fail(st.message(), kExitUsage);
+  if (f.variance == "off" && f.pipe.engine.targetPsnr && *f.pipe.engine.targetPsnr == kTargetRender)
+    return Fail("--target-psnr render needs the exact pixels' variance, which --variance off leaves out", kExitUsage);
   if (Status st = toolkit::CheckOutputs({{"scene", f.scene}}, {{"-o", output},
                                                                {"--stats", stats},
                                                                {"--sample-map", sampleMap},
@@ -318,8 +325,10 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   // The exact pixels' variance goes to the engine where their noise matters.
   const double noisePsnr =
       keys.count("noise_psnr") ? std::atof(keys.at("noise_psnr").c_str()) : std::numeric_limits<double>::quiet_NaN();
+  // --target-psnr render is the full render's own error, which only the variance tells.
+  const bool targetRender = f.pipe.engine.targetPsnr && *f.pipe.engine.targetPsnr == kTargetRender;
   const bool useVariance = provider->Capabilities().variance &&
-                           (f.variance == "on" || (f.variance == "auto" && noisePsnr < kNoisyPsnr));
+                           (f.variance == "on" || (f.variance == "auto" && (targetRender || noisePsnr < kNoisyPsnr)));
   // The variance is pooled over the elementary block of the noisy regime.
   ProviderCapabilities noisyCaps = provider->Capabilities();
   noisyCaps.variance = true;
@@ -657,7 +666,8 @@ Registration reg("blender", "Render a .blend with Cycles at the pixels DCM asks 
                    app->add_option("--variance", f->variance,
                                    "exact pixels as two renders of half the samples with two seeds, whose difference "
                                    "gives the engine their variance: auto (where the preview's halves say their "
-                                   "noise costs less than 42 dB PSNR), on, or off (one render each, no variance)")
+                                   "noise costs less than 42 dB PSNR, and always with --target-psnr render), on, "
+                                   "or off (one render each, no variance)")
                        ->check(CLI::IsMember({"auto", "on", "off"}))
                        ->capture_default_str();
                    app->add_option("--estimate-from", f->estimateFrom,

@@ -37,4 +37,23 @@ std::vector<RGB> SurfaceWindowMean(std::span<const RGB> v, int width, int height
                                    std::span<const uint32_t> objectId, std::span<const uint32_t> shaderId,
                                    int r, std::span<const Point2i> at = {});
 
+/// What SurfaceWindowRelativeMean adds to every |value| (linear,
+/// scene-referred): a tenth of sRGB's linear segment, where the display no
+/// longer tells a value from 0; it keeps a window of black pixels defined.
+inline constexpr float kRelativeVarianceFloor = 3e-4f;
+
+/// The variance `v` of values `L` (both width x height, row-major) pooled over
+/// the window SurfaceWindowMean pools over, as a share of the value: per
+/// channel, the window's sum of v over its sum of |L| + f, times |L| + f at the
+/// pixel itself (f: kRelativeVarianceFloor). A Monte Carlo estimate's
+/// variance grows with its value; the window mean of the variance itself
+/// gives a dark pixel the variance of a bright neighbour (a highlight, a
+/// caustic), which the display's steep slope at dark values then magnifies
+/// (docs/NOISE.md, "Pooling the variance"). A ratio of sums, not a mean of
+/// ratios: no pixel's noisy value near 0 divides. A pixel whose `v` or `L` is
+/// not finite gives no value.
+std::vector<RGB> SurfaceWindowRelativeMean(std::span<const RGB> v, std::span<const RGB> L, int width, int height,
+                                           std::span<const uint32_t> objectId, std::span<const uint32_t> shaderId,
+                                           int r, std::span<const Point2i> at = {});
+
 }  // namespace dcm

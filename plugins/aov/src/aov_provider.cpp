@@ -954,7 +954,7 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
           d->Lc[i] = (d->Lc[i] + b.Lc[i]) * 0.5f;
         }
       }
-      d->var = SurfaceWindowMean(diff2, *d, 2);
+      d->var = dcm::SurfaceWindowRelativeMean(diff2, d->L, d->width(), d->height(), d->objectId, d->shaderId, 2);
       d->notes.push_back("samples: the mean of the inputs and the second render " + Quote(options.secondRender[0]) +
                          "; variance from their difference (5x5 window on each surface)");
     } else if (options.estimateVariance) {

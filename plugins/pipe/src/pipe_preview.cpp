@@ -39,7 +39,7 @@ Status PipeProvider::FetchPreview(const SampleRequest& what, std::unique_ptr<Sam
     GuideImage ids;
     DCM_RETURN_IF_ERROR(
         Guides(Bounds2i{{0, 0}, {caps_.width, caps_.height}}, {caps_.objectId, caps_.shaderId, false, false}, &ids));
-    var = SurfaceWindowMean(var, caps_.width, caps_.height, ids.objectId, ids.shaderId, varianceRadius);
+    var = SurfaceWindowRelativeMean(var, L, caps_.width, caps_.height, ids.objectId, ids.shaderId, varianceRadius);
   }
   *out = std::make_unique<ImagePreviewProvider>(caps_.width, caps_.height, caps_.width, caps_.height, std::move(L),
                                                 std::move(Li), std::move(Lc), std::move(var));
