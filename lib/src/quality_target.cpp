@@ -485,7 +485,7 @@ PsnrEstimate RenderEstimate(const Validation& v, const QualityGoal& goal) {
 /// Evaluates the working pixels of the validation's output pixels through
 /// `cache` and keeps their box means.
 Status EvaluateValidation(CachingProvider& cache, const ReconstructionOptions& options, const SampleRequest& what,
-                          Validation* v, std::vector<Point2i>* pending) {
+                          const QualityGoal& goal, Validation* v, std::vector<Point2i>* pending) {
   const ProviderCapabilities caps = cache.Capabilities();
   const int s = std::max(1, options.downsample);
   std::vector<Point2i> work;
@@ -496,6 +496,12 @@ Status EvaluateValidation(CachingProvider& cache, const ReconstructionOptions& o
   const Status st = cache.Evaluate(work, what, samples);
   if (st.pending() && pending) *pending = work;
   DCM_RETURN_IF_ERROR(st);
+  if (what.variance && goal.ownVariance) {
+    std::vector<RGB> variance(work.size());
+    for (size_t i = 0; i < work.size(); ++i) variance[i] = samples[i].variance;
+    goal.ownVariance(work, variance);
+    for (size_t i = 0; i < work.size(); ++i) samples[i].variance = variance[i];
+  }
   size_t k = 0;
   for (const Point2i& p : v->pixels) {
     RGB sum;
@@ -619,7 +625,7 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
                        : DrawValidation(outW, outH, count, goal.seed + uint64_t(draws), &more.weights);
     more.total = double(outPixels);
     more.importance = from != nullptr;
-    DCM_RETURN_IF_ERROR(EvaluateValidation(cache, options, what, &more, pending));
+    DCM_RETURN_IF_ERROR(EvaluateValidation(cache, options, what, goal, &more, pending));
     ++draws;
     for (const Point2i& p : more.pixels) {
       uint8_t& mark = drawn[size_t(p.y) * size_t(outW) + size_t(p.x)];

@@ -233,16 +233,27 @@ class PooledVarianceProvider final : public SampleProvider {
       shaderId_ = std::move(g.shaderId);
       raw_.assign(n, RGB::Gray(std::numeric_limits<float>::quiet_NaN()));
       value_ = raw_;
+      rendered_.assign(n, 0);
     }
     for (size_t i = 0; i < pixels.size(); ++i) {
       const size_t k = size_t(pixels[i].y) * size_t(caps_.width) + size_t(pixels[i].x);
       raw_[k] = out[i].variance;
       value_[k] = out[i].L;
+      rendered_[k] = 1;
     }
     const std::vector<RGB> pooled =
         SurfaceWindowRelativeMean(raw_, value_, caps_.width, caps_.height, objectId_, shaderId_, radius_, pixels);
     for (size_t i = 0; i < pixels.size(); ++i) out[i].variance = pooled[i];
     return Status::Ok();
+  }
+
+  /// The child's variance of each of `pixels` from that pixel alone where it
+  /// rendered it (QualityGoal::ownVariance).
+  void OwnVariance(std::span<const Point2i> pixels, std::span<RGB> variance) const {
+    for (size_t i = 0; i < pixels.size(); ++i) {
+      const size_t k = size_t(pixels[i].y) * size_t(caps_.width) + size_t(pixels[i].x);
+      if (k < rendered_.size() && rendered_[k]) variance[i] = raw_[k];
+    }
   }
 
  private:
@@ -251,6 +262,7 @@ class PooledVarianceProvider final : public SampleProvider {
   int radius_;
   std::vector<RGB> raw_;    ///< the child's per-pixel variance; NaN: not rendered
   std::vector<RGB> value_;  ///< the rendered pixels' values; NaN: not rendered
+  std::vector<uint8_t> rendered_;
   std::vector<uint32_t> objectId_, shaderId_;
 };
 
@@ -378,6 +390,10 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   // --target-psnr / --budget: the quality search, each run planned on the preview.
   QualityGoal goal;
   const bool haveGoal = QualityGoalOf(f.pipe.engine, &goal);
+  if (useVariance)
+    goal.ownVariance = [&pooled](std::span<const Point2i> pixels, std::span<RGB> variance) {
+      pooled.OwnVariance(pixels, variance);
+    };
   // Without a goal or a threshold, dcm's own method aims at kDefaultTargetPsnr
   // where the preview can judge it; the published methods keep their threshold.
   const bool defaultGoal = !haveGoal && !f.pipe.engine.threshold && !options.fullEvaluation &&

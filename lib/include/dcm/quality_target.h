@@ -14,6 +14,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <span>
 #include <vector>
 
 #include "dcm/color.h"
@@ -58,6 +59,14 @@ struct QualityGoal {
   std::function<Status(SampleProvider& provider, const ReconstructionOptions& options, Reconstruction* out,
                        std::vector<Point2i>* pending)>
       reconstruct;
+  /// Replaces `variance`, the variance the provider reported for each of
+  /// `pixels` (working pixels), by that pixel's own where the provider
+  /// knows it, for a provider that reports a variance pooled over
+  /// neighbours for the engine's tests: pooled over the few exact pixels
+  /// near a validation pixel, which gather at edges where the relative noise
+  /// is highest, it is biased there; the pixel's own is not, and the
+  /// estimate averages it over the validation pixels. Empty: the provider's.
+  std::function<void(std::span<const Point2i> pixels, std::span<RGB> variance)> ownVariance;
 
   /// Checks the ranges ("--target-psnr: ..."); the message names the flag.
   Status Validate() const;
