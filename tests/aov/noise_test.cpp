@@ -216,6 +216,37 @@ TEST(AovNoise, ReconstructFromTwoNoisyRendersBeatsTheirMean) {
               s["reference"]["psnr"].get<double>(), m["reference"]["psnr"].get<double>());
 }
 
+TEST(AovNoise, StatsAndVerboseSayWhetherTheRenderIsCloser) {
+  // Issue 26: where dcm cannot be as close to the converged image as the
+  // full render, -v and the stats say so. Clear-cut cases either way (the
+  // estimates printed): noise of sd 0.05, where the render's noise costs
+  // about 33 dB and dcm's denoised result shows none beyond it (estimated
+  // +inf), and noise of sd 0.00005 with a budget of 6 %, where the render's
+  // costs about 94 dB and dcm's interpolation error about 71 dB.
+  ScratchDir dir;
+  const Scene sc{256, 256};
+  for (float sigma : {kSigma, 0.00005f}) {
+    const bool noisy = sigma == kSigma;
+    WriteExr(dir / "a.exr", sc.width, sc.height, NoisyChannels(sc, true, 5, sigma));
+    WriteExr(dir / "b.exr", sc.width, sc.height, NoisyChannels(sc, true, 6, sigma));
+    std::vector<std::string> args = {"reconstruct", dir / "a.exr", "--second-render", dir / "b.exr", "-o",
+                                     dir / "out.exr", "--stats", dir / "s.json", "-v"};
+    if (!noisy) args.insert(args.end(), {"--budget", "0.06"});
+    const RunResult r = RunDcm(args, dir);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto s = nlohmann::json::parse(ReadText(dir / "s.json"));
+    ASSERT_TRUE(s.contains("closer_than_render")) << s.dump();
+    EXPECT_EQ(s["closer_than_render"].get<bool>(), noisy) << s.dump();
+    // JSON has no infinity: an estimate of +inf (no error seen beyond the noise) is written as null.
+    const double estimate = s["estimated_psnr"].is_null() ? HUGE_VAL : s["estimated_psnr"].get<double>();
+    EXPECT_EQ(s["closer_than_render"].get<bool>(), estimate >= s["estimated_render_psnr"].get<double>());
+    std::printf("sd %g: estimated %.2f dB, the render %.2f dB\n", sigma, estimate,
+                s["estimated_render_psnr"].get<double>());
+    EXPECT_NE(r.err.find(noisy ? "this result is closer, by" : "the full render is closer, by"), std::string::npos)
+        << r.err;
+  }
+}
+
 TEST(AovNoise, ReconstructWithTheNoiseEstimatedBeatsTheNoisyRender) {
   // One noisy render and no variance channel: --estimate-variance. dcm must
   // come closer to the clean image than the render itself.

@@ -168,6 +168,9 @@ void AddQualityJson(const QualityReport& r, double targetPsnr, double budget, nl
     (*j)["estimated_render_psnr"] = r.renderEstimate.psnr;
     (*j)["estimated_render_psnr_low"] = r.renderEstimate.low;
     (*j)["estimated_render_psnr_high"] = r.renderEstimate.high;
+    // By the two estimates: is the result closer to the converged image than the full render?
+    if (std::isfinite(r.renderEstimate.psnr) && !std::isnan(r.estimate.psnr))
+      (*j)["closer_than_render"] = r.estimate.psnr >= r.renderEstimate.psnr;
   }
   nlohmann::json levels = nlohmann::json::array();
   for (const LevelEstimate& l : r.levels)

@@ -54,7 +54,8 @@ void AddEstimateMetadata(const PsnrEstimate& estimate, Metadata* metadata);
 /// and quality.target_render true. With samples of known variance
 /// (QualityReport::againstConverged) also estimated_psnr_against "converged"
 /// and estimated_render_psnr, _low, _high (the full render's own PSNR
-/// against the converged image).
+/// against the converged image), and closer_than_render (the result's
+/// estimate at least the render's) where both are known.
 void AddQualityJson(const QualityReport& report, double targetPsnr, double budget, nlohmann::json* j);
 
 /// Adds AddEstimateMetadata() of the report's estimate and, with samples of

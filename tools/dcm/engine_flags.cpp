@@ -318,6 +318,13 @@ std::string QualityLine(const QualityReport& r, const EngineFlags& f) {
     std::snprintf(noise, sizeof noise, " (%.2f to %.2f)", n.low, n.high);
     line += noise;
   }
+  if (std::isfinite(n.psnr) && !std::isnan(e.psnr)) {
+    // Issue 26's question, by the two estimates: which is closer to the converged image.
+    std::snprintf(noise, sizeof noise, e.psnr >= n.psnr ? ": this result is closer, by %.2f dB"
+                                                        : ": the full render is closer, by %.2f dB",
+                  std::fabs(e.psnr - n.psnr));
+    line += noise;
+  }
   return line;
 }
 
