@@ -242,7 +242,7 @@ TEST(AovNoise, StatsAndVerboseSayWhetherTheRenderIsCloser) {
     EXPECT_EQ(s["closer_than_render"].get<bool>(), estimate >= s["estimated_render_psnr"].get<double>());
     std::printf("sd %g: estimated %.2f dB, the render %.2f dB\n", sigma, estimate,
                 s["estimated_render_psnr"].get<double>());
-    EXPECT_NE(r.err.find(noisy ? "this result is closer, by" : "the full render is closer, by"), std::string::npos)
+    EXPECT_NE(r.err.find(noisy ? ": this result is closer" : ": the full render is closer, by"), std::string::npos)
         << r.err;
   }
 }

@@ -207,8 +207,9 @@ class TimedProvider final : public SampleProvider {
 /// halves alone: one degree of freedom per channel, often near 0 or several
 /// times the truth) over the exact pixels known so far on the same surface
 /// (equal object and shader IDs) within one noisy elementary block
-/// (dcm::SurfaceWindowRelativeMean): a lattice corner then pools the corners around
-/// it, and a pixel on an edge its neighbours along the edge.
+/// as a share of the value (dcm::SurfaceWindowRelativeMean): a lattice corner
+/// then pools the corners around it, and a pixel on an edge its neighbours
+/// along the edge.
 /// `use` false: the samples go to the engine without variance.
 class PooledVarianceProvider final : public SampleProvider {
  public:
@@ -260,9 +261,9 @@ class PooledVarianceProvider final : public SampleProvider {
   SampleProvider& p_;
   ProviderCapabilities caps_;
   int radius_;
-  std::vector<RGB> raw_;    ///< the child's per-pixel variance; NaN: not rendered
-  std::vector<RGB> value_;  ///< the rendered pixels' values; NaN: not rendered
-  std::vector<uint8_t> rendered_;
+  std::vector<RGB> raw_;           ///< the child's per-pixel variance; NaN: not rendered
+  std::vector<RGB> value_;         ///< the rendered pixels' values; NaN: not rendered
+  std::vector<uint8_t> rendered_;  ///< 1 where the child rendered the pixel (its value may be NaN)
   std::vector<uint32_t> objectId_, shaderId_;
 };
 

@@ -320,10 +320,13 @@ std::string QualityLine(const QualityReport& r, const EngineFlags& f) {
   }
   if (std::isfinite(n.psnr) && !std::isnan(e.psnr)) {
     // Issue 26's question, by the two estimates: which is closer to the converged image.
-    std::snprintf(noise, sizeof noise, e.psnr >= n.psnr ? ": this result is closer, by %.2f dB"
-                                                        : ": the full render is closer, by %.2f dB",
-                  std::fabs(e.psnr - n.psnr));
-    line += noise;
+    if (std::isinf(e.psnr)) line += ": this result is closer (its validation pixels show no error beyond the noise)";
+    else {
+      std::snprintf(noise, sizeof noise, e.psnr >= n.psnr ? ": this result is closer, by %.2f dB"
+                                                          : ": the full render is closer, by %.2f dB",
+                    std::fabs(e.psnr - n.psnr));
+      line += noise;
+    }
   }
   return line;
 }
