@@ -168,9 +168,7 @@ void AddQualityJson(const QualityReport& r, double targetPsnr, double budget, nl
     (*j)["estimated_render_psnr"] = r.renderEstimate.psnr;
     (*j)["estimated_render_psnr_low"] = r.renderEstimate.low;
     (*j)["estimated_render_psnr_high"] = r.renderEstimate.high;
-    // By the two estimates: is the result closer to the converged image than the full render?
-    if (std::isfinite(r.renderEstimate.psnr) && !std::isnan(r.estimate.psnr))
-      (*j)["closer_than_render"] = r.estimate.psnr >= r.renderEstimate.psnr;
+    if (const std::optional<bool> closer = CloserThanRender(r)) (*j)["closer_than_render"] = *closer;
   }
   nlohmann::json levels = nlohmann::json::array();
   for (const LevelEstimate& l : r.levels)
@@ -188,6 +186,11 @@ void AddQualityJson(const QualityReport& r, double targetPsnr, double budget, nl
                      {"threshold", r.threshold < 0 ? nlohmann::json(nullptr) : nlohmann::json(r.threshold)},
                      {"levels", levels}};
   if (targetPsnr < 0) (*j)["quality"]["target_render"] = true;
+}
+
+std::optional<bool> CloserThanRender(const QualityReport& r) {
+  if (!r.againstConverged || !std::isfinite(r.renderEstimate.psnr) || std::isnan(r.estimate.psnr)) return {};
+  return r.estimate.psnr >= r.renderEstimate.psnr;
 }
 
 void AddQualityMetadata(const QualityReport& r, Metadata* m) {

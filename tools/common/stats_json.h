@@ -2,6 +2,7 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -57,6 +58,10 @@ void AddEstimateMetadata(const PsnrEstimate& estimate, Metadata* metadata);
 /// against the converged image), and closer_than_render (the result's
 /// estimate at least the render's) where both are known.
 void AddQualityJson(const QualityReport& report, double targetPsnr, double budget, nlohmann::json* j);
+
+/// Whether the result is at least as close to the converged image as the
+/// full render, by the two estimates; empty where either is not known.
+std::optional<bool> CloserThanRender(const QualityReport& report);
 
 /// Adds AddEstimateMetadata() of the report's estimate and, with samples of
 /// known variance, dcm:estimated_render_psnr (finite values only) to EXR

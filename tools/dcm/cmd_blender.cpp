@@ -278,7 +278,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   ReconstructionOptions options;
   if (Status st = ToOptions(f.pipe.engine, &options); !st.ok()) return Fail(st.message(), kExitUsage);
   if (Status st = toolkit::CheckExrFormat(f.pipe.exr); !st.ok()) return Fail(st.message(), kExitUsage);
-  if (f.variance == "off" && f.pipe.engine.targetPsnr && *f.pipe.engine.targetPsnr == kTargetRender)
+  if (f.variance == "off" && f.pipe.engine.TargetsRender())
     return Fail("--target-psnr render needs the exact pixels' variance, which --variance off leaves out", kExitUsage);
   if (Status st = toolkit::CheckOutputs({{"scene", f.scene}}, {{"-o", output},
                                                                {"--stats", stats},
@@ -339,9 +339,9 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   const double noisePsnr =
       keys.count("noise_psnr") ? std::atof(keys.at("noise_psnr").c_str()) : std::numeric_limits<double>::quiet_NaN();
   // --target-psnr render is the full render's own error, which only the variance tells.
-  const bool targetRender = f.pipe.engine.targetPsnr && *f.pipe.engine.targetPsnr == kTargetRender;
-  const bool useVariance = provider->Capabilities().variance &&
-                           (f.variance == "on" || (f.variance == "auto" && (targetRender || noisePsnr < kNoisyPsnr)));
+  const bool useVariance =
+      provider->Capabilities().variance &&
+      (f.variance == "on" || (f.variance == "auto" && (f.pipe.engine.TargetsRender() || noisePsnr < kNoisyPsnr)));
   // The variance is pooled over the elementary block of the noisy regime.
   ProviderCapabilities noisyCaps = provider->Capabilities();
   noisyCaps.variance = true;

@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "common/image_io.h"
+#include "common/stats_json.h"
 #include "flag_checks.h"
 #include "dcm/downsample.h"
 
@@ -263,7 +264,7 @@ std::string SettingsSummary(const ReconstructionOptions& o, const ProviderCapabi
 
 bool QualityGoalOf(const EngineFlags& f, QualityGoal* goal) {
   *goal = QualityGoal{};
-  if (f.targetPsnr && *f.targetPsnr == kTargetRender) goal->targetRender = true;
+  if (f.TargetsRender()) goal->targetRender = true;
   else if (f.targetPsnr) goal->targetPsnr = *f.targetPsnr;
   if (f.budget) goal->budget = *f.budget;
   return f.targetPsnr || f.budget;
@@ -318,12 +319,12 @@ std::string QualityLine(const QualityReport& r, const EngineFlags& f) {
     std::snprintf(noise, sizeof noise, " (%.2f to %.2f)", n.low, n.high);
     line += noise;
   }
-  if (std::isfinite(n.psnr) && !std::isnan(e.psnr)) {
-    // Issue 26's question, by the two estimates: which is closer to the converged image.
+  if (const std::optional<bool> closer = toolkit::CloserThanRender(r)) {
+    // Issue 26's question: which is closer to the converged image.
     if (std::isinf(e.psnr)) line += ": this result is closer (its validation pixels show no error beyond the noise)";
     else {
-      std::snprintf(noise, sizeof noise, e.psnr >= n.psnr ? ": this result is closer, by %.2f dB"
-                                                          : ": the full render is closer, by %.2f dB",
+      std::snprintf(noise, sizeof noise, *closer ? ": this result is closer, by %.2f dB"
+                                                 : ": the full render is closer, by %.2f dB",
                     std::fabs(e.psnr - n.psnr));
       line += noise;
     }

@@ -38,6 +38,9 @@ struct EngineFlags {
   std::string contrast;        ///< mitchell | display
   std::string progressive;     ///< folder for an image after each refinement level
   bool verbose = false, quiet = false;
+
+  /// Whether --target-psnr is `render`.
+  bool TargetsRender() const { return targetPsnr && *targetPsnr == kTargetRender; }
 };
 
 /// Adds the engine's flags in their help groups (flag_checks.h): quality
