@@ -23,6 +23,12 @@ def display_mse(a, b):
     return float(np.mean((enc(a[..., :3].astype(np.float64)) - enc(b[..., :3].astype(np.float64))) ** 2))
 
 
+def no_blender_left(marker):
+    """No process but this one has `marker` in its command line (pgrep -f)."""
+    out = subprocess.run(["pgrep", "-f", marker], capture_output=True, text=True).stdout.split()
+    return not [pid for pid in out if int(pid) != os.getpid()]
+
+
 def read_exr(path, layer="ViewLayer.Combined."):
     import OpenImageIO as oiio
     inp = oiio.ImageInput.open(path)

@@ -30,12 +30,6 @@ def run(dcm, args, env=None):
     return p.returncode, p.stdout, p.stderr
 
 
-def no_blender_left(marker):
-    """No process of this test's scene is running (pgrep over command lines)."""
-    out = subprocess.run(["pgrep", "-f", marker], capture_output=True, text=True).stdout.split()
-    return not [pid for pid in out if int(pid) != os.getpid()]
-
-
 def exact(dcm, blender, src, tmp):
     blend = bs.make_scene(blender, src, tmp)
     digest = hashlib.sha256(open(blend, "rb").read()).hexdigest()
@@ -73,7 +67,7 @@ def exact(dcm, blender, src, tmp):
         print("%s: %.1f %% exact in %d render calls, %.1f %% bit-identical to the full render; %.2f s" % (
             schedule, 100 * j["exact_fraction"], rounds, 100 * (err == 0).all(axis=1).mean(), b["wall_s"]))
     assert hashlib.sha256(open(blend, "rb").read()).hexdigest() == digest, "the .blend changed"
-    assert no_blender_left(blend)
+    assert bs.no_blender_left(blend)
 
 
 def exact_mask(smap, h, w):
@@ -166,7 +160,7 @@ def variance(dcm, blender, src, tmp):
              runs["auto"][2]["blender"]["noise_psnr"], runs["auto"][2]["blender"]["variance"], first["on"],
              first["exact preview"], runs["exact preview"][2]["blender"]["preview_psnr"],
              runs["exact preview"][2].get("estimated_psnr")))
-    assert no_blender_left(blend)
+    assert bs.no_blender_left(blend)
 
 
 def display_psnr(a, b):
@@ -211,7 +205,7 @@ def quality(dcm, blender, src, tmp):
     assert j["exact_fraction"] <= budget and rendered <= budget * total, (j["exact_fraction"], rendered)
     print("--budget %g: %.1f %% exact (%d pixels rendered), estimated %.2f dB, true %.2f dB"
           % (budget, 100 * j["exact_fraction"], rendered, j["estimated_psnr"], display_psnr(bs.read_exr(out)[0], ref)))
-    assert no_blender_left(blend)
+    assert bs.no_blender_left(blend)
 
 
 def preview_target(dcm, blender, src, tmp):
@@ -301,7 +295,7 @@ def preview_target(dcm, blender, src, tmp):
         code, so, se = run(dcm, [blend, "-o", out, "--blender", blender, "--samples", "64", "--target-psnr", "30",
                                  "--estimate-from", "preview"] + flags)
         assert code == 2 and "--estimate-from preview" in se, (flags, code, se)
-    assert no_blender_left(blend)
+    assert bs.no_blender_left(blend)
 
 
 def errors(dcm, blender, src, tmp):
@@ -315,7 +309,7 @@ def errors(dcm, blender, src, tmp):
             assert part in se, (args, part, se)
         assert not os.path.exists(out), args
         assert not [f for f in os.listdir(tmp) if f.startswith("out")], os.listdir(tmp)
-        assert no_blender_left(blend), "a Blender is still running"
+        assert bs.no_blender_left(blend), "a Blender is still running"
 
     missing = os.path.join(tmp, "missing.blend")
     refused([missing, "-o", out, "--blender", blender], missing, "no such file", "reading the scene")
@@ -368,11 +362,11 @@ def signalled(dcm, blender, blend, out, scratch):
         p.send_signal(sig)
         assert p.wait(timeout=30) == -sig, p.returncode
         deadline = time.time() + 10
-        while time.time() < deadline and (os.listdir(scratch) or guardian_left() or not no_blender_left(blend)):
+        while time.time() < deadline and (os.listdir(scratch) or guardian_left() or not bs.no_blender_left(blend)):
             time.sleep(0.1)
         assert os.listdir(scratch) == [], (sig, os.listdir(scratch))
         assert not guardian_left(), sig
-        assert no_blender_left(blend), (sig, "a Blender is still running")
+        assert bs.no_blender_left(blend), (sig, "a Blender is still running")
         assert not os.path.exists(out), sig
 
 

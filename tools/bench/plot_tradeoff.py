@@ -6,7 +6,8 @@ one curve per method, per scene.
 
 Reads bench.csv (written by `dcm bench`) and writes, for every scene,
 SCENE_psnr_vs_time.png and SCENE_psnr_vs_exact.png into OUT (atomically:
-a temporary file renamed into place). Needs Debian's python3-matplotlib.
+a temporary file renamed into place); for the noise sweep SCENE_noise.png,
+for a .blend SCENE_cycles.png. Needs Debian's python3-matplotlib.
 """
 import csv
 import math
@@ -81,6 +82,43 @@ def plot_noise(scene, rows, path):
     save(fig, path)
 
 
+def plot_cycles(scene, rows, path):
+    """dcm bench on a .blend: PSNR against the converged render over wall time,
+    the full Cycles render and each dcm blender variant as curves over their
+    samples per pixel, adaptive sampling as points."""
+    fig, ax = plt.subplots(figsize=(7.5, 5.4))
+    labels = []
+    for r in rows:
+        label = r["label"].rsplit(" spp=", 1)[0]
+        if r["method"] != "adaptive" and label not in labels:
+            labels.append(label)
+    styles = [dict(color="k", marker="s", linestyle="--")] + [
+        dict(color=c, marker="o") for c in ("tab:red", "tab:blue", "tab:green", "tab:purple", "tab:brown")]
+    for label, style in zip(labels, styles):
+        c = sorted((r for r in rows if r["method"] != "adaptive" and r["label"].rsplit(" spp=", 1)[0] == label),
+                   key=lambda r: num(r["spp"]))
+        x, y = [num(r["time_total_s"]) for r in c], [num(r["psnr_db"]) for r in c]
+        ax.plot(x, y, label=label if label != "full Cycles" else "full Cycles render", linewidth=1.4, **style)
+        for r, xi, yi in zip(c, x, y):
+            ax.annotate("%s spp" % r["spp"], (xi, yi), textcoords="offset points", xytext=(5, -11), fontsize=7,
+                        color=style["color"])
+    adaptive = [r for r in rows if r["method"] == "adaptive"]
+    if adaptive:
+        ax.scatter([num(r["time_total_s"]) for r in adaptive], [num(r["psnr_db"]) for r in adaptive], marker="^",
+                   color="tab:orange", s=40, zorder=3, label="Cycles adaptive sampling (noise threshold)")
+        for r in adaptive:
+            ax.annotate(r["label"].rsplit(" spp=", 1)[0].split()[-1], (num(r["time_total_s"]), num(r["psnr_db"])),
+                        textcoords="offset points", xytext=(5, 4), fontsize=7, color="tab:orange")
+    ax.set_xscale("log")
+    ax.set_xlabel("wall clock from the command to the EXR, s (Blender's start-up included)")
+    ax.set_ylabel("PSNR against the converged render, dB (higher is better)")
+    ax.set_title("%s: what accuracy costs in time (Cycles)" % scene)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    save(fig, path)
+
+
 def main(argv):
     if len(argv) < 3:
         print(__doc__, file=sys.stderr)
@@ -95,6 +133,13 @@ def main(argv):
             scenes.append(r["scene"])
     for scene in scenes:
         pts = [r for r in rows if r["scene"] == scene]
+        cycles = [r for r in pts if "cycles" in r["sweeps"].split("|")]
+        if cycles:
+            path = os.path.join(out_dir, "%s_cycles.png" % scene)
+            plot_cycles(scene, cycles, path)
+            if not quiet:
+                print("wrote %s" % path, file=sys.stderr)
+            continue
         noise = [r for r in pts if "noise" in r["sweeps"].split("|")]
         if noise:
             path = os.path.join(out_dir, "%s_noise.png" % scene)

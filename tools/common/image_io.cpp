@@ -113,6 +113,19 @@ Status ReadRgb(const std::string& path, int* width, int* height, std::vector<RGB
   DCM_RETURN_IF_ERROR(CheckImageDimensions(path, spec.width, spec.height, 3));
   int idx[3] = {spec.channelindex("R"), spec.channelindex("G"), spec.channelindex("B")};
   if (idx[0] < 0 || idx[1] < 0 || idx[2] < 0) {
+    // Blender's multilayer EXR: the one layer <view layer>.Combined.
+    std::vector<std::string> combined;
+    for (const auto& n : spec.channelnames) {
+      const std::string suffix = ".Combined.R";
+      if (n.size() > suffix.size() && n.compare(n.size() - suffix.size(), suffix.size(), suffix) == 0) {
+        const std::string layer = n.substr(0, n.size() - 1);
+        if (spec.channelindex(layer + "G") >= 0 && spec.channelindex(layer + "B") >= 0) combined.push_back(layer);
+      }
+    }
+    if (combined.size() == 1)
+      for (int c = 0; c < 3; ++c) idx[c] = spec.channelindex(combined[0] + "RGB"[c]);
+  }
+  if (idx[0] < 0 || idx[1] < 0 || idx[2] < 0) {
     if (spec.nchannels == 1) {
       idx[0] = idx[1] = idx[2] = 0;
     } else {

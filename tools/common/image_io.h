@@ -58,8 +58,9 @@ Status WriteRgb8(const std::string& path, int width, int height, std::span<const
 /// from the header, before allocating. The message names the file.
 Status CheckImageDimensions(const std::string& path, int width, int height, int channels);
 
-/// Reads the R, G, B channels of an image (by channel name; a 1-channel image
-/// is read as gray): the pixels of its data window. The message names the file and what is wrong.
+/// Reads the R, G, B channels of an image (by channel name; without them,
+/// those of its one layer `*.Combined`, Blender's multilayer EXR; a 1-channel
+/// image is read as gray): the pixels of its data window. The message names the file and what is wrong.
 Status ReadRgb(const std::string& path, int* width, int* height, std::vector<RGB>* pixels);
 
 }  // namespace dcm::toolkit

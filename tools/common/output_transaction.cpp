@@ -360,7 +360,10 @@ Status OutputTransaction::MakeFolder(const std::string& folder) {
     if (p == p.parent_path()) break;
   }
   CreationScope scope;
-  for (const auto& p : missing) folders_.push_back({p.string(), Register(p.string(), kFolderSlot)});
+  // Before those of earlier calls: a later folder may lie inside an earlier one.
+  std::vector<std::pair<std::string, int>> made;
+  for (const auto& p : missing) made.push_back({p.string(), Register(p.string(), kFolderSlot)});
+  folders_.insert(folders_.begin(), made.begin(), made.end());
   fs::create_directories(folder, ec);
   if (ec) return Status::Error("cannot create the folder '" + folder + "': " + ec.message());
   return Status::Ok();

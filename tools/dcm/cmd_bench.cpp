@@ -7,6 +7,8 @@
 // upsampling guided by the provider's guides) at the same exact-pixel budgets.
 // Writes bench.csv, bench.json and summary.md (the paper's tables beside ours,
 // the goal check), error heat maps, and the plots (tools/bench/plot_tradeoff.py).
+// A .blend input is measured by bench_cycles.cpp instead: Cycles' full render,
+// `dcm blender` and adaptive sampling at each --spp, timed end to end.
 //
 // Builds only with the Embree plugin (like `dcm render`); AOV inputs only when
 // plugins/aov is available.
@@ -29,6 +31,7 @@
 #include <vector>
 
 #include "dcm/downsample.h"
+#include "bench.h"
 #include "bench_rivals.h"
 #include "commands.h"
 #include "common/image_io.h"
@@ -38,6 +41,7 @@
 #include "common/output_guard.h"
 #include "common/output_transaction.h"
 #include "common/stats_json.h"
+#include "dcm/pipe/run_command.h"
 #include "dcm/pipe/scratch_folder.h"
 #include "dcm/reconstructor.h"
 #include "dcm/embree/embree_provider.h"
@@ -55,58 +59,9 @@
 namespace dcm::cli {
 namespace {
 
+using pipe::ShellQuote;
+
 namespace fs = std::filesystem;
-
-struct BenchFlags {
-  std::vector<std::string> inputs;
-  std::string out;
-  bool quick = false;
-  std::optional<float> scale;
-  std::vector<float> thresholds;
-  int threads = 0;
-  bool noPlots = false;
-  std::string python = "/usr/bin/python3";
-  std::string plotScript;
-  bool quiet = false, verbose = false;
-  // AOV inputs (dense mode).
-  std::string preset = "generic";
-  std::vector<std::string> maps;
-  int downsample = 1;
-  std::optional<float> highlightLevel;  ///< empty: the AOV provider's default
-  bench::JbuParams jbu;
-  // Scenes: scene overrides and the noise sweep.
-  std::vector<std::string> overrides;
-  std::vector<int> spp;
-  std::optional<int> referenceSpp;
-};
-
-/// The settings of one point of the sweep.
-struct Config {
-  std::string method;   ///< dcm | paper | guo | bilinear | jbu | full
-  std::string label;    ///< unique within an input
-  std::string sweeps;   ///< sweeps this point belongs to, '|'-separated
-  ReconstructionOptions options;
-  int supersampling = 1;
-  int spp = 0;  ///< noise sweep: estimates per exact pixel (0: the scene's own)
-  // Rivals: the budget (exact pixels) and the label of the point it matches.
-  int64_t budget = 0;
-  std::string budgetOf;
-};
-
-/// One measured point.
-struct Point {
-  std::string input, scene;
-  Config config;
-  bool rival = false;
-  int64_t exactPixels = 0, totalPixels = 0;
-  double exactFraction = 0;
-  double timeIllumS = 0, timeGuidesS = 0, timeEngineS = 0, timeTotalS = 0;
-  toolkit::ImageError error;
-  /// What the run used (ReconstructionStats::settings): the regime's
-  /// threshold and thin-object test, no centre probes where the provider's
-  /// guides show every hard shadow.
-  ResolvedSettings settings;
-};
 
 /// An input: a scene file or a dense AOV EXR, with a provider factory.
 struct Subject {
@@ -431,9 +386,10 @@ nlohmann::json PointToJson(const Point& p) {
                       {"non_finite", p.error.nonFinite}};
   if (p.rival) {
     j["budget_of"] = p.config.budgetOf;
-  } else if (p.config.method != "full") {
+  } else if (p.config.method != "full" && !p.external) {
     j["options"] = AllOptionsJson(o);
   }
+  j.update(p.extra);
   return j;
 }
 
@@ -459,7 +415,7 @@ std::string CsvQuote(const std::string& s) {
 
 std::string PointToCsv(const Point& p) {
   const auto& o = p.config.options;
-  const bool engine = !p.rival && p.config.method != "full";
+  const bool engine = !p.rival && p.config.method != "full" && !p.external;
   std::ostringstream s;
   s << CsvQuote(p.scene) << ',' << CsvQuote(p.input) << ',' << p.config.method << ',' << CsvQuote(p.config.label)
     << ',' << p.config.sweeps << ',';
@@ -574,12 +530,6 @@ std::string FindPlotScript(const BenchFlags& f) {
   return "";
 }
 
-std::string ShellQuote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
 int Fail(const Status& st, int code = kExitFailure) {
   std::cerr << "dcm bench: error: " << st.message() << "\n";
   return code;
@@ -588,9 +538,36 @@ int Fail(const Status& st, int code = kExitFailure) {
 int RunBench(const BenchFlags& f) {
   std::vector<toolkit::FileArg> inputs;
   for (const auto& in : f.inputs) inputs.push_back({"input", in});
+  if (!f.reference.empty()) inputs.push_back({"--reference", f.reference});
   std::vector<toolkit::FileArg> outputs;
   for (const char* name : {"bench.csv", "bench.json", "summary.md", "*.png"})
     outputs.push_back({"--out", (fs::path(f.out) / name).string(), std::string(name).find('*') != std::string::npos});
+  // .blend inputs: their renders and dcm's stats in OUT/STEM/.
+  const size_t blends = size_t(std::count_if(f.inputs.begin(), f.inputs.end(), IsBlendInput));
+  auto usageError = [](const std::string& why) {
+    std::cerr << "dcm bench: error: " << why << "\n";
+    return kExitUsage;
+  };
+  if (blends == 0) {
+    for (const auto& [given, flag] : {std::pair{!f.reference.empty(), "--reference"}, {!f.adaptive.empty(), "--adaptive"},
+                                      {!f.variants.empty(), "--variant"}, {f.renderThreads != 0, "--render-threads"}})
+      if (given) return usageError(std::string(flag) + " applies to .blend inputs only");
+  } else {
+#ifndef DCM_HAVE_PIPE
+    return usageError("this dcm was built without plugins/pipe: .blend inputs need it");
+#endif
+    if (f.spp.empty()) return usageError(".blend inputs need --spp: the samples per pixel to compare at (e.g. --spp 64,512)");
+    if (!f.reference.empty() && blends > 1) return usageError("--reference needs a single .blend input");
+    std::vector<std::string> stems;
+    for (const auto& in : f.inputs) {
+      if (!IsBlendInput(in)) continue;
+      const std::string stem = fs::path(in).stem().string();
+      if (std::find(stems.begin(), stems.end(), stem) != stems.end())
+        return usageError("two .blend inputs named '" + stem + "': their renders would share --out's folder " + stem);
+      stems.push_back(stem);
+      outputs.push_back({"--out", (fs::path(f.out) / stem / "*").string(), true});
+    }
+  }
   if (Status st = toolkit::CheckOutputs(inputs, outputs); !st.ok()) {
     std::cerr << "dcm bench: error: " << st.message() << "\n";
     return kExitUsage;
@@ -612,6 +589,18 @@ int RunBench(const BenchFlags& f) {
           << (f.quick ? "; --quick" : "") << ".\n\n";
 
   for (const std::string& input : f.inputs) {
+#ifdef DCM_HAVE_PIPE
+    if (IsBlendInput(input)) {
+      const std::string dir = (fs::path(f.out) / fs::path(input).stem()).string();
+      if (Status st = transaction.MakeFolder(dir); !st.ok()) return Fail(Status::Error("--out: " + st.message()));
+      std::vector<Point> pts;
+      nlohmann::json ij;
+      if (Status st = MeasureCycles(f, input, dir, &pts, &summary, &ij); !st.ok()) return Fail(st);
+      inputsJson.push_back(ij);
+      for (auto& p : pts) all.push_back(std::move(p));
+      continue;
+    }
+#endif
     Subject s;
     bool usage = false;
     if (Status st = OpenSubject(f, input, &s, &usage); !st.ok()) return Fail(st, usage ? kExitUsage : kExitFailure);
@@ -949,7 +938,7 @@ int RunBench(const BenchFlags& f) {
     }
     if (!plotNote.empty() && !f.quiet) std::cerr << "dcm bench: warning: " << plotNote << "\n";
     for (const auto& ij : inputsJson) {
-      for (const char* kind : {"psnr_vs_time", "psnr_vs_exact", "noise"}) {
+      for (const char* kind : {"psnr_vs_time", "psnr_vs_exact", "noise", "cycles"}) {
         const std::string name = ij["scene"].get<std::string>() + "_" + kind + ".png";
         if (!staging || !fs::is_regular_file(fs::path(staging->path()) / name, ec)) continue;
         const fs::path from = fs::path(staging->path()) / name;
@@ -991,7 +980,8 @@ Registration reg(
       auto f = std::make_shared<BenchFlags>();
       app->option_defaults()->group(kGroupIo);
       app->add_option("inputs", f->inputs,
-                      DCM_BENCH_HAVE_AOV ? "scene files (JSON) or dense AOV EXRs" : "scene files (JSON)")
+                      DCM_BENCH_HAVE_AOV ? "scene files (JSON), dense AOV EXRs or .blend files (Cycles, with --spp)"
+                                         : "scene files (JSON) or .blend files (Cycles, with --spp)")
           ->required();
       app->add_option("--out", f->out, "output folder (bench.csv, bench.json, summary.md, PNGs)")->required();
       app->add_option("--scale", f->scale, "scale the scenes' resolution (default 1, 0.125 with --quick)")
@@ -1035,12 +1025,28 @@ Registration reg(
       app->option_defaults()->group(kGroupNoise);
       app->add_option("--spp", f->spp,
                       "scenes: the noise sweep instead of the accuracy sweeps: at each number of estimates per "
-                      "pixel (render.samples_per_pixel), full noisy render, dcm, dcm with the noise ignored, paper")
+                      "pixel (render.samples_per_pixel), full noisy render, dcm, dcm with the noise ignored, paper; "
+                      ".blend files: the full Cycles render and dcm blender at each number of samples, timed")
           ->delimiter(',')
           ->transform(Integer(2, 1 << 20));
       app->add_option("--reference-spp", f->referenceSpp,
                       "--spp: estimates per pixel of the reference (default 16x the largest --spp)")
           ->transform(Integer(2, 1 << 20));
+      app->add_option("--reference", f->reference,
+                      ".blend inputs: the converged render to compare with (R,G,B or Blender's Combined layer; "
+                      "default: rendered at --reference-spp with another seed)");
+      app->add_option("--adaptive", f->adaptive,
+                      ".blend inputs: also Cycles' adaptive sampling at these noise thresholds, at the largest --spp")
+          ->delimiter(',')
+          ->transform(FiniteNumber(1e-6, 1));
+      app->add_option("--variant", f->variants,
+                      ".blend inputs: flags of one dcm blender run at each --spp (repeatable, e.g. "
+                      "--variant '--target-psnr 45'; default one run with dcm's defaults)")
+          ->allow_extra_args(false);
+      app->add_option("--blender", f->blender, ".blend inputs: the Blender executable")->capture_default_str();
+      app->add_option("--render-threads", f->renderThreads, ".blend inputs: Cycles threads (0: Blender's choice)")
+          ->transform(Integer(0, kMaxThreads))
+          ->capture_default_str();
       app->option_defaults()->group(kGroupInternals);
       app->add_option("--threads", f->threads, "worker threads (0: all cores)")
           ->transform(Integer(0, kMaxThreads))

@@ -33,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "blender_files.h"
 #include "commands.h"
 #include "common/output_exr.h"
 #include "common/output_guard.h"
@@ -42,6 +43,7 @@
 #include "common/stats_json.h"
 #include "dcm/noise_estimate.h"
 #include "dcm/pipe/pipe_provider.h"
+#include "dcm/pipe/run_command.h"
 #include "dcm/pipe/scratch_folder.h"
 #include "dcm/preview_target.h"
 #include "dcm/quality_preview.h"
@@ -54,6 +56,8 @@
 
 namespace dcm::cli {
 namespace {
+
+using pipe::ShellQuote;
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
@@ -99,77 +103,6 @@ std::string PercentDecoded(const std::string& s) {
 }
 
 double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-/// A word quoted for /bin/sh.
-std::string ShellQuote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-/// The child script: $DCM_BLENDER_CHILD, else installed beside the binary
-/// (../share/dcm/blender), else the source tree's.
-Status FindChildScript(std::string* path) {
-  std::vector<fs::path> candidates;
-  if (const char* env = std::getenv("DCM_BLENDER_CHILD"); env && *env) candidates.push_back(env);
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) candidates.push_back(exe.parent_path().parent_path() / "share/dcm/blender/child_main.py");
-  candidates.push_back(fs::path(DCM_SOURCE_DIR) / "plugins/blender/child_main.py");
-  for (const auto& c : candidates) {
-    if (fs::is_regular_file(c, ec)) {
-      *path = c.string();
-      return Status::Ok();
-    }
-  }
-  return Status::Error("the Blender child script child_main.py is not installed (looked in " +
-                       candidates.back().parent_path().string() + "; set DCM_BLENDER_CHILD)");
-}
-
-/// `name` as an executable: a path, or a name looked up in $PATH.
-Status FindExecutable(const std::string& name, std::string* path) {
-  auto ok = [](const fs::path& p) {
-    std::error_code ec;
-    return fs::is_regular_file(p, ec) && ::access(p.c_str(), X_OK) == 0;
-  };
-  if (name.find('/') != std::string::npos) {
-    if (ok(name)) {
-      *path = name;
-      return Status::Ok();
-    }
-  } else if (const char* env = std::getenv("PATH")) {
-    std::string dirs = env;
-    size_t start = 0;
-    while (start <= dirs.size()) {
-      const size_t end = std::min(dirs.find(':', start), dirs.size());
-      const fs::path p = fs::path(dirs.substr(start, end - start).empty() ? "." : dirs.substr(start, end - start)) / name;
-      if (ok(p)) {
-        *path = p.string();
-        return Status::Ok();
-      }
-      start = end + 1;
-    }
-  }
-  return Status::Error("blender '" + name + "' not found or not executable (--blender PATH; Debian: apt-get install "
-                       "blender)");
-}
-
-/// The scene must be a readable .blend: plain ("BLENDER"), gzip or zstd compressed.
-Status CheckBlendFile(const std::string& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) return Status::Error("'" + path + "': no such file (reading the scene)");
-  if (!fs::is_regular_file(path, ec)) return Status::Error("'" + path + "': not a file (reading the scene)");
-  std::ifstream in(path, std::ios::binary);
-  char head[7] = {};
-  if (!in.read(head, sizeof head))
-    return Status::Error("'" + path + "': cannot read it, or shorter than a .blend header (reading the scene)");
-  const std::string h(head, sizeof head);
-  const bool plain = h == "BLENDER";
-  const bool gzip = uint8_t(h[0]) == 0x1f && uint8_t(h[1]) == 0x8b;
-  const bool zstd = uint8_t(h[0]) == 0x28 && uint8_t(h[1]) == 0xb5 && uint8_t(h[2]) == 0x2f && uint8_t(h[3]) == 0xfd;
-  if (!plain && !gzip && !zstd) return Status::Error("'" + path + "': not a .blend file (reading the scene)");
-  return Status::Ok();
-}
 
 /// Times every call of the exact provider: a round each with the preview schedule.
 class TimedProvider final : public SampleProvider {
@@ -297,8 +230,8 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
                   "' does not exist or is not writable (checking the outputs before rendering)");
   }
   std::string blender, child;
-  if (Status st = FindExecutable(f.blender, &blender); !st.ok()) return Fail(st.message());
-  if (Status st = FindChildScript(&child); !st.ok()) return Fail(st.message());
+  if (Status st = FindBlender(f.blender, &blender); !st.ok()) return Fail(st.message());
+  if (Status st = FindBlenderScript("child_main.py", "DCM_BLENDER_CHILD", &child); !st.ok()) return Fail(st.message());
 
   // Every output of the run appears at its Commit(), or none; a signal ends Blender too.
   toolkit::OutputTransaction outputs;

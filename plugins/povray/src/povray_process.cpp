@@ -13,18 +13,14 @@
 #include <thread>
 
 #include "child_process.h"
+#include "dcm/pipe/run_command.h"
 #include "scratch_dir.h"
 
 namespace dcm::povray {
 
 namespace {
 
-/// `s` as one word of /bin/sh.
-std::string ShellQuote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
+using pipe::ShellQuote;
 
 std::string Dirname(const std::string& path) {
   const size_t slash = path.rfind('/');

@@ -1,0 +1,297 @@
+// dcm bench on a .blend: the noise axis for Cycles. At each number of
+// samples per pixel, the full render of the file and `dcm blender`, each a
+// process of its own timed from the command to its EXR (Blender's start-up
+// included), then Cycles' adaptive sampling at the largest; all against one
+// converged render (bench.h, MeasureCycles).
+#include "bench.h"
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+namespace dcm::cli {
+
+namespace fs = std::filesystem;
+
+bool IsBlendInput(const std::string& input) {
+  std::string ext = fs::path(input).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext == ".blend";
+}
+
+}  // namespace dcm::cli
+
+#ifdef DCM_HAVE_PIPE
+
+#include "blender_files.h"
+#include "common/image_io.h"
+#include "common/output_transaction.h"
+#include "dcm/pipe/pipe_provider.h"
+#include "dcm/pipe/run_command.h"
+#include "dcm/pipe/scratch_folder.h"
+
+namespace dcm::cli {
+
+namespace {
+
+using pipe::ShellQuote;
+
+using Clock = std::chrono::steady_clock;
+
+/// A render may take long (a converged reference at thousands of samples);
+/// a day is a hang.
+constexpr std::chrono::seconds kRunTimeout{24 * 3600};
+
+/// A threshold as written: 0.05, 1e-05.
+std::string Short(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+std::string Fixed(double v, int digits) {
+  if (!std::isfinite(v)) return v > 0 ? "inf" : "–";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+  return buf;
+}
+
+/// The image of `path` (R, G, B or Blender's Combined layer), `what` in
+/// messages; the first image read fixes the size (`*sizeOf` says which).
+Status ReadImage(const std::string& path, const std::string& what, int* w, int* h, std::string* sizeOf,
+                 std::vector<RGB>* rgb) {
+  int iw = 0, ih = 0;
+  if (Status st = toolkit::ReadRgb(path, &iw, &ih, rgb); !st.ok()) return Status::Error(what + ": " + st.message());
+  auto size = [](int x, int y) { return std::to_string(x) + "x" + std::to_string(y); };
+  if (*w == 0) {
+    *w = iw;
+    *h = ih;
+    *sizeOf = what;
+  } else if (iw != *w || ih != *h) {
+    return Status::Error(what + " is " + size(iw, ih) + ", " + *sizeOf + " " + size(*w, *h));
+  }
+  return Status::Ok();
+}
+
+/// The full render's PSNR at wall time `t`, interpolated linearly in log time
+/// between the full renders around it; NaN outside their range.
+double FullPsnrAt(const std::vector<Point>& full, double t) {
+  if (full.size() == 1 && t == full[0].timeTotalS) return full[0].error.psnr;
+  for (size_t i = 0; i + 1 < full.size(); ++i) {
+    const double t0 = full[i].timeTotalS, t1 = full[i + 1].timeTotalS;
+    if (t < std::min(t0, t1) || t > std::max(t0, t1) || t0 <= 0 || t1 <= 0) continue;
+    const double a = t1 == t0 ? 0.0 : std::log(t / t0) / std::log(t1 / t0);
+    return full[i].error.psnr + a * (full[i + 1].error.psnr - full[i].error.psnr);
+  }
+  return std::nan("");
+}
+
+double Number(const nlohmann::json& j, const char* key) {
+  return j.contains(key) && j[key].is_number() ? j[key].get<double>() : std::nan("");
+}
+
+}  // namespace
+
+Status MeasureCycles(const BenchFlags& f, const std::string& input, const std::string& dir,
+                     std::vector<Point>* points, std::ostringstream* summary, nlohmann::json* inputJson) {
+  const bool talk = !f.quiet;
+  const std::string name = fs::path(input).stem().string();
+  std::string blender, script, self;
+  DCM_RETURN_IF_ERROR(CheckBlendFile(input));
+  DCM_RETURN_IF_ERROR(FindBlender(f.blender, &blender));
+  DCM_RETURN_IF_ERROR(FindBlenderScript("render_main.py", "DCM_BLENDER_RENDER", &script));
+  {
+    std::error_code ec;
+    self = fs::read_symlink("/proc/self/exe", ec).string();
+    if (ec) return Status::Error("cannot find this dcm executable (/proc/self/exe): " + ec.message());
+  }
+  // Each run writes into a scratch folder (removed even if dcm is killed);
+  // what it wrote is copied into the output transaction after it.
+  std::unique_ptr<pipe::ScratchFolder> scratch;
+  DCM_RETURN_IF_ERROR(pipe::ScratchFolder::Make("dcm-bench-cycles", &scratch));
+  toolkit::SetSignalHook(pipe::KillAllChildren);
+  auto staged = [&](const std::string& file) { return scratch->path() + "/" + file; };
+  auto keep = [&](const std::string& file) {
+    return toolkit::WriteAtomically((fs::path(dir) / file).string(), [&](const std::string& tmp) {
+      std::error_code ec;
+      fs::copy_file(staged(file), tmp, fs::copy_options::overwrite_existing, ec);
+      return ec ? Status::Error("cannot copy " + staged(file) + ": " + ec.message()) : Status::Ok();
+    });
+  };
+
+  std::vector<int> spps = f.spp;
+  std::sort(spps.begin(), spps.end());
+  spps.erase(std::unique(spps.begin(), spps.end()), spps.end());
+  const int top = spps.back();
+  const int referenceSpp = f.referenceSpp ? *f.referenceSpp : 16 * top;
+
+  // Runs `command` to its end: the seconds from its start to its end.
+  int runs = 0;
+  auto run = [&](const std::string& what, const std::string& command, double* seconds) -> Status {
+    const std::string log = staged("run" + std::to_string(++runs) + ".log");
+    if (talk) std::cerr << "dcm bench: " << name << ": " << what << " ...\n";
+    const auto t0 = Clock::now();
+    Status st = pipe::RunCommand(command, log, kRunTimeout);
+    *seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    if (!st.ok()) return Status::Error(input + ": " + what + ": " + st.message());
+    if (talk) std::cerr << "dcm bench: " << name << ": " << what << ": " << Fixed(*seconds, 2) << " s\n";
+    return Status::Ok();
+  };
+  // The full render of the file as Blender makes it (render_main.py).
+  auto cycles = [&](const std::string& what, int spp, int seedOffset, double adaptive, const std::string& file,
+                    double* seconds) {
+    std::string cmd = ShellQuote(blender) + " -b " + ShellQuote(input) + " --python-exit-code 1 --python " + ShellQuote(script) +
+                      " -- --out " + ShellQuote(staged(file)) + " --samples " + std::to_string(spp);
+    if (seedOffset) cmd += " --seed-offset " + std::to_string(seedOffset);
+    if (adaptive > 0) cmd += " --adaptive-threshold " + Fixed(adaptive, 6);
+    if (f.renderThreads > 0) cmd += " --threads " + std::to_string(f.renderThreads);
+    return run(what, cmd, seconds);
+  };
+
+  int w = 0, h = 0;
+  std::string sizeOf;
+  std::vector<RGB> reference;
+  std::string referenceText;
+  if (!f.reference.empty()) {
+    DCM_RETURN_IF_ERROR(ReadImage(f.reference, "--reference '" + f.reference + "'", &w, &h, &sizeOf, &reference));
+    referenceText = "the converged render " + f.reference;
+  } else {
+    // Another seed: with the file's, the reference's first samples would be
+    // the full renders' own, and their errors against it too small.
+    double seconds = 0;
+    DCM_RETURN_IF_ERROR(cycles("the reference, " + std::to_string(referenceSpp) + " spp", referenceSpp, 1000, 0,
+                               "reference.exr", &seconds));
+    DCM_RETURN_IF_ERROR(ReadImage(staged("reference.exr"), "the reference render", &w, &h, &sizeOf, &reference));
+    DCM_RETURN_IF_ERROR(keep("reference.exr"));
+    referenceText = "a render of " + std::to_string(referenceSpp) + " spp with the file's seed + 1000 (reference.exr, " +
+                    Fixed(seconds, 1) + " s)";
+  }
+
+  auto point = [&](const std::string& method, const std::string& label, int spp) {
+    Point p;
+    p.input = input;
+    p.scene = name;
+    p.external = true;
+    p.config.method = method;
+    p.config.label = label + " spp=" + std::to_string(spp);
+    p.config.sweeps = "cycles";
+    p.config.spp = spp;
+    p.totalPixels = int64_t(w) * h;
+    p.exactPixels = p.totalPixels;
+    p.exactFraction = 1.0;
+    return p;
+  };
+  auto compare = [&](Point* p, const std::string& file) -> Status {
+    std::vector<RGB> img;
+    if (Status st = ReadImage(staged(file), file + " (" + p->config.label + ")", &w, &h, &sizeOf, &img); !st.ok())
+      return Status::Error(input + ": " + st.message());
+    p->error = toolkit::Compare(img, reference, w, h);
+    return keep(file);
+  };
+  const std::vector<std::string> variants = f.variants.empty() ? std::vector<std::string>{""} : f.variants;
+  std::vector<Point> pts, full;
+  for (int spp : spps) {
+    Point p = point("full", "full Cycles", spp);
+    const std::string file = "full_" + std::to_string(spp) + ".exr";
+    DCM_RETURN_IF_ERROR(cycles("full render, " + std::to_string(spp) + " spp", spp, 0, 0, file, &p.timeTotalS));
+    DCM_RETURN_IF_ERROR(compare(&p, file));
+    full.push_back(p);
+    pts.push_back(p);
+    for (size_t v = 0; v < variants.size(); ++v) {
+      const std::string label = variants[v].empty() ? "dcm blender" : "dcm blender " + variants[v];
+      Point d = point("dcm blender", label, spp);
+      const std::string stem = "dcm" + (variants.size() > 1 ? std::to_string(v) : std::string()) + "_" +
+                               std::to_string(spp);
+      const std::string cmd = ShellQuote(self) + " blender " + ShellQuote(input) + " -q -o " + ShellQuote(staged(stem + ".exr")) +
+                              " --stats " + ShellQuote(staged(stem + ".json")) + " --samples " + std::to_string(spp) +
+                              " --blender " + ShellQuote(blender) +
+                              (f.renderThreads > 0 ? " --render-threads " + std::to_string(f.renderThreads) : "") +
+                              (variants[v].empty() ? "" : " " + variants[v]);
+      DCM_RETURN_IF_ERROR(run(label + ", " + std::to_string(spp) + " spp", cmd, &d.timeTotalS));
+      DCM_RETURN_IF_ERROR(compare(&d, stem + ".exr"));
+      nlohmann::json stats;
+      try {
+        std::ifstream in(staged(stem + ".json"));
+        stats = nlohmann::json::parse(in);
+      } catch (const std::exception& e) {
+        return Status::Error(input + ": " + label + ": its stats are not JSON: " + e.what());
+      }
+      DCM_RETURN_IF_ERROR(keep(stem + ".json"));
+      d.exactFraction = Number(stats, "exact_fraction");
+      d.exactPixels = int64_t(std::llround(d.exactFraction * double(d.totalPixels)));
+      const nlohmann::json b = stats.value("blender", nlohmann::json::object());
+      d.timeIllumS = Number(b, "rounds_s");
+      d.timeGuidesS = Number(b, "guides_s") + Number(b, "preview_s");
+      d.timeEngineS = Number(b, "engine_s");
+      d.extra = {{"flags", variants[v]},
+                 {"estimated_psnr", Number(stats, "estimated_psnr")},
+                 {"startup_s", Number(b, "startup_s")},
+                 {"stats", stem + ".json"}};
+      pts.push_back(d);
+    }
+  }
+  for (double t : f.adaptive) {
+    Point p = point("adaptive", "adaptive " + Short(t), top);
+    p.exactFraction = std::nan("");  // every pixel, each with as many samples as it needs
+    p.exactPixels = 0;
+    const std::string file = "adaptive_" + Short(t) + ".exr";
+    DCM_RETURN_IF_ERROR(cycles("adaptive sampling " + Short(t) + ", " + std::to_string(top) + " spp at most", top,
+                               0, t, file, &p.timeTotalS));
+    DCM_RETURN_IF_ERROR(compare(&p, file));
+    p.extra = {{"adaptive_threshold", t}};
+    pts.push_back(p);
+  }
+
+  // The table: each run beside the full render at its samples and at its wall time.
+  *summary << "## " << name << " (" << input << "): Cycles\n\n"
+           << w << "x" << h << ", the file's settings but the samples (adaptive sampling and denoising off unless "
+           << "named). Each row is one run, timed from the command to its EXR (Blender's start-up included), in the "
+           << "order of the table. PSNR, display-referred, against " << referenceText << ".\n\n"
+           << "| spp | method | exact % | PSNR dB | SSIM | wall s | speed-up | the full render at this wall time |\n"
+           << "|---|---|---|---|---|---|---|---|\n";
+  for (const Point& p : pts) {
+    const Point* same = nullptr;
+    for (const Point& q : full)
+      if (q.config.spp == p.config.spp) same = &q;
+    const double atTime = FullPsnrAt(full, p.timeTotalS);
+    std::string cell;
+    if (p.config.method != "full" && std::isfinite(atTime)) {
+      cell = Fixed(atTime, 2) + " dB (" + (p.error.psnr >= atTime ? "+" : "") + Fixed(p.error.psnr - atTime, 2) + ")";
+    } else if (p.config.method != "full") {
+      const auto [fastest, slowest] = std::minmax_element(
+          full.begin(), full.end(), [](const Point& a, const Point& b) { return a.timeTotalS < b.timeTotalS; });
+      const bool faster = p.timeTotalS < fastest->timeTotalS;
+      const Point& end = faster ? *fastest : *slowest;
+      cell = std::string(faster ? "faster" : "slower") + " than the " + std::to_string(end.config.spp) +
+             "-spp render's " + Fixed(end.timeTotalS, 2) + " s";
+    }
+    *summary << "| " << p.config.spp << " | " << p.config.label.substr(0, p.config.label.rfind(" spp=")) << " | "
+             << (std::isfinite(p.exactFraction) ? Fixed(100 * p.exactFraction, 2) : "adaptive") << " | "
+             << Fixed(p.error.psnr, 2) << " | " << Fixed(p.error.ssim, 4) << " | " << Fixed(p.timeTotalS, 2) << " | "
+             << (same && p.timeTotalS > 0 ? Fixed(same->timeTotalS / p.timeTotalS, 2) + "x" : "") << " | " << cell
+             << " |\n";
+  }
+  *summary << "\nSpeed-up: the full render at the same samples (adaptive sampling: at its largest) over this run's "
+              "wall time. The full render at this wall time: its PSNR interpolated in log time between the full "
+              "renders around it, and this run's PSNR less it.\n\n";
+  *inputJson = {{"input", input},
+                {"scene", name},
+                {"kind", "blend"},
+                {"resolution", {w, h}},
+                {"reference", f.reference.empty() ? "reference.exr" : f.reference},
+                {"reference_spp", f.reference.empty() ? nlohmann::json(referenceSpp) : nlohmann::json(nullptr)},
+                {"spp", spps},
+                {"variants", variants},
+                {"adaptive", f.adaptive},
+                {"blender", blender}};
+  for (auto& p : pts) points->push_back(std::move(p));
+  return Status::Ok();
+}
+
+}  // namespace dcm::cli
+
+#endif  // DCM_HAVE_PIPE
