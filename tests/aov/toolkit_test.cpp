@@ -154,6 +154,52 @@ TEST(ImageIo, TransactionPutsAllOutputsInPlaceAtCommitOrNone) {
   EXPECT_EQ(dir.Files(), (std::vector<std::string>{"a.exr", "b.json"}));
 }
 
+// A folder made inside one an earlier MakeFolder call made (dcm bench's
+// OUT/SCENE): without a commit both go, the inner one first.
+TEST(ImageIo, TransactionRemovesNestedFoldersItMade) {
+  ScratchDir dir;
+  const fs::path out = fs::path(dir / "out"), inner = out / "scene";
+  {
+    toolkit::OutputTransaction run;
+    ASSERT_TRUE(run.MakeFolder(out.string()).ok());
+    ASSERT_TRUE(run.MakeFolder(inner.string()).ok());
+    ASSERT_TRUE(fs::is_directory(inner));
+  }
+  EXPECT_FALSE(fs::exists(out)) << "the outer folder stayed behind";
+}
+
+// Blender's multilayer EXR: without R, G, B, the one layer *.Combined is the image.
+TEST(ImageIo, ReadRgbTakesBlendersCombinedLayer) {
+  ScratchDir dir;
+  auto write = [&](const std::string& name, const std::vector<std::string>& channels) {
+    OIIO::ImageSpec spec(2, 1, int(channels.size()), OIIO::TypeDesc::FLOAT);
+    spec.channelnames = channels;
+    std::vector<float> px(2 * channels.size());
+    for (size_t c = 0; c < channels.size(); ++c) px[c] = px[channels.size() + c] = float(c + 1);
+    const std::string path = dir / name;
+    auto o = OIIO::ImageOutput::create(path);
+    EXPECT_TRUE(o && o->open(path, spec) && o->write_image(OIIO::TypeDesc::FLOAT, px.data()) && o->close());
+    return path;
+  };
+  // OpenEXR sorts the channels by name: Combined's R, G, B are not the first three.
+  const std::string one = write("one.exr", {"ViewLayer.Combined.A", "ViewLayer.Combined.B", "ViewLayer.Combined.G",
+                                            "ViewLayer.Combined.R", "ViewLayer.Depth.Z"});
+  int w = 0, h = 0;
+  std::vector<RGB> rgb;
+  ASSERT_TRUE(toolkit::ReadRgb(one, &w, &h, &rgb).ok());
+  ASSERT_EQ(rgb.size(), 2u);
+  EXPECT_EQ(rgb[1].r, 4.f);  // the value written to ViewLayer.Combined.R
+  EXPECT_EQ(rgb[1].g, 3.f);
+  EXPECT_EQ(rgb[1].b, 2.f);
+  // Two view layers: which is meant is not known; the message lists the channels.
+  const std::string two = write("two.exr", {"A.Combined.R", "A.Combined.G", "A.Combined.B", "B.Combined.R",
+                                            "B.Combined.G", "B.Combined.B"});
+  const Status st = toolkit::ReadRgb(two, &w, &h, &rgb);
+  ASSERT_FALSE(st.ok());
+  EXPECT_THAT(st.message(), HasSubstr("two.exr"));
+  EXPECT_THAT(st.message(), HasSubstr("B.Combined.R"));
+}
+
 // SIGTERM while two threads write outputs without pause: whichever thread
 // takes the signal, and wherever the other one is in its write, no temporary
 // is left. Many trials at random moments, since a miss is a narrow window.

@@ -110,6 +110,11 @@ def plot_cycles(scene, rows, path):
             ax.annotate(r["label"].rsplit(" spp=", 1)[0].split()[-1], (num(r["time_total_s"]), num(r["psnr_db"])),
                         textcoords="offset points", xytext=(5, 4), fontsize=7, color="tab:orange")
     ax.set_xscale("log")
+    # Seconds as numbers at 1, 2, 5 x 10^k: a few seconds to minutes rarely span a decade.
+    from matplotlib.ticker import FormatStrFormatter, LogLocator, NullFormatter
+    ax.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+    ax.xaxis.set_major_formatter(FormatStrFormatter("%g"))
+    ax.xaxis.set_minor_formatter(NullFormatter())
     ax.set_xlabel("wall clock from the command to the EXR, s (Blender's start-up included)")
     ax.set_ylabel("PSNR against the converged render, dB (higher is better)")
     ax.set_title("%s: what accuracy costs in time (Cycles)" % scene)

@@ -45,6 +45,7 @@ struct BenchFlags {
   std::vector<std::string> variants;     ///< dcm blender flags, one run per entry and spp
   std::string blender = "blender";
   int renderThreads = 0;                 ///< Cycles threads (0: Blender's choice)
+  int repeat = 1;                        ///< times each run is timed (the median)
 };
 
 /// The settings of one point of the sweep.

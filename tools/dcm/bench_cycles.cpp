@@ -129,27 +129,36 @@ Status MeasureCycles(const BenchFlags& f, const std::string& input, const std::s
   const int top = spps.back();
   const int referenceSpp = f.referenceSpp ? *f.referenceSpp : 16 * top;
 
-  // Runs `command` to its end: the seconds from its start to its end.
+  // Runs `command` to its end `times` times: the median of the seconds from
+  // its start to its end (a render's are the same images each time).
   int runs = 0;
-  auto run = [&](const std::string& what, const std::string& command, double* seconds) -> Status {
-    const std::string log = staged("run" + std::to_string(++runs) + ".log");
-    if (talk) std::cerr << "dcm bench: " << name << ": " << what << " ...\n";
-    const auto t0 = Clock::now();
-    Status st = pipe::RunCommand(command, log, kRunTimeout);
-    *seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-    if (!st.ok()) return Status::Error(input + ": " + what + ": " + st.message());
-    if (talk) std::cerr << "dcm bench: " << name << ": " << what << ": " << Fixed(*seconds, 2) << " s\n";
+  auto run = [&](const std::string& what, const std::string& command, int times, double* seconds,
+                 std::vector<double>* all) -> Status {
+    std::vector<double> t;
+    for (int i = 0; i < times; ++i) {
+      const std::string log = staged("run" + std::to_string(++runs) + ".log");
+      const std::string step = what + (times > 1 ? " (" + std::to_string(i + 1) + " of " + std::to_string(times) + ")" : "");
+      if (talk) std::cerr << "dcm bench: " << name << ": " << step << " ...\n";
+      const auto t0 = Clock::now();
+      Status st = pipe::RunCommand(command, log, kRunTimeout);
+      t.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
+      if (!st.ok()) return Status::Error(input + ": " + step + ": " + st.message());
+      if (talk) std::cerr << "dcm bench: " << name << ": " << step << ": " << Fixed(t.back(), 2) << " s\n";
+    }
+    if (all) *all = t;
+    std::sort(t.begin(), t.end());
+    *seconds = t.size() % 2 ? t[t.size() / 2] : (t[t.size() / 2 - 1] + t[t.size() / 2]) / 2;
     return Status::Ok();
   };
   // The full render of the file as Blender makes it (render_main.py).
   auto cycles = [&](const std::string& what, int spp, int seedOffset, double adaptive, const std::string& file,
-                    double* seconds) {
+                    int times, double* seconds, std::vector<double>* all) {
     std::string cmd = ShellQuote(blender) + " -b " + ShellQuote(input) + " --python-exit-code 1 --python " + ShellQuote(script) +
                       " -- --out " + ShellQuote(staged(file)) + " --samples " + std::to_string(spp);
     if (seedOffset) cmd += " --seed-offset " + std::to_string(seedOffset);
     if (adaptive > 0) cmd += " --adaptive-threshold " + Fixed(adaptive, 6);
     if (f.renderThreads > 0) cmd += " --threads " + std::to_string(f.renderThreads);
-    return run(what, cmd, seconds);
+    return run(what, cmd, times, seconds, all);
   };
 
   int w = 0, h = 0;
@@ -164,7 +173,7 @@ Status MeasureCycles(const BenchFlags& f, const std::string& input, const std::s
     // the full renders' own, and their errors against it too small.
     double seconds = 0;
     DCM_RETURN_IF_ERROR(cycles("the reference, " + std::to_string(referenceSpp) + " spp", referenceSpp, 1000, 0,
-                               "reference.exr", &seconds));
+                               "reference.exr", 1, &seconds, nullptr));
     DCM_RETURN_IF_ERROR(ReadImage(staged("reference.exr"), "the reference render", &w, &h, &sizeOf, &reference));
     DCM_RETURN_IF_ERROR(keep("reference.exr"));
     referenceText = "a render of " + std::to_string(referenceSpp) + " spp with the file's seed + 1000 (reference.exr, " +
@@ -197,8 +206,11 @@ Status MeasureCycles(const BenchFlags& f, const std::string& input, const std::s
   for (int spp : spps) {
     Point p = point("full", "full Cycles", spp);
     const std::string file = "full_" + std::to_string(spp) + ".exr";
-    DCM_RETURN_IF_ERROR(cycles("full render, " + std::to_string(spp) + " spp", spp, 0, 0, file, &p.timeTotalS));
+    std::vector<double> times;
+    DCM_RETURN_IF_ERROR(
+        cycles("full render, " + std::to_string(spp) + " spp", spp, 0, 0, file, f.repeat, &p.timeTotalS, &times));
     DCM_RETURN_IF_ERROR(compare(&p, file));
+    p.extra = {{"times_s", times}};
     full.push_back(p);
     pts.push_back(p);
     for (size_t v = 0; v < variants.size(); ++v) {
@@ -211,7 +223,8 @@ Status MeasureCycles(const BenchFlags& f, const std::string& input, const std::s
                               " --blender " + ShellQuote(blender) +
                               (f.renderThreads > 0 ? " --render-threads " + std::to_string(f.renderThreads) : "") +
                               (variants[v].empty() ? "" : " " + variants[v]);
-      DCM_RETURN_IF_ERROR(run(label + ", " + std::to_string(spp) + " spp", cmd, &d.timeTotalS));
+      std::vector<double> dcmTimes;
+      DCM_RETURN_IF_ERROR(run(label + ", " + std::to_string(spp) + " spp", cmd, f.repeat, &d.timeTotalS, &dcmTimes));
       DCM_RETURN_IF_ERROR(compare(&d, stem + ".exr"));
       nlohmann::json stats;
       try {
@@ -228,6 +241,7 @@ Status MeasureCycles(const BenchFlags& f, const std::string& input, const std::s
       d.timeGuidesS = Number(b, "guides_s") + Number(b, "preview_s");
       d.timeEngineS = Number(b, "engine_s");
       d.extra = {{"flags", variants[v]},
+                 {"times_s", dcmTimes},
                  {"estimated_psnr", Number(stats, "estimated_psnr")},
                  {"startup_s", Number(b, "startup_s")},
                  {"stats", stem + ".json"}};
@@ -239,10 +253,11 @@ Status MeasureCycles(const BenchFlags& f, const std::string& input, const std::s
     p.exactFraction = std::nan("");  // every pixel, each with as many samples as it needs
     p.exactPixels = 0;
     const std::string file = "adaptive_" + Short(t) + ".exr";
+    std::vector<double> times;
     DCM_RETURN_IF_ERROR(cycles("adaptive sampling " + Short(t) + ", " + std::to_string(top) + " spp at most", top,
-                               0, t, file, &p.timeTotalS));
+                               0, t, file, f.repeat, &p.timeTotalS, &times));
     DCM_RETURN_IF_ERROR(compare(&p, file));
-    p.extra = {{"adaptive_threshold", t}};
+    p.extra = {{"adaptive_threshold", t}, {"times_s", times}};
     pts.push_back(p);
   }
 
@@ -250,7 +265,8 @@ Status MeasureCycles(const BenchFlags& f, const std::string& input, const std::s
   *summary << "## " << name << " (" << input << "): Cycles\n\n"
            << w << "x" << h << ", the file's settings but the samples (adaptive sampling and denoising off unless "
            << "named). Each row is one run, timed from the command to its EXR (Blender's start-up included), in the "
-           << "order of the table. PSNR, display-referred, against " << referenceText << ".\n\n"
+           << "order of the table" << (f.repeat > 1 ? ", each " + std::to_string(f.repeat) + " times (the median)" : "")
+           << ". PSNR, display-referred, against " << referenceText << ".\n\n"
            << "| spp | method | exact % | PSNR dB | SSIM | wall s | speed-up | the full render at this wall time |\n"
            << "|---|---|---|---|---|---|---|---|\n";
   for (const Point& p : pts) {

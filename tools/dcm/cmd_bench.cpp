@@ -550,7 +550,8 @@ int RunBench(const BenchFlags& f) {
   };
   if (blends == 0) {
     for (const auto& [given, flag] : {std::pair{!f.reference.empty(), "--reference"}, {!f.adaptive.empty(), "--adaptive"},
-                                      {!f.variants.empty(), "--variant"}, {f.renderThreads != 0, "--render-threads"}})
+                                      {!f.variants.empty(), "--variant"}, {f.renderThreads != 0, "--render-threads"},
+                                      {f.repeat != 1, "--repeat"}})
       if (given) return usageError(std::string(flag) + " applies to .blend inputs only");
   } else {
 #ifndef DCM_HAVE_PIPE
@@ -1044,6 +1045,9 @@ Registration reg(
                       "--variant '--target-psnr 45'; default one run with dcm's defaults)")
           ->allow_extra_args(false);
       app->add_option("--blender", f->blender, ".blend inputs: the Blender executable")->capture_default_str();
+      app->add_option("--repeat", f->repeat, ".blend inputs: time each run N times, back to back (the median)")
+          ->transform(Integer(1, 100))
+          ->capture_default_str();
       app->add_option("--render-threads", f->renderThreads, ".blend inputs: Cycles threads (0: Blender's choice)")
           ->transform(Integer(0, kMaxThreads))
           ->capture_default_str();
