@@ -63,7 +63,7 @@ endfunction()
 
 run("cmake --install" ${CMAKE_COMMAND} --install "${DCM_BUILD_DIR}" --prefix "${_prefix}")
 foreach(_f include/dcm/dcm.h include/dcm/reconstructor.h lib/libdcm.so bin/dcm lib/cmake/dcm/dcmConfig.cmake
-           lib/pkgconfig/dcm.pc)
+           lib/pkgconfig/dcm.pc share/dcm/blender/child_main.py share/dcm/blender/render_main.py)
   if(NOT EXISTS "${_prefix}/${_f}")
     message(FATAL_ERROR "not installed: ${_f}")
   endif()

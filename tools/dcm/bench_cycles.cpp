@@ -153,7 +153,8 @@ Status MeasureCycles(const BenchFlags& f, const std::string& input, const std::s
   // The full render of the file as Blender makes it (render_main.py).
   auto cycles = [&](const std::string& what, int spp, int seedOffset, double adaptive, const std::string& file,
                     int times, double* seconds, std::vector<double>* all) {
-    std::string cmd = ShellQuote(blender) + " -b " + ShellQuote(input) + " --python-exit-code 1 --python " + ShellQuote(script) +
+    // Blender's own session folder in the scratch folder: gone with it, also when Blender is killed.
+    std::string cmd = "TMPDIR=" + ShellQuote(scratch->path()) + " " + ShellQuote(blender) + " -b " + ShellQuote(input) + " --python-exit-code 1 --python " + ShellQuote(script) +
                       " -- --out " + ShellQuote(staged(file)) + " --samples " + std::to_string(spp);
     if (seedOffset) cmd += " --seed-offset " + std::to_string(seedOffset);
     if (adaptive > 0) cmd += " --adaptive-threshold " + Fixed(adaptive, 6);
