@@ -14,7 +14,6 @@ import shutil
 import signal
 import subprocess
 import sys
-import tempfile
 import time
 
 import numpy as np
@@ -148,21 +147,5 @@ def errors(dcm, blender, src, tmp):
         shutil.rmtree(out, ignore_errors=True)
 
 
-def main():
-    dcm, blender, src, what = sys.argv[1:5]
-    if not shutil.which(blender):
-        print("blender not found: skipped")
-        return 77
-    tmp = tempfile.mkdtemp(prefix="dcm-bench-test-")
-    os.environ["TMPDIR"] = os.path.join(tmp, "tmpdir")
-    os.mkdir(os.environ["TMPDIR"])
-    try:
-        {"run": run, "errors": errors}[what](dcm, blender, src, tmp)
-        print("ok")
-        return 0
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
-
-
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(bs.main({"run": run, "errors": errors}, "dcm-bench-test-"))

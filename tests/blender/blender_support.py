@@ -101,3 +101,25 @@ class Child:
         self.p.stdin.write(b"quit\n")
         self.p.stdin.close()
         return self.p.wait(timeout=60)
+
+
+def main(cases, prefix):
+    """`SCRIPT DCM BLENDER SOURCE_DIR CASE`: runs cases[CASE](dcm, blender, src, tmp) in a
+    temporary folder (removed after), every Blender's session folder in it; exit 77 when
+    Blender is missing."""
+    import shutil
+    import sys
+    import tempfile
+    dcm, blender, src, what = sys.argv[1:5]
+    if not shutil.which(blender):
+        print("blender not found: skipped")
+        return 77
+    tmp = tempfile.mkdtemp(prefix=prefix)
+    os.environ["TMPDIR"] = os.path.join(tmp, "tmpdir")
+    os.mkdir(os.environ["TMPDIR"])
+    try:
+        cases[what](dcm, blender, src, tmp)
+        print("ok")
+        return 0
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)

@@ -12,11 +12,9 @@ Exit 77 (skipped) when Blender is missing."""
 import hashlib
 import json
 import os
-import shutil
 import signal
 import subprocess
 import sys
-import tempfile
 import time
 
 import numpy as np
@@ -370,23 +368,6 @@ def signalled(dcm, blender, blend, out, scratch):
         assert not os.path.exists(out), sig
 
 
-def main():
-    dcm, blender, src, what = sys.argv[1:5]
-    if not shutil.which(blender):
-        print("blender not found: skipped")
-        return 77
-    tmp = tempfile.mkdtemp(prefix="dcm-blender-test-")
-    # Every Blender this test starts makes its session folder here, removed with tmp.
-    os.environ["TMPDIR"] = os.path.join(tmp, "tmpdir")
-    os.mkdir(os.environ["TMPDIR"])
-    try:
-        {"exact": exact, "variance": variance, "quality": quality, "preview_target": preview_target,
-         "errors": errors}[what](dcm, blender, src, tmp)
-        print("ok")
-        return 0
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
-
-
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(bs.main({"exact": exact, "variance": variance, "quality": quality,
+                      "preview_target": preview_target, "errors": errors}, "dcm-blender-test-"))
