@@ -138,17 +138,13 @@ def main(argv):
             scenes.append(r["scene"])
     for scene in scenes:
         pts = [r for r in rows if r["scene"] == scene]
-        cycles = [r for r in pts if "cycles" in r["sweeps"].split("|")]
-        if cycles:
-            path = os.path.join(out_dir, "%s_cycles.png" % scene)
-            plot_cycles(scene, cycles, path)
-            if not quiet:
-                print("wrote %s" % path, file=sys.stderr)
-            continue
-        noise = [r for r in pts if "noise" in r["sweeps"].split("|")]
-        if noise:
-            path = os.path.join(out_dir, "%s_noise.png" % scene)
-            plot_noise(scene, noise, path)
+        # A .blend's sweep (Cycles) or the noise sweep: one plot of its own instead of the trade-off pair.
+        special = next(((sweep, plot) for sweep, plot in (("cycles", plot_cycles), ("noise", plot_noise))
+                        if any(sweep in r["sweeps"].split("|") for r in pts)), None)
+        if special:
+            sweep, plot = special
+            path = os.path.join(out_dir, "%s_%s.png" % (scene, sweep))
+            plot(scene, [r for r in pts if sweep in r["sweeps"].split("|")], path)
             if not quiet:
                 print("wrote %s" % path, file=sys.stderr)
             continue

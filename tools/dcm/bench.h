@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -80,6 +81,13 @@ struct Point {
   /// estimated_psnr, the times of its phases; Cycles: the adaptive threshold).
   nlohmann::json extra = nlohmann::json::object();
 };
+
+/// `v` formatted by the printf format `fmt` (one double).
+inline std::string Fmt(const char* fmt, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, fmt, v);
+  return buf;
+}
 
 /// True for a .blend input (measured by MeasureCycles).
 bool IsBlendInput(const std::string& input);

@@ -46,13 +46,6 @@ using Clock = std::chrono::steady_clock;
 /// a day is a hang.
 constexpr std::chrono::seconds kRunTimeout{24 * 3600};
 
-/// A threshold as written: 0.05, 1e-05.
-std::string Short(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
 std::string Fixed(double v, int digits) {
   if (!std::isfinite(v)) return v > 0 ? "inf" : "–";
   char buf[64];
@@ -250,12 +243,12 @@ Status MeasureCycles(const BenchFlags& f, const std::string& input, const std::s
     }
   }
   for (double t : f.adaptive) {
-    Point p = point("adaptive", "adaptive " + Short(t), top);
+    Point p = point("adaptive", "adaptive " + Fmt("%g", t), top);
     p.exactFraction = std::nan("");  // every pixel, each with as many samples as it needs
     p.exactPixels = 0;
-    const std::string file = "adaptive_" + Short(t) + ".exr";
+    const std::string file = "adaptive_" + Fmt("%g", t) + ".exr";
     std::vector<double> times;
-    DCM_RETURN_IF_ERROR(cycles("adaptive sampling " + Short(t) + ", " + std::to_string(top) + " spp at most", top,
+    DCM_RETURN_IF_ERROR(cycles("adaptive sampling " + Fmt("%g", t) + ", " + std::to_string(top) + " spp at most", top,
                                0, t, file, f.repeat, &p.timeTotalS, &times));
     DCM_RETURN_IF_ERROR(compare(&p, file));
     p.extra = {{"adaptive_threshold", t}, {"times_s", times}};

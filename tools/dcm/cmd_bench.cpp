@@ -77,12 +77,6 @@ struct Subject {
   std::map<std::pair<int, int>, std::unique_ptr<SampleProvider>> providers;
 };
 
-std::string Fmt(const char* fmt, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, fmt, v);
-  return buf;
-}
-
 std::string Join(const std::vector<std::string>& v, const char* sep = ",") {
   std::string s;
   for (const auto& e : v) s += (s.empty() ? "" : sep) + e;
