@@ -44,7 +44,8 @@ bool CanTargetFromPreview(SampleProvider& preview, const PreviewScheduleOptions&
 
 double RenderPsnrFromPreview(SampleProvider& preview, const PreviewScheduleOptions& schedule) {
   const double own = PreviewNoisePsnr(preview, schedule.previewOwnVariance);
-  return schedule.exactVarianceShare > 0 ? own - 10 * std::log10(schedule.exactVarianceShare) : HUGE_VAL;
+  const double share = ExactVarianceShare(schedule);
+  return share > 0 ? own - 10 * std::log10(share) : HUGE_VAL;
 }
 
 Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& preview,
@@ -66,8 +67,8 @@ Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& pre
   PreviewTargetStats& s = stats ? *stats : local;
   s = PreviewTargetStats{};
   try {
-    s.renderPsnr = RenderPsnrFromPreview(preview, schedule);
-    s.beyondRender = !(targetPsnr <= s.renderPsnr - kRenderNoiseMarginDb);
+    s.renderPsnrAtStart = RenderPsnrFromPreview(preview, schedule);
+    s.beyondRender = !(targetPsnr <= s.renderPsnrAtStart - kRenderNoiseMarginDb);
     PlanningProvider planning(exact, preview);
     ReconstructionOptions o = options;
     const double defaultThreshold = double(ResolveSettings(options, caps).contrastThreshold);
@@ -98,6 +99,8 @@ Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& pre
       reached = e.low >= targetPsnr;
       if (flat >= 2) break;
     }
+    // With the exact pixels' noise measured on the rounds, where it was.
+    s.renderPsnr = RenderPsnrFromPreview(preview, schedule);
     s.renderedPixels = planning.KnownCount();
     // As ReconstructToQuality's: the cost of every run (with noisy samples a
     // pixel an earlier run rendered is interpolated again, and still paid for).

@@ -48,6 +48,11 @@ RoundSchedule ChooseSchedule(const RoundCost& cost, double latencySamplesThresho
                                                                    : RoundSchedule::kLevels;
 }
 
+double ExactVarianceShare(const PreviewScheduleOptions& schedule) {
+  const double measured = schedule.measuredExactVarianceShare ? schedule.measuredExactVarianceShare() : 0.0;
+  return measured > 0 && std::isfinite(measured) ? measured : schedule.exactVarianceShare;
+}
+
 Status CheckPreviewSchedule(SampleProvider& exact, SampleProvider& preview, const ReconstructionOptions& options,
                             const PreviewScheduleOptions& schedule) {
   if (schedule.maxRounds < 1)
@@ -140,7 +145,7 @@ Status FinishPreviewRun(PlanningProvider& planning, SampleProvider& preview, con
     const auto start = std::chrono::steady_clock::now();
     DCM_RETURN_IF_ERROR(CorrectTowardPreview(preview, schedule.correctionRadius, options.downsample, out,
                                              &stats->correction, schedule.previewOwnVariance,
-                                             schedule.exactVarianceShare,
+                                             ExactVarianceShare(schedule),
                                              out->stats.settings.split ? std::span<const RGB>(
                                                                              schedule.previewTextureCovariance)
                                                                        : std::span<const RGB>()));

@@ -64,6 +64,7 @@ class Child:
         self.width, self.height = int(kv["width"]), int(kv["height"])
         self.caps = kv["caps"].split(",")
         self.round_latency, self.sample_cost = float(kv["round_latency"]), float(kv["sample_cost"])
+        self.preview_samples = int(kv["preview_samples"])
 
     def _ask(self, request):
         self.p.stdin.write(request)

@@ -39,6 +39,9 @@ def main():
         assert (child.width, child.height) == (w, h), (child.width, child.height)
         assert "preview" in child.caps and "split" in child.caps, child.caps
         assert child.round_latency > 0 and child.sample_cost > 0, child.hello
+        # 16 samples: a sixteenth would be 1; the preview takes 8, the floor below which
+        # its error estimate is biased by the sRGB curve (docs/BLENDER.md).
+        assert child.preview_samples == 8, child.hello
 
         ids, shaders, tau, normal = child.guides()
         # Floor, cube, the two spheres, the shade and the sky: six objects and materials.
@@ -84,7 +87,7 @@ def main():
 
         # With halves the texture guide is the mean of the two guide renders' DiffCol, and the
         # preview carries its covariance with L, (tau_A - tau_B)(L_A - L_B) nA nB / N^2, as the
-        # variance (L_A - L_B)^2 nA nB / N^2 (16 samples: 8 + 8).
+        # variance (L_A - L_B)^2 nA nB / N^2 (8 preview samples: 4 + 4).
         keep_h = os.path.join(tmp, "renders_halves")
         child = bs.Child(blender, src, blend, ["--variance-halves", "--keep-renders", keep_h])
         assert "texture_covariance" in child.caps and "variance" in child.caps, child.caps

@@ -101,10 +101,20 @@ def variance(dcm, blender, src, tmp):
         assert b["variance"] == ("halves" if used else "halves, not used"), b
         # The variance reached the engine: it runs its noise regime.
         assert j["settings"]["noisy"] == used, j["settings"]
+        # The first round (256 pixels or more) measures the exact pixels' variance against
+        # the preview's, used or not: 16 samples against 8 assume half, and leave less
+        # noise than the preview's (1) but some (0). A preview of 16 samples is the same
+        # two renders as the exact pixels: the same variance (float sums: 1e-6).
+        share = b["exact_noise_share"]
+        assert b["rounds"][0]["pixels"] >= 256 and share["pixels"] == b["rounds"][0]["pixels"], (share, b["rounds"])
+        if name == "exact preview":
+            assert share["assumed"] == 1 and abs(share["measured"] - 1) < 1e-6, share
+        else:
+            assert share["assumed"] == 0.5 and 0 < share["measured"] < 1, share
         runs[name] = (bs.read_exr(out)[0], exact_mask(smap, h, w), j)
-    # The preview (4 samples of the exact pixels' 16: twice their noise) comes with its variance: the engine tests its contrasts against its noise, and its
-    # first round asks for no more than a plan on a preview of the exact pixels' samples
-    # (16), but for the two previews' different noise (25 %). Without the variance the
+    # The preview (8 samples of the exact pixels' 16) comes with its variance: the engine tests its contrasts
+    # against its noise, and its first round asks for no more than a plan on a preview of the exact pixels'
+    # samples (16), but for the two previews' different noise (25 %). Without the variance the
     # preview's noise passed for edges: 996 pixels against 761 at 16 samples.
     first = {k: runs[k][2]["blender"]["rounds"][0]["pixels"] for k in ("on", "exact preview")}
     assert first["on"] <= 1.25 * first["exact preview"], first
@@ -134,8 +144,6 @@ def variance(dcm, blender, src, tmp):
     # The corrected run estimates its PSNR against the converged image from the
     # preview where the preview's own noise costs less than 25 dB; without the
     # correction there is no estimate.
-    # correction there is no estimate. (The 4-sample preview costs about 23 dB,
-    # the 16-sample one about 29.)
     assert "estimated_psnr" not in unc[2] and "preview_psnr" not in unc[2]["blender"], unc[2]
     for k in ("on", "exact preview"):
         j = runs[k][2]

@@ -137,6 +137,43 @@ TEST(PreviewTarget, ATargetBeyondTheRendersOwnNoiseIsNotSearchedFor) {
   EXPECT_GT(stats.thresholds[0], double(ResolveSettings(Options(), truth.Capabilities()).contrastThreshold));
 }
 
+TEST(PreviewTarget, AShareMeasuredOnTheRoundsReplacesTheRatioOfSamples) {
+  // The ratio of samples says the exact pixels keep half the preview's
+  // variance; the rounds measure a tenth of that (as a stratified sampler's
+  // faster convergence would). The limit is decided before any round with
+  // the ratio, and reported with the measurement: 10 dB apart.
+  AnalyticProvider truth(M, M, FurnishedScene(M, M));
+  CountingProvider exact(truth);
+  ImagePreviewProvider preview = NoisyPreview(truth.FullRender(), 0.01f, 6);
+  PreviewScheduleOptions schedule;
+  schedule.exactVarianceShare = 0.5;
+  schedule.measuredExactVarianceShare = [&exact] { return exact.calls > 0 ? 0.05 : std::nan(""); };
+  EXPECT_EQ(ExactVarianceShare(schedule), 0.5) << "nothing measured yet";
+  Reconstruction r;
+  QualityReport report;
+  PreviewTargetStats stats;
+  ASSERT_TRUE(ReconstructToTargetFromPreview(exact, preview, Options(), 45, schedule, &r, &report, &stats).ok());
+  EXPECT_EQ(ExactVarianceShare(schedule), 0.05);
+  const double own = PreviewNoisePsnr(preview);
+  EXPECT_NEAR(stats.renderPsnrAtStart, own + 10 * std::log10(2.0), 1e-9);
+  EXPECT_TRUE(stats.beyondRender) << "decided on the ratio: " << stats.renderPsnrAtStart;
+  EXPECT_NEAR(stats.renderPsnr, own + 10 * std::log10(20.0), 1e-9);
+  EXPECT_EQ(report.renderEstimate.psnr, stats.renderPsnr);
+  // The exact pixels' share of the estimated error shrinks with their noise.
+  PreviewScheduleOptions assumed;
+  assumed.exactVarianceShare = 0.5;
+  Reconstruction r2;
+  QualityReport report2;
+  ASSERT_TRUE(ReconstructToTargetFromPreview(truth, preview, Options(), 45, assumed, &r2, &report2).ok());
+  EXPECT_EQ(r2.image, r.image) << "the same run: only the estimate differs";
+  EXPECT_GT(report.estimate.psnr, report2.estimate.psnr);
+  // Neither zero nor a negative or non-finite measurement replaces the ratio.
+  for (double bad : {0.0, -1.0, HUGE_VAL}) {
+    schedule.measuredExactVarianceShare = [bad] { return bad; };
+    EXPECT_EQ(ExactVarianceShare(schedule), 0.5) << bad;
+  }
+}
+
 TEST(PreviewTarget, APreviewThatCannotTellIsRefusedWithTheReason) {
   AnalyticProvider truth(M, M, FurnishedScene(M, M));
   const std::vector<RGB> ref = truth.FullRender();

@@ -41,6 +41,7 @@
 #include "common/progress.h"
 #include "common/sample_map.h"
 #include "common/stats_json.h"
+#include "dcm/exact_noise_meter.h"
 #include "dcm/noise_estimate.h"
 #include "dcm/pipe/pipe_provider.h"
 #include "dcm/pipe/run_command.h"
@@ -73,7 +74,7 @@ struct BlenderFlags {
   std::string frames;      ///< A-B: one output per frame, '#' in -o replaced by the frame number
   std::string viewLayer;   ///< empty: the first that renders
   int samples = 0;         ///< 0: the file's
-  int previewSamples = 0;  ///< 0: samples / 16, at least 4
+  int previewSamples = 0;  ///< 0: samples / 16, at least 8
   RoundFlags rounds;       ///< --schedule, --max-rounds
   int renderThreads = 0;
   /// Exact pixels as two halves with two seeds; their variance to the engine:
@@ -279,7 +280,8 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   ProviderCapabilities noisyCaps = provider->Capabilities();
   noisyCaps.variance = true;
   const int poolRadius = ResolveSettings(options, noisyCaps).elementaryBlock;
-  PooledVarianceProvider pooled(*provider, poolRadius, useVariance);
+  ExactNoiseMeter meter(*provider);
+  PooledVarianceProvider pooled(meter, poolRadius, useVariance);
   const ProviderCapabilities caps = pooled.Capabilities();
   RoundSchedule schedule = RoundSchedule::kLevels;
   if (Status st = ScheduleFor(f.rounds, provider->roundCost(), provider->hasPreview(), &schedule); !st.ok())
@@ -337,6 +339,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   PreviewTargetStats ptarget;
   bool targetFromPreview = false;
   double previewS = 0, goalS = 0;
+  double assumedShare = std::numeric_limits<double>::quiet_NaN();  ///< the ratio of samples
   Status st;
   if (schedule == RoundSchedule::kPreview) {
     const auto tp = Clock::now();
@@ -355,6 +358,9 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     const double samples = keys.count("samples") ? std::atof(keys.at("samples").c_str()) : 0.0;
     const double previewSamples = keys.count("preview_samples") ? std::atof(keys.at("preview_samples").c_str()) : 0.0;
     if (samples > 0 && previewSamples > 0) so.exactVarianceShare = std::min(1.0, previewSamples / samples);
+    assumedShare = so.exactVarianceShare;
+    meter.SetPreviewVariance(&so.previewOwnVariance);
+    so.measuredExactVarianceShare = [&meter] { return meter.share(); };
     so.maxRounds = f.rounds.maxRounds;
     so.correctionRadius = f.rounds.previewCorrection;
     so.minRoundShare = f.rounds.minRoundShare;
@@ -397,12 +403,12 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       sched = ptarget.last;
       if (st.ok() && ptarget.beyondRender && defaultGoal && f.pipe.engine.verbose)
         std::cerr << "blender: the default threshold: the render itself is about " << std::fixed
-                  << std::setprecision(2) << ptarget.renderPsnr << std::defaultfloat
+                  << std::setprecision(2) << ptarget.renderPsnrAtStart << std::defaultfloat
                   << " dB from the converged image, too close to the default goal (--target-psnr " << DefaultTarget()
                   << ") to search for it\n";
       else if (st.ok() && ptarget.beyondRender && !defaultGoal)
         std::cerr << "dcm " << cmd << ": warning: --target-psnr " << target << ": beyond what these samples give: the "
-                  << "render itself is about " << std::fixed << std::setprecision(2) << ptarget.renderPsnr
+                  << "render itself is about " << std::fixed << std::setprecision(2) << ptarget.renderPsnrAtStart
                   << std::defaultfloat << " dB from the converged image (from the preview); reconstructed at the "
                   << "default threshold. More --samples raise it, more exact pixels do not\n";
     } else if (st.ok() && haveGoal) {
@@ -425,6 +431,13 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   }
   progress.Done();
   if (!st.ok()) return Fail("'" + f.scene + "': " + timed.step + ": " + st.message());
+  if (f.pipe.engine.verbose && meter.pixels() > 0) {
+    char line[200];
+    std::snprintf(line, sizeof line, "blender: the exact pixels' variance is %.3g of the preview's, measured on %lld "
+                  "pixels of the first round (the ratio of samples says %.3g)\n", meter.share(),
+                  static_cast<long long>(meter.pixels()), assumedShare);
+    std::cerr << line;
+  }
   // Blender must end cleanly before anything is written.
   if (Status fin = provider->Finish(); !fin.ok()) return Fail("'" + f.scene + "': " + fin.message());
   const double wallS = Since(t0);
@@ -509,6 +522,10 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     b["seeds"] = seeds;
     b["variance"] = useVariance ? "halves" : provider->Capabilities().variance ? "halves, not used" : "none";
     if (!std::isnan(noisePsnr)) b["noise_psnr"] = noisePsnr;
+    if (std::isfinite(assumedShare))
+      b["exact_noise_share"] = {{"assumed", assumedShare},
+                                {"measured", meter.pixels() > 0 ? nlohmann::json(meter.share()) : nlohmann::json()},
+                                {"pixels", meter.pixels()}};
     j["blender"] = b;
     if (previewEstimate) {
       toolkit::AddEstimateJson(fromPreview, 0.90, &j);  // EstimatePsnr's interval
@@ -611,7 +628,7 @@ Registration reg("blender", "Render a .blend with Cycles at the pixels DCM asks 
                    app->add_option("--samples", f->samples, "Cycles samples of the exact pixels (0: the file's)")
                        ->transform(Integer(0, 1 << 24));
                    app->add_option("--preview-samples", f->previewSamples,
-                                   "samples of the guides and preview render (0: a sixteenth of --samples, at least 4)")
+                                   "samples of the guides and preview render (0: a sixteenth of --samples, at least 8)")
                        ->transform(Integer(0, 1 << 24));
                    app->add_option("--variance", f->variance,
                                    "exact pixels as two renders of half the samples with two seeds, whose difference "

@@ -30,8 +30,11 @@ struct PreviewTargetStats {
   /// options' threshold was made, and the target is reported not reached.
   bool beyondRender = false;
   /// That limit: the full render's own PSNR against the converged image, as
-  /// the preview estimates it (+inf with noise-free exact samples).
+  /// the preview estimates it with the exact share known at the end
+  /// (ExactVarianceShare; +inf with noise-free exact samples).
   double renderPsnr = 0;
+  /// The same before the first round: what decided `beyondRender`.
+  double renderPsnrAtStart = 0;
 };
 
 /// Whether ReconstructToTargetFromPreview can judge a target with this
@@ -46,7 +49,7 @@ inline constexpr double kRenderNoiseMarginDb = 0.5;
 
 /// The full render's own display-referred PSNR against the converged image,
 /// as the preview tells it: every pixel exact, each with
-/// `schedule.exactVarianceShare` of the preview's noise (+inf at share 0, NaN
+/// ExactVarianceShare(schedule) of the preview's noise (+inf at share 0, NaN
 /// without the preview's variance). Raw exact samples cannot beat it; the
 /// engine's denoising of noisy samples (ResolvedSettings::noisy) can.
 double RenderPsnrFromPreview(SampleProvider& preview, const PreviewScheduleOptions& schedule);
@@ -70,7 +73,9 @@ double RenderPsnrFromPreview(SampleProvider& preview, const PreviewScheduleOptio
 /// `schedule.exactVarianceShare` of the preview's noise: what every pixel
 /// rendered would reach, less 0.5 dB) is not searched for: one run at the
 /// options' threshold, `stats->beyondRender`, reported not reached (more
-/// samples are the remedy, not more exact pixels).
+/// samples are the remedy, not more exact pixels). That is decided before
+/// any exact pixel is rendered, with the share known then
+/// (PreviewTargetStats::renderPsnrAtStart).
 Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& preview,
                                       const ReconstructionOptions& options, double targetPsnr,
                                       const PreviewScheduleOptions& schedule, Reconstruction* out,

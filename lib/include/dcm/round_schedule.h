@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string_view>
 #include <vector>
 
@@ -67,6 +68,12 @@ struct PreviewScheduleOptions {
   /// samples over the exact ones'), for the estimate: an exact pixel's error
   /// against the converged image. 0: exact samples count as noise-free.
   double exactVarianceShare = 0;
+  /// Where set and it returns a positive number: that share as measured on
+  /// the exact pixels rendered so far (two halves of their samples against
+  /// the preview's at the same pixels). It replaces exactVarianceShare, whose
+  /// ratio of samples assumes the noise falls as 1 / samples (a stratified
+  /// sampler's often falls faster). Read after each run's rounds.
+  std::function<double()> measuredExactVarianceShare;
   /// Where the texture guide comes from the preview's own samples (Blender's
   /// DiffCol of the same renders), the covariance of the preview's estimates
   /// of tau and of L per working pixel and channel, from its two halves: an
@@ -75,6 +82,10 @@ struct PreviewScheduleOptions {
   /// texture guide is independent of the preview's noise.
   std::vector<RGB> previewTextureCovariance;
 };
+
+/// The exact samples' variance as a share of the preview's: the measured
+/// share where there is one, else `schedule.exactVarianceShare`.
+double ExactVarianceShare(const PreviewScheduleOptions& schedule);
 
 /// What a preview-planned reconstruction did.
 struct PreviewScheduleStats {
