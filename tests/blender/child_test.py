@@ -8,7 +8,6 @@ Exit 77 (skipped) when Blender is missing."""
 import hashlib
 import os
 import shutil
-import subprocess
 import sys
 import tempfile
 
