@@ -36,7 +36,8 @@ Status ExactNoiseMeter::Evaluate(std::span<const Point2i> pixels, const SampleRe
     if (!IsFinite(out[i].L) || !IsFinite(v) || !IsFinite(o)) continue;
     ++used;
     for (int c = 0; c < 3; ++c) {
-      const double w = SrgbSlope(out[i].L[c]) * SrgbSlope(out[i].L[c]);
+      const double slope = SrgbSlope(out[i].L[c]);
+      const double w = slope * slope;
       exact += w * std::max(double(v[c]), 0.0);
       preview += w * std::max(double(o[c]), 0.0);
     }

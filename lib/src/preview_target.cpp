@@ -24,6 +24,13 @@ constexpr int kMaxRuns = 7;
 /// reached what the threshold can give (the exact samples' noise, stand-ins).
 constexpr double kPlateauDb = 0.1;
 
+/// The full render's PSNR from the preview's own (`previewPsnr`): each exact
+/// pixel keeps ExactVarianceShare(schedule) of the preview's noise.
+double RenderPsnr(double previewPsnr, const PreviewScheduleOptions& schedule) {
+  const double share = ExactVarianceShare(schedule);
+  return share > 0 ? previewPsnr - 10 * std::log10(share) : HUGE_VAL;
+}
+
 std::string Db(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.2f dB", v);
@@ -43,9 +50,7 @@ bool CanTargetFromPreview(SampleProvider& preview, const PreviewScheduleOptions&
 }
 
 double RenderPsnrFromPreview(SampleProvider& preview, const PreviewScheduleOptions& schedule) {
-  const double own = PreviewNoisePsnr(preview, schedule.previewOwnVariance);
-  const double share = ExactVarianceShare(schedule);
-  return share > 0 ? own - 10 * std::log10(share) : HUGE_VAL;
+  return RenderPsnr(PreviewNoisePsnr(preview, schedule.previewOwnVariance), schedule);
 }
 
 Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& preview,
@@ -67,7 +72,9 @@ Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& pre
   PreviewTargetStats& s = stats ? *stats : local;
   s = PreviewTargetStats{};
   try {
-    s.renderPsnrAtStart = RenderPsnrFromPreview(preview, schedule);
+    // The preview's own noise, once: only the exact share changes over the runs.
+    const double previewPsnr = PreviewNoisePsnr(preview, schedule.previewOwnVariance);
+    s.renderPsnrAtStart = RenderPsnr(previewPsnr, schedule);
     s.beyondRender = !(targetPsnr <= s.renderPsnrAtStart - kRenderNoiseMarginDb);
     PlanningProvider planning(exact, preview);
     ReconstructionOptions o = options;
@@ -100,7 +107,7 @@ Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& pre
       if (flat >= 2) break;
     }
     // With the exact pixels' noise measured on the rounds, where it was.
-    s.renderPsnr = RenderPsnrFromPreview(preview, schedule);
+    s.renderPsnr = RenderPsnr(previewPsnr, schedule);
     s.renderedPixels = planning.KnownCount();
     // As ReconstructToQuality's: the cost of every run (with noisy samples a
     // pixel an earlier run rendered is interpolated again, and still paid for).
