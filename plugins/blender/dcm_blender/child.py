@@ -188,8 +188,9 @@ def main(argv):
         print("dcm-blender: the scene was not restored:\n" + "\n".join(diff), file=sys.stderr)
         status = 3
     if args.verbose:
-        for label, s in session.render_seconds:
-            print("dcm-blender: render %s %.2f s" % (label, s), file=sys.stderr)
+        for label, s, sync, render in session.render_seconds:
+            print("dcm-blender: render %s %.2f s (Cycles: sync %.2f s, render %.2f s)" % (label, s, sync, render),
+                  file=sys.stderr)
         print("dcm-blender: %d renders kept masked pixels for an eighth of the samples (an exact pixel might "
               "have stopped early); %d exact pixels stopped early and were rendered again"
               % (session.careful_renders, session.rendered_again), file=sys.stderr)

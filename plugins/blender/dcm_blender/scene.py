@@ -95,6 +95,14 @@ def _noise_psnr(var, L):
     return 99.0 if not mse > 0 else -10 * np.log10(mse)
 
 
+def _clock_seconds(text):
+    """Seconds of a time as Blender's metadata writes it ("[HH:]MM:SS.ss"); NaN if not one."""
+    try:
+        return sum(float(part) * 60 ** i for i, part in enumerate(reversed(text.split(":"))))
+    except ValueError:
+        return float("nan")
+
+
 def _log(msg):
     print("dcm-blender: " + msg, file=os.sys.stderr, flush=True)
 
@@ -383,7 +391,10 @@ class Session:
             raise SceneError("Cycles did not render (%s)" % label)
         w, h, planes, meta = exr.read(path)
         os.remove(path)
-        self.render_seconds.append((label, time.monotonic() - t0))
+        # The call's wall clock, then Cycles' own synchronisation and render time.
+        cycles = [_clock_seconds(meta.get("cycles.%s.%s" % (self.layer.name, k), "")) for k in
+                  ("synchronization_time", "render_time")]
+        self.render_seconds.append((label, time.monotonic() - t0, *cycles))
         if self.args.keep_renders:
             os.makedirs(self.args.keep_renders, exist_ok=True)
             dst = os.path.join(self.args.keep_renders, "%02d_%s.npz" % (self._round, label))
@@ -409,7 +420,8 @@ class Session:
             counts = [ps - ps // 2, ps // 2] if self.halves and ps >= 2 else [ps]
             pls = [self._render(n, "guides", seed) for n, seed in zip(counts, self.seeds)]
             if len(pls) == 2:  # one entry: round_cost() reads the guides render's time
-                self.render_seconds[-2:] = [("guides", self.render_seconds[-2][1] + self.render_seconds[-1][1])]
+                self.render_seconds[-2:] = [("guides", *(a + b for a, b in zip(self.render_seconds[-2][1:],
+                                                                                 self.render_seconds[-1][1:])))]
                 self.scene.cycles.seed = self.seeds[0]
 
             def mean(name, comps="RGB"):
