@@ -250,6 +250,28 @@ def preview_target(dcm, blender, src, tmp):
                  len(b["rounds"])))
     # A higher target costs at least as many exact pixels.
     assert runs[34.0][1]["exact_fraction"] >= runs[30.0][1]["exact_fraction"], runs
+    # Where the engine does not weigh the exact pixels' variance (at 1024 samples their noise costs
+    # more than 42 dB: --variance auto leaves it out), it is measured (the first round in two halves,
+    # a render call more) only where it can move the estimate: the render's own noise from the ratio
+    # of samples (about 48 dB) within 6 dB of the target. At 40 dB it is not: the same first round
+    # (the ladder starts at the same threshold) in half the render calls.
+    meas = {}
+    for target in (40.0, 44.0):
+        code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--blender", blender, "--samples", "1024",
+                                 "--preview-samples", "64", "--target-psnr", str(target), "--schedule", "preview",
+                                 "-v"])
+        assert code == 0 and "judged by the preview's estimate" in se, se
+        b = json.load(open(stats))["blender"]
+        assert b["variance"] == "halves, not used", b
+        meas[target] = (b, se.count("dcm-blender: render eval1 "), se)
+    (low, low_calls, low_se), (high, high_calls, _) = meas[40.0], meas[44.0]
+    assert low["exact_noise_share"]["pixels"] == 0 and low["exact_noise_share"]["measured"] is None, low
+    assert "noise is not measured" in low_se, low_se
+    ratio = low["render_psnr_from_ratio"]
+    assert 40 + 6 <= ratio < 44 + 6 and high["render_psnr_from_ratio"] == ratio, (low, high)
+    assert high["exact_noise_share"]["pixels"] == high["rounds"][0]["pixels"] >= 256, high
+    assert low["rounds"][0]["pixels"] == high["rounds"][0]["pixels"], (low["rounds"], high["rounds"])
+    assert high_calls == 2 * low_calls > 0, (low_calls, high_calls)
     # A target beyond the render's own noise (about 36 dB here) is not searched for: one run at the
     # default threshold, a warning that says what more samples would do, the target not reached.
     code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--blender", blender, "--samples", "64",
