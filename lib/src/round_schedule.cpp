@@ -41,8 +41,11 @@ Status Parse(std::string_view s, RoundSchedule* out) {
   return Status::Error("unknown round schedule '" + std::string(s) + "' (levels, preview)");
 }
 
-RoundSchedule ChooseSchedule(const RoundCost& cost, double latencySamplesThreshold) {
+RoundSchedule ChooseSchedule(const RoundCost& cost, int previewRounds, double latencySamplesThreshold) {
   if (!(cost.latencyS > 0)) return RoundSchedule::kLevels;
+  if (cost.previewS >= 0)
+    return (kLevelScheduleRounds - previewRounds) * cost.latencyS > cost.previewS ? RoundSchedule::kPreview
+                                                                                   : RoundSchedule::kLevels;
   if (!(cost.perSampleS > 0)) return RoundSchedule::kPreview;
   return cost.latencyS > latencySamplesThreshold * cost.perSampleS ? RoundSchedule::kPreview
                                                                    : RoundSchedule::kLevels;

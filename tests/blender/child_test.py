@@ -38,6 +38,8 @@ def main():
         assert (child.width, child.height) == (w, h), (child.width, child.height)
         assert "preview" in child.caps and "split" in child.caps, child.caps
         assert child.round_latency > 0 and child.sample_cost > 0, child.hello
+        # The preview comes with the guides render: it costs no schedule anything more.
+        assert " preview_cost=0 " in child.hello, child.hello
         # 16 samples: a sixteenth would be 1; the preview takes 8, the floor below which
         # its error estimate is biased by the sRGB curve (docs/BLENDER.md).
         assert child.preview_samples == 8, child.hello

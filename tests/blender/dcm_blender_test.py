@@ -272,6 +272,18 @@ def preview_target(dcm, blender, src, tmp):
     assert high["exact_noise_share"]["pixels"] == high["rounds"][0]["pixels"] >= 256, high
     assert low["rounds"][0]["pixels"] == high["rounds"][0]["pixels"], (low["rounds"], high["rounds"])
     assert high_calls == 2 * low_calls > 0, (low_calls, high_calls)
+    # --schedule auto (the default) plans on the preview, which the guides render gives (preview_cost=0),
+    # also where a render call costs fewer samples than the old rule's 1000: at 4096 samples the masked
+    # pixels stop at 16 and the call's fixed time is a few hundred pixel-samples (the child reported
+    # 8x more until its latency counted that, and the rule read the inflated figure).
+    code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--blender", blender, "--samples", "4096",
+                             "--preview-samples", "256", "--threshold", "0.3", "-v"])
+    assert code == 0, se
+    j = json.load(open(stats))
+    b = j["blender"]
+    assert j["schedule"] == "preview", (j["schedule"], se)
+    print("--samples 4096: round latency %.3f s, %.3g s per pixel (%.0f pixels' cost), schedule %s"
+          % (b["round_latency_s"], b["sample_cost_s"], b["round_latency_s"] / b["sample_cost_s"], j["schedule"]))
     # A target beyond the render's own noise (about 36 dB here) is not searched for: one run at the
     # default threshold, a warning that says what more samples would do, the target not reached.
     code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--blender", blender, "--samples", "64",

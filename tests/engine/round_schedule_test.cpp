@@ -279,6 +279,13 @@ TEST(RoundSchedule, ChoiceFollowsTheCostOfARound) {
   EXPECT_EQ(ChooseSchedule({0.5, 0}), RoundSchedule::kPreview) << "latency, per-sample cost unknown";
   EXPECT_EQ(ChooseSchedule({0.5, 1e-3}), RoundSchedule::kLevels) << "a round costs 500 samples";
   EXPECT_EQ(ChooseSchedule({0.5, 1e-5}), RoundSchedule::kPreview) << "a round costs 50000 samples";
+  // The preview's cost known: the 20 - 3 calls the preview schedule saves against it, whatever a call
+  // costs in samples.
+  EXPECT_EQ(ChooseSchedule({0.5, 1e-3, 0}), RoundSchedule::kPreview) << "a free preview saves 17 calls";
+  EXPECT_EQ(ChooseSchedule({0.5, 1e-3, 8}), RoundSchedule::kPreview) << "17 x 0.5 s > 8 s";
+  EXPECT_EQ(ChooseSchedule({0.5, 1e-3, 9}), RoundSchedule::kLevels) << "17 x 0.5 s < 9 s";
+  EXPECT_EQ(ChooseSchedule({0.5, 1e-3, 8}, 5), RoundSchedule::kLevels) << "15 x 0.5 s < 8 s";
+  EXPECT_EQ(ChooseSchedule({0, 1e-3, 0}), RoundSchedule::kLevels) << "no latency, nothing to save";
   for (RoundSchedule s : {RoundSchedule::kLevels, RoundSchedule::kPreview}) {
     RoundSchedule parsed;
     ASSERT_TRUE(Parse(ToString(s), &parsed).ok());

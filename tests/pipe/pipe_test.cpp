@@ -171,7 +171,20 @@ TEST(PipeProvider, HandshakeCarriesTheRoundCostAndThePreview) {
   EXPECT_DOUBLE_EQ(p->roundCost().latencyS, 0.25);
   EXPECT_DOUBLE_EQ(p->roundCost().perSampleS, 2e-4);
   EXPECT_EQ(dcm::ChooseSchedule(p->roundCost()), dcm::RoundSchedule::kPreview);
+  EXPECT_LT(p->roundCost().previewS, 0) << "not announced: unknown";
   EXPECT_TRUE(p->Finish().ok());
+  // A request of 500 samples' cost: level by level, unless the preview is known to cost less than
+  // the requests it saves.
+  for (const auto& [preview, schedule] : {std::pair{"", dcm::RoundSchedule::kLevels},
+                                          std::pair{" preview_cost=0", dcm::RoundSchedule::kPreview},
+                                          std::pair{" preview_cost=20", dcm::RoundSchedule::kLevels}}) {
+    ASSERT_TRUE(Start(std::string("printf 'dcm-pipe 1 width=4 height=3 caps=preview round_latency=0.5 "
+                                  "sample_cost=1e-3") + preview + "\\n'; cat >/dev/null",
+                      &p)
+                    .ok());
+    EXPECT_EQ(dcm::ChooseSchedule(p->roundCost()), schedule) << preview;
+    EXPECT_TRUE(p->Finish().ok());
+  }
   // A provider that says nothing costs nothing and has no preview: the levels schedule.
   ASSERT_TRUE(Start("printf 'dcm-pipe 1 width=4 height=3\\n'; cat >/dev/null", &p).ok());
   EXPECT_FALSE(p->hasPreview());
@@ -180,7 +193,8 @@ TEST(PipeProvider, HandshakeCarriesTheRoundCostAndThePreview) {
   std::vector<dcm::ExactSample> s;
   EXPECT_FALSE(p->Preview({{0, 0}, {4, 3}}, {}, &s).ok());
   EXPECT_TRUE(p->Finish().ok());
-  for (const char* bad : {"round_latency=-1", "round_latency=abc", "sample_cost=nan", "round_latency=1e9"}) {
+  for (const char* bad :
+       {"round_latency=-1", "round_latency=abc", "sample_cost=nan", "round_latency=1e9", "preview_cost=-1"}) {
     const dcm::Status st =
         Start(std::string("printf 'dcm-pipe 1 width=4 height=3 ") + bad + "\\n'; cat >/dev/null", &p);
     ASSERT_FALSE(st.ok()) << bad;

@@ -232,7 +232,7 @@ void AddRoundFlags(CLI::App* app, RoundFlags* f) {
 
 Status ScheduleFor(const RoundFlags& flags, const RoundCost& cost, bool previewAvailable, RoundSchedule* out) {
   if (flags.schedule == "auto") {
-    *out = previewAvailable ? ChooseSchedule(cost) : RoundSchedule::kLevels;
+    *out = previewAvailable ? ChooseSchedule(cost, flags.maxRounds) : RoundSchedule::kLevels;
     return Status::Ok();
   }
   DCM_RETURN_IF_ERROR(Parse(flags.schedule, out));

@@ -19,10 +19,17 @@ namespace dcm {
 /// What exact samples cost a provider: `latencyS` per Evaluate() call (a
 /// round: process start-up, scene sync, a render call over the whole frame)
 /// and `perSampleS` per pixel evaluated. Zero: unknown or negligible.
+/// `previewS`: what the preview costs beyond what every schedule pays (0: it
+/// comes with the guides, or was handed in); negative: unknown.
 struct RoundCost {
   double latencyS = 0;
   double perSampleS = 0;
+  double previewS = -1;
 };
+
+/// Calls the level schedule makes, about: one per refinement step (21 for
+/// `dcm blender` at 256^2, about 20 at 512^2; docs/ENGINE.md).
+inline constexpr int kLevelScheduleRounds = 20;
 
 /// How the engine asks for its exact samples.
 enum class RoundSchedule : uint8_t {
@@ -43,10 +50,13 @@ enum class RoundSchedule : uint8_t {
 std::string_view ToString(RoundSchedule);
 Status Parse(std::string_view, RoundSchedule*);
 
-/// The schedule to use for a provider of cost `cost`: kPreview where a round
-/// costs more than evaluating `latencySamplesThreshold` samples (or the
-/// per-sample cost is unknown and the latency is not zero), else kLevels.
-RoundSchedule ChooseSchedule(const RoundCost& cost, double latencySamplesThreshold = 1000);
+/// The schedule to use for a provider of cost `cost`, kLevels without a
+/// latency. Where the preview's cost is known, the cheaper in latency and
+/// preview: kPreview where the kLevelScheduleRounds - `previewRounds` calls
+/// it saves cost more than the preview. Else kPreview where a round costs
+/// more than evaluating `latencySamplesThreshold` samples (or the per-sample
+/// cost is unknown), else kLevels.
+RoundSchedule ChooseSchedule(const RoundCost& cost, int previewRounds = 3, double latencySamplesThreshold = 1000);
 
 struct PreviewScheduleOptions {
   /// Calls to the exact provider at most (>= 1).

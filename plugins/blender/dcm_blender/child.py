@@ -161,9 +161,10 @@ def main(argv):
         # The guides and preview render first: its time tells what a round costs.
         session.guides()
         latency, per_sample = session.round_cost()
-        # view_layer (percent-encoded: names have spaces) and guides_seconds are for `dcm blender`.
+        # view_layer (percent-encoded: names have spaces) and guides_seconds are for `dcm blender`;
+        # the preview comes with the guides render, which every schedule pays.
         proto.send("dcm-pipe 1 width=%d height=%d caps=%s name=blender-cycles round_latency=%.4g sample_cost=%.4g "
-                   "view_layer=%s guides_seconds=%.3f samples=%d preview_samples=%d seeds=%s%s"
+                   "preview_cost=0 view_layer=%s guides_seconds=%.3f samples=%d preview_samples=%d seeds=%s%s"
                    % (session.width, session.height, CAPS + (",variance,texture_covariance" if session.halves else ""), latency, per_sample,
                       urllib.parse.quote(session.layer.name, safe=""), session.render_seconds[0][1],
                       session.samples, session.preview_samples,

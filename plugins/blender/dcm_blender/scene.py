@@ -478,8 +478,7 @@ class Session:
         if self.args.border_tile > 0:
             return self._runs(xs, ys, self.args.border_tile)
         n = self.samples // calls
-        # A masked pixel stops at Cycles' first check past the minimum (every 16 samples).
-        masked = self._masked_seconds(min(n, 16 * (self._masked_min_samples(n) // 16 + 1)), n)
+        masked = self._masked_seconds(self._masked_stop(n), n)
         best, best_cost = [None], calls * self.args.call_seconds + self.width * self.height * masked
         for t in (16, 32, 64):
             rects = self._runs(xs, ys, t)
@@ -493,6 +492,11 @@ class Session:
         """What a masked pixel costs for `samples` of a render of n samples: about
         a seventh of a rendered pixel's per sample (docs/BLENDER.md)."""
         return 0.14 * self.pixel_seconds() * samples / n
+
+    def _masked_stop(self, n):
+        """Samples a masked pixel of a render of n samples takes: it stops at Cycles'
+        first check (every 16 samples) past the minimum."""
+        return min(n, 16 * (self._masked_min_samples(n) // 16 + 1))
 
     def _masked_min_samples(self, n, careful=False):
         """Samples after which a masked pixel of a render of n samples may stop:
@@ -659,14 +663,13 @@ class Session:
         return self.render_seconds[0][1] * self.samples / self.preview_samples / (self.width * self.height)
 
     def round_cost(self):
-        """(seconds per render call, seconds per exact pixel), from the guides render: a
-        pixel at full samples costs samples / preview_samples times a preview pixel; a
-        masked pixel still costs about 14 % of one (camera ray, shader, film), and a render
-        call in a running Blender about 0.1 s (docs/BLENDER.md)."""
-        seconds = self.render_seconds[0][1]
-        full = seconds * self.samples / self.preview_samples
-        pixels = self.width * self.height
-        return 0.1 * len(self.seeds) + 0.14 * full, full / pixels
+        """(seconds per round, seconds per exact pixel), from the guides render: a
+        pixel at full samples costs samples / preview_samples times a preview pixel
+        (pixel_seconds); a round is a render call per seed, each its fixed time
+        (call_seconds) and the masked pixels of the whole frame until they stop
+        (_masked_stop; docs/BLENDER.md)."""
+        masked = self._masked_seconds(self._masked_stop(self.samples // len(self.seeds)), self.samples)
+        return len(self.seeds) * (self.args.call_seconds + self.width * self.height * masked), self.pixel_seconds()
 
     def fingerprint(self):
         """What setup() may change, as text: restore() must bring it back."""

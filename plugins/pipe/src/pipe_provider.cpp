@@ -222,11 +222,11 @@ Status PipeProvider::Handshake() {
       }
     } else if (key == "name") {
       caps_.name = value;
-    } else if (key == "round_latency" || key == "sample_cost") {
+    } else if (key == "round_latency" || key == "sample_cost" || key == "preview_cost") {
       double seconds = 0;
       if (!ParseSeconds(value, &seconds))
         return Fail("handshake: " + key + " must be seconds from 0 to 86400, got " + Quote(value));
-      (key == "round_latency" ? cost_.latencyS : cost_.perSampleS) = seconds;
+      (key == "round_latency" ? cost_.latencyS : key == "sample_cost" ? cost_.perSampleS : cost_.previewS) = seconds;
     }
     // Unknown keys are ignored (newer providers).
   }
