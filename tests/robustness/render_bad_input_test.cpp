@@ -11,6 +11,7 @@
 
 #include <cctype>
 #include <cerrno>
+#include <chrono>
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
@@ -20,6 +21,8 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "dcm_process.h"
 
@@ -110,6 +113,30 @@ TEST(RenderBadInput, ControlGoodSceneWritesItsOutputs) {
       << "not replaced by an EXR";
   EXPECT_EQ(dir.Files(), (std::set<std::string>{"scene.json", "fresh.exr", "fresh.json", "fresh_map.png",
                                                 "fresh.png", "existing.exr"}));
+}
+
+// With --with-reference the stats give what two processes, one per run, would
+// take end to end (issue 21: the start-up counts): each at least its run and the
+// start-up, neither more than the process took. Tolerance: the start is known
+// to a clock tick (10 ms).
+TEST(RenderCommand, WithReferenceReportsEndToEndTimes) {
+  TempDir dir;
+  dir.Write("scene.json", Scene(kBox));
+  const auto t0 = std::chrono::steady_clock::now();
+  Result r = RunDcm(dir.path(), {"render", "scene.json", "-o", "out.exr", "--with-reference", "--stats", "s.json",
+                                 "--quiet"});
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_TRUE(r.exited && r.code == 0) << r.Describe();
+  const nlohmann::json j = nlohmann::json::parse(ReadAll(dir.path() / "s.json"));
+  ASSERT_TRUE(j.contains("end_to_end")) << j.dump();
+  const nlohmann::json& e = j["end_to_end"];
+  const double tick = 0.011, startup = e["startup_s"], dcmS = e["dcm_s"], fullS = e["full_s"];
+  EXPECT_GT(startup, 0);
+  EXPECT_GE(dcmS, startup + j["time_wall_s"].get<double>() - tick) << e.dump();
+  EXPECT_GE(fullS, startup + j["full"]["time_wall_s"].get<double>() - tick) << e.dump();
+  EXPECT_LE(dcmS, wall + tick) << e.dump();
+  EXPECT_LE(fullS, wall + tick) << e.dump();
+  EXPECT_DOUBLE_EQ(e["speedup"].get<double>(), fullS / dcmS);
 }
 
 TEST(RenderBadInput, MissingSceneFile) {

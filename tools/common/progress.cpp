@@ -1,11 +1,18 @@
 // Progress on stderr.
 #include "progress.h"
 
+#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <sstream>
+#include <string>
 
 namespace dcm::toolkit {
 
@@ -42,6 +49,34 @@ void Progress::Done() {
     std::fflush(stderr);
   }
   printed_ = false;
+}
+
+// /proc/self/stat's 22nd field, the start in clock ticks since boot, against
+// CLOCK_BOOTTIME (the kernel counts the start on that clock); the command name
+// (field 2) may hold spaces and parentheses, so fields count from the last ')'.
+double ProcessSeconds() {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::ifstream in("/proc/self/stat");
+  const std::string stat((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const size_t close = stat.rfind(')');
+  timespec now{};
+  const long ticks = ::sysconf(_SC_CLK_TCK);
+  if (close == std::string::npos || ticks <= 0 || ::clock_gettime(CLOCK_BOOTTIME, &now) != 0) return nan;
+  std::istringstream fields(stat.substr(close + 1));
+  std::string field;
+  for (int i = 3; i <= 22 && fields >> field; ++i) {
+    if (i < 22) continue;
+    char* end = nullptr;
+    const unsigned long long start = std::strtoull(field.c_str(), &end, 10);
+    if (end == field.c_str() || *end) return nan;
+    return double(now.tv_sec) + 1e-9 * double(now.tv_nsec) - double(start) / double(ticks);
+  }
+  return nan;
+}
+
+double StartupSeconds() {
+  static const double startup = ProcessSeconds();
+  return startup;
 }
 
 }  // namespace dcm::toolkit

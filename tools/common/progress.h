@@ -26,4 +26,12 @@ class Progress {
   bool printed_ = false;
 };
 
+/// Seconds since this process was started (exec): the dynamic loader's work
+/// and static initialisers included, at 1/CLK_TCK resolution (10 ms); NaN
+/// where /proc/self/stat cannot be read.
+double ProcessSeconds();
+
+/// ProcessSeconds() at the first call, which main() makes first: the start-up.
+double StartupSeconds();
+
 }  // namespace dcm::toolkit

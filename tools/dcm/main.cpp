@@ -9,6 +9,7 @@
 #include "flag_checks.h"
 #include "common/output_transaction.h"
 #include "common/output_exr.h"
+#include "common/progress.h"
 
 namespace dcm::cli {
 std::vector<CommandEntry>& CommandRegistry() {
@@ -19,6 +20,7 @@ std::vector<CommandEntry>& CommandRegistry() {
 
 int main(int argc, char** argv) {
   using namespace dcm::cli;
+  dcm::toolkit::StartupSeconds();  // the loader's and static initialisers' time, for end-to-end figures
   // Interrupted at any moment, a run leaves no temporary file and no child.
   dcm::toolkit::InstallSignalCleanup();
   dcm::toolkit::SetCommandLine(argc, argv);  // the provenance of every output
