@@ -273,9 +273,8 @@ def preview_target(dcm, blender, src, tmp):
     assert low["rounds"][0]["pixels"] == high["rounds"][0]["pixels"], (low["rounds"], high["rounds"])
     assert high_calls == 2 * low_calls > 0, (low_calls, high_calls)
     # --schedule auto (the default) plans on the preview, which the guides render gives (preview_cost=0),
-    # also where a render call costs fewer samples than the old rule's 1000: at 4096 samples the masked
-    # pixels stop at 16 and the call's fixed time is a few hundred pixel-samples (the child reported
-    # 8x more until its latency counted that, and the rule read the inflated figure).
+    # also where a render call costs fewer than the 1000 samples of the rule for an unknown preview cost:
+    # at 4096 samples a call (its fixed time, the masked pixels until they stop at 16) costs a few hundred.
     code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--blender", blender, "--samples", "4096",
                              "--preview-samples", "256", "--threshold", "0.3", "-v"])
     assert code == 0, se

@@ -26,8 +26,8 @@ class Progress {
   bool printed_ = false;
 };
 
-/// Seconds since this process was started (exec): the dynamic loader's work
-/// and static initialisers included, at 1/CLK_TCK resolution (10 ms); NaN
+/// Seconds since this process was created (its fork; exec follows at once):
+/// the dynamic loader's work and static initialisers included, at 1/CLK_TCK resolution (10 ms); NaN
 /// where /proc/self/stat cannot be read.
 double ProcessSeconds();
 
