@@ -380,9 +380,10 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       if (so.correctionRadius < 1) why = "--preview-correction 0: the correction makes the estimate";
       else if (options.downsample != 1) why = "--downsample: the preview estimates at final resolution only";
       targetFromPreview = why.empty() && CanTargetFromPreview(*preview, so, &why);
+      if (targetFromPreview) ratioRenderPsnr = RenderPsnrFromPreview(*preview, so);
       // The render's own noise bounds raw exact samples; the engine's denoising
       // of noisy ones can pass it, which only validation pixels tell.
-      const double renderPsnr = targetFromPreview && useVariance ? RenderPsnrFromPreview(*preview, so) : HUGE_VAL;
+      const double renderPsnr = targetFromPreview && useVariance ? ratioRenderPsnr : HUGE_VAL;
       if (target > renderPsnr - kRenderNoiseMarginDb) {
         targetFromPreview = false;
         char line[160];
@@ -407,11 +408,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     // render call more, unless the engine weighs the variance) but for a
     // target judged by the preview that the render's own noise, from the
     // ratio of samples, lies kMeasureNoiseMarginDb or more beyond.
-    measureNoise = true;
-    if (st.ok() && targetFromPreview && !useVariance) {
-      ratioRenderPsnr = RenderPsnrFromPreview(*preview, so);
-      measureNoise = !(ratioRenderPsnr >= target + kMeasureNoiseMarginDb);
-    }
+    measureNoise = !(st.ok() && targetFromPreview && !useVariance && ratioRenderPsnr >= target + kMeasureNoiseMarginDb);
     if (measureNoise) meter.SetPreviewVariance(&so.previewOwnVariance);
     if (targetFromPreview) {
       QualityReport report;
