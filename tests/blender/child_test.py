@@ -147,6 +147,22 @@ def main():
         want = ref64.reshape(-1, ref64.shape[-1])[sel][:, :3]
         err = np.abs(L - want)
         assert (err <= 1e-5 * np.maximum(np.abs(want), 1) + 1e-7).all(), "max |L - full render| = %g" % err.max()
+
+        # A Gaussian's rays leave up to 1.5 widths from the pixel's centre, 2.25 px at 1.5 px:
+        # a mask over half its width left some of an exact pixel's rays outside, and the
+        # pixel too dark by their share (the tolerance of the rounds above).
+        gtmp = os.path.join(tmp, "gaussian")
+        os.mkdir(gtmp)
+        gblend = bs.make_scene(blender, src, gtmp, pixel_filter="GAUSSIAN:1.5")
+        gref = bs.render_full(blender, src, gblend, gtmp)
+        child = bs.Child(blender, src, gblend)
+        child.guides()
+        L, _, _ = child.eval(sel % w, sel // w)
+        assert child.quit() == 0
+        want = gref.reshape(-1, gref.shape[-1])[sel][:, :3]
+        err = np.abs(L - want)
+        assert (err <= 1e-5 * np.maximum(np.abs(want), 1) + 1e-7).all(), \
+            "Gaussian 1.5 px: max |L - full render| = %g" % err.max()
         print("ok")
         return 0
     finally:

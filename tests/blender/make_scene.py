@@ -1,7 +1,7 @@
 # Builds the tiny procedural scene of the Blender tests and saves it as a .blend:
 #
 #   blender -b --factory-startup --python make_scene.py -- --out scene.blend \
-#       [--res 64x48] [--samples 16]
+#       [--res 64x48] [--samples 16] [--filter GAUSSIAN:1.5]
 #
 # What real files contain, in small: a floor whose checker texture sits in a
 # node group, a cube whose material has no nodes, a sphere without any
@@ -22,6 +22,7 @@ def parse_args():
     ap.add_argument("--out", required=True, help=".blend to write")
     ap.add_argument("--res", default="64x48", help="WxH")
     ap.add_argument("--samples", type=int, default=16)
+    ap.add_argument("--filter", default="BLACKMAN_HARRIS:1.5", help="pixel filter TYPE:WIDTH")
     return ap.parse_args(argv)
 
 
@@ -69,6 +70,8 @@ def main():
     sc.cycles.use_denoising = False
     sc.render.resolution_x, sc.render.resolution_y = w, h
     sc.render.resolution_percentage = 100
+    sc.cycles.pixel_filter_type, width = args.filter.split(":")
+    sc.cycles.filter_width = float(width)
 
     world = bpy.data.worlds.new("Sky")
     world.use_nodes = True

@@ -210,10 +210,10 @@ class Session:
         im = r.image_settings
         c.restore_later(im, ("file_format", "color_depth", "exr_codec"))
         im.file_format, im.color_depth, im.exr_codec = "OPEN_EXR_MULTILAYER", "32", "NONE"
-        # How far from its centre a pixel's camera rays leave: Box, the pixel; Gaussian, half
-        # the filter width; Blackman-Harris, the width (Cycles doubles its support).
-        self.filter_radius = {"BOX": 0.5, "GAUSSIAN": max(0.5, cy.filter_width / 2)}.get(
-            cy.pixel_filter_type, max(0.5, cy.filter_width))
+        # How far from its centre a pixel's camera rays leave: Cycles samples a filter over
+        # [-W/2, W/2], W = 3 widths for a Gaussian, 2 for Blackman-Harris; a Box keeps to the
+        # pixel whatever its width (docs/BLENDER.md, "The pixel filter").
+        self.filter_radius = max(0.5, {"BOX": 0.0, "GAUSSIAN": 1.5}.get(cy.pixel_filter_type, 1.0) * cy.filter_width)
         if self.filter_radius > 0.5:
             self.notes.append("pixel filter %s %.2f px: the mask around each exact pixel spans %.1f px, where its "
                               "rays leave (a Gaussian of 0.01 px renders the fewest pixels; docs/BLENDER.md)"
