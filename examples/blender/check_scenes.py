@@ -45,6 +45,8 @@ def parse_args():
     ap.add_argument("--seed", type=int, default=1, help="Cycles seed")
     ap.add_argument("--threads", type=int, default=2, help="render threads (0: all)")
     ap.add_argument("--save-blend", default="", help="also save the scene as .blend")
+    ap.add_argument("--pixel-filter", default="GAUSSIAN:0.01",
+                    help="TYPE:WIDTH (Blender's default: BLACKMAN_HARRIS:1.5)")
     return ap.parse_args(argv)
 
 

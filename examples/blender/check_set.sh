@@ -17,7 +17,9 @@
 # Cycles' own render time from the EXR's metadata.
 #
 # Environment: BLENDER (default blender), THREADS (Cycles threads, default 2),
-# SCENES (default "glossy spines mirror outdoor"), RES (default 256).
+# SCENES (default "glossy spines mirror outdoor"), RES (default 256),
+# FILTER (the pixel filter, TYPE:WIDTH; default GAUSSIAN:0.01, near point
+# sampling; Blender's own default is BLACKMAN_HARRIS:1.5).
 set -euo pipefail
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -27,6 +29,7 @@ BLENDER="${BLENDER:-blender}"
 THREADS="${THREADS:-2}"
 SCENES="${SCENES:-glossy spines mirror outdoor}"
 RES="${RES:-256}"
+FILTER="${FILTER:-GAUSSIAN:0.01}"
 command -v "$BLENDER" >/dev/null ||
   { echo "check_set.sh: no '$BLENDER' (sudo apt-get install --no-install-recommends blender)" >&2; exit 1; }
 command -v oiiotool >/dev/null || { echo "check_set.sh: no oiiotool (scripts/install-deps.sh)" >&2; exit 1; }
@@ -44,7 +47,7 @@ render() {  # SCENE EXR SAMPLES SEED [ARGS...]: renders EXR unless it exists
   # Written under a temporary name: an interrupted render leaves no EXR that
   # the next run would take as done.
   "$BLENDER" -b --factory-startup --python "$here/check_scenes.py" -- --scene "$scene" --out "$tmp" \
-    --res "$RES" --samples "$spp" --seed "$seed" --threads "$THREADS" "$@" > "$log" 2>&1 ||
+    --res "$RES" --samples "$spp" --seed "$seed" --threads "$THREADS" --pixel-filter "$FILTER" "$@" > "$log" 2>&1 ||
     { tail -20 "$log" >&2; rm -f "$tmp"; exit 1; }
   mv "$tmp" "$exr"
   local wall cycles

@@ -158,9 +158,11 @@ def setup_render(args):
     sc.cycles.seed = args.seed
     # (near) point sampling: the index and UV passes are not anti-aliased.
     # Gaussian, not Box: Cycles ignores the width of the Box filter (it always
-    # spreads the samples over the whole pixel).
-    sc.cycles.pixel_filter_type = "GAUSSIAN"
-    sc.cycles.filter_width = 0.01
+    # spreads the samples over the whole pixel). --pixel-filter TYPE:WIDTH
+    # where the script has it (Blender's default: BLACKMAN_HARRIS:1.5).
+    kind, width = (getattr(args, "pixel_filter", "") or "GAUSSIAN:0.01").split(":")
+    sc.cycles.pixel_filter_type = kind
+    sc.cycles.filter_width = float(width)
     sc.render.resolution_x = sc.render.resolution_y = args.res
     sc.render.resolution_percentage = 100
     sc.render.film_transparent = False

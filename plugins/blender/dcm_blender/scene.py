@@ -215,10 +215,13 @@ class Session:
         # pixel whatever its width (docs/BLENDER.md, "The pixel filter").
         self.filter_radius = max(0.5, {"BOX": 0.0, "GAUSSIAN": 1.5}.get(cy.pixel_filter_type, 1.0) * cy.filter_width)
         if self.filter_radius > 0.5:
-            self.notes.append("pixel filter %s %.2f px: the mask around each exact pixel spans %.1f px, where its "
-                              "rays leave (a Gaussian of 0.01 px renders the fewest pixels; docs/BLENDER.md)"
+            lo, hi = self._footprint()
+            self.notes.append("pixel filter %s %.2f px: a pixel's rays leave up to %.2f px from its centre, so the "
+                              "mask around each exact pixel spans %.2f x %.2f px, and every camera ray in it is "
+                              "traced in full (a Gaussian of 0.01 px: the pixel's own rays alone; docs/BLENDER.md, "
+                              "\"The pixel filter's cost\")"
                               % (cy.pixel_filter_type.replace("_", "-").title(), cy.filter_width,
-                                 2 * self.filter_radius))
+                                 self.filter_radius, (hi - lo) / self.args.mask_scale, (hi - lo) / self.args.mask_scale))
         self._insert_masks()
 
     # -------------------------------------------------------- the masks --
