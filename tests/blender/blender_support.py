@@ -6,8 +6,8 @@ import subprocess
 import numpy as np
 
 
-def make_scene(blender, src, tmp, res="64x48", samples=16, pixel_filter="BLACKMAN_HARRIS:1.5", name="scene.blend"):
-    out = os.path.join(tmp, name)
+def make_scene(blender, src, tmp, res="64x48", samples=16, pixel_filter="BLACKMAN_HARRIS:1.5"):
+    out = os.path.join(tmp, "scene.blend")
     subprocess.run([blender, "-b", "--factory-startup", "--python",
                     os.path.join(src, "tests/blender/make_scene.py"), "--", "--out", out,
                     "--res", res, "--samples", str(samples), "--filter", pixel_filter],

@@ -148,9 +148,9 @@ def main():
         err = np.abs(L - want)
         assert (err <= 1e-5 * np.maximum(np.abs(want), 1) + 1e-7).all(), "max |L - full render| = %g" % err.max()
 
-        # A Gaussian's rays leave up to 1.5 widths from the pixel's centre, 2.25 px at 1.5 px:
-        # a mask over half its width left some of an exact pixel's rays outside, and the
-        # pixel too dark by their share (the tolerance of the rounds above).
+        # A Gaussian's rays leave up to 1.5 widths from the pixel's centre, 2.25 px at 1.5 px.
+        # A mask over half its width missed some of them: the child's check refused the round,
+        # and the pixels missed their rays' share (the tolerance of the rounds above).
         gtmp = os.path.join(tmp, "gaussian")
         os.mkdir(gtmp)
         gblend = bs.make_scene(blender, src, gtmp, pixel_filter="GAUSSIAN:1.5")
