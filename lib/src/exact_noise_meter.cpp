@@ -21,6 +21,7 @@ Status ExactNoiseMeter::Evaluate(std::span<const Point2i> pixels, const SampleRe
   const size_t n = size_t(std::max(caps.width, 0)) * size_t(std::max(caps.height, 0));
   const bool measure =
       pixels_ == 0 && caps.variance && own_ && own_->size() == n && n > 0 && pixels.size() >= kMinPixels;
+  zeroExtraVariance_ = measure && !what.variance;
   if (!measure) return exact_.Evaluate(pixels, what, out);
   SampleRequest halves = what;
   halves.variance = true;
@@ -49,6 +50,12 @@ Status ExactNoiseMeter::Evaluate(std::span<const Point2i> pixels, const SampleRe
   if (!what.variance)
     for (ExactSample& s : out) s.variance = RGB{};
   return Status::Ok();
+}
+
+void ExactNoiseMeter::TakeExtraSamples(std::vector<Point2i>* pixels, std::vector<ExactSample>* samples) {
+  exact_.TakeExtraSamples(pixels, samples);
+  if (zeroExtraVariance_)
+    for (ExactSample& s : *samples) s.variance = RGB{};
 }
 
 }  // namespace dcm

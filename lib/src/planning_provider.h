@@ -94,7 +94,9 @@ class PlanningProvider : public SampleProvider {
   /// Working pixels evaluated exactly so far.
   int64_t KnownCount() const { return known_.size() - std::count(known_.begin(), known_.end(), uint8_t(0)); }
 
-  /// Evaluates `pixels` with the exact provider in one call and keeps them.
+  /// Evaluates `pixels` with the exact provider in one call and keeps them,
+  /// and the pixels it computed exactly besides (TakeExtraSamples) that are not
+  /// known yet: later runs get them without a call, and the result keeps them.
   Status EvaluateExactly(const std::vector<Point2i>& pixels) {
     std::vector<ExactSample> got(pixels.size());
     Status s = exact_.Evaluate(pixels, request_, got);
@@ -104,8 +106,23 @@ class PlanningProvider : public SampleProvider {
       samples_[k] = got[i];
       known_[k] = 1;
     }
+    std::vector<Point2i> extra;
+    std::vector<ExactSample> extraSamples;
+    exact_.TakeExtraSamples(&extra, &extraSamples);
+    for (size_t i = 0; i < extra.size() && i < extraSamples.size(); ++i) {
+      const Point2i p = extra[i];
+      if (p.x < 0 || p.y < 0 || p.x >= caps_.width || p.y >= caps_.height) continue;
+      const size_t k = Index(p);
+      if (known_[k]) continue;
+      samples_[k] = extraSamples[i];
+      known_[k] = 1;
+      ++extraCount_;
+    }
     return Status::Ok();
   }
+
+  /// Pixels kept from TakeExtraSamples(): exact without being asked for.
+  int64_t ExtraCount() const { return extraCount_; }
 
  private:
   size_t Index(const Point2i& p) const { return size_t(p.y) * size_t(caps_.width) + size_t(p.x); }
@@ -119,6 +136,7 @@ class PlanningProvider : public SampleProvider {
   std::vector<ExactSample> samples_;
   std::vector<Point2i> wantedList_;
   std::vector<size_t> missing_;
+  int64_t extraCount_ = 0;
 };
 
 /// The schedule's options in range, and a preview of the image's size that

@@ -88,6 +88,16 @@ class Child:
         line = self._ask(b"eval %d L,split\n" % len(xs) + xy.tobytes())
         assert line.split() == ["samples", str(len(xs))], line
         rec = self._read("<f4", 9 * len(xs)).reshape(-1, 9)
+        # Capability `extra`: the pixels the round rendered exactly besides, as
+        # self.extra = (x, y, L, L_i, L_c).
+        self.extra = None
+        if "extra" in self.caps:
+            t = self.p.stdout.readline().decode().split()
+            assert len(t) == 2 and t[0] == "extra", t
+            m = int(t[1])
+            exy = self._read("<i4", 2 * m).reshape(-1, 2)
+            erec = self._read("<f4", 9 * m).reshape(-1, 9)
+            self.extra = exy[:, 0], exy[:, 1], erec[:, 0:3], erec[:, 3:6], erec[:, 6:9]
         return rec[:, 0:3], rec[:, 3:6], rec[:, 6:9]
 
     def preview(self, x0, y0, x1, y1, what="L"):

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <utility>
 
 #include "dcm/round_schedule.h"
 #include "noisy_provider.h"
@@ -220,6 +221,81 @@ TEST(RoundSchedule, ThePreviewCorrectionCostsLittleWhereThePreviewIsMuchNoisier)
   std::printf("without the correction %.2f dB, with %.2f dB\n", psnr[0], psnr[1]);
   // Measured 38.44 and 38.04 dB (docs/ENGINE.md): a loss, bounded here at 0.6 dB.
   EXPECT_GE(psnr[1], psnr[0] - 0.6);
+}
+
+/// Offers, after every Evaluate(), the pixels right of those asked for as extra
+/// samples (TakeExtraSamples), with the values of `extraValues`: a renderer whose
+/// round renders some pixels besides (Cycles with a wide pixel filter).
+class ExtraRightProvider : public SampleProvider {
+ public:
+  ExtraRightProvider(SampleProvider& inner, SampleProvider& extraValues) : inner_(inner), values_(extraValues) {}
+  ProviderCapabilities Capabilities() const override { return inner_.Capabilities(); }
+  Status Guides(const Bounds2i& r, const GuideRequest& w, GuideImage* out) override { return inner_.Guides(r, w, out); }
+  Status Evaluate(std::span<const Point2i> p, const SampleRequest& w, std::span<ExactSample> out) override {
+    asked.emplace_back(p.begin(), p.end());
+    DCM_RETURN_IF_ERROR(inner_.Evaluate(p, w, out));
+    extra_.clear();
+    for (const Point2i& q : p)
+      if (q.x + 1 < inner_.Capabilities().width) extra_.push_back({q.x + 1, q.y});
+    extraSamples_.resize(extra_.size());
+    offered.push_back(extra_);
+    return values_.Evaluate(extra_, w, extraSamples_);
+  }
+  void TakeExtraSamples(std::vector<Point2i>* pixels, std::vector<ExactSample>* samples) override {
+    *pixels = std::exchange(extra_, {});
+    *samples = std::exchange(extraSamples_, {});
+  }
+  std::vector<std::vector<Point2i>> asked, offered;  ///< per call
+
+ private:
+  SampleProvider& inner_;
+  SampleProvider& values_;
+  std::vector<Point2i> extra_;
+  std::vector<ExactSample> extraSamples_;
+};
+
+TEST(RoundSchedule, ExtraSamplesAreKeptExactAndNeverAskedForAgain) {
+  const int N = 128;
+  AnalyticProvider truth(N, N, FurnishedScene(N, N)), values(N, N, FurnishedScene(N, N)),
+      other(N, N, FurnishedScene(N, N));
+  ExtraRightProvider exact(truth, values);
+  ImagePreviewProvider preview = LowResolutionPreview(truth, N, N, 8);
+  PreviewScheduleOptions schedule;
+  schedule.maxRounds = 3;
+  Reconstruction planned, plain;
+  PreviewScheduleStats stats, plainStats;
+  ASSERT_TRUE(ReconstructWithPreview(exact, preview, {}, schedule, &planned, &stats).ok());
+  ASSERT_TRUE(ReconstructWithPreview(other, preview, {}, schedule, &plain, &plainStats).ok());
+  ASSERT_GE(exact.asked.size(), 2u) << "a second round, which the first's extras could spare pixels";
+  // A pixel offered once is known: no later round asks the renderer for it.
+  std::vector<uint8_t> seen(size_t(N) * N, 0);
+  std::vector<Point2i> all;
+  for (size_t call = 0; call < exact.asked.size(); ++call) {
+    for (const Point2i& q : exact.asked[call])
+      EXPECT_FALSE(seen[size_t(q.y) * N + size_t(q.x)]) << "(" << q.x << ", " << q.y << ") asked for after it was offered";
+    for (const Point2i& q : exact.offered[call]) {
+      seen[size_t(q.y) * N + size_t(q.x)] = 1;
+      all.push_back(q);
+    }
+  }
+  // Every offered pixel is exact in the result (asked for by the final run, or
+  // kept: kRendered), with its exact value.
+  std::vector<ExactSample> want(all.size());
+  ASSERT_TRUE(values.Evaluate(all, {}, want).ok());
+  int64_t kept = 0;
+  for (size_t i = 0; i < all.size(); ++i) {
+    const Point2i q = all[i];
+    const size_t k = size_t(q.y) * N + size_t(q.x);
+    EXPECT_NE(planned.sampleMap[k], SampleReason::kInterpolated) << q.x << ", " << q.y;
+    EXPECT_NE(planned.sampleMap[k], SampleReason::kPreviewStandIn) << q.x << ", " << q.y;
+    if (planned.sampleMap[k] == SampleReason::kRendered) {
+      ++kept;
+      EXPECT_EQ(planned.workImage[k], want[i].L) << q.x << ", " << q.y;
+    }
+  }
+  EXPECT_GT(kept, 0);
+  EXPECT_GT(planned.stats.exactPixels, plain.stats.exactPixels);
+  EXPECT_EQ(truth.MaxEvaluationsOfOnePixel(), 1);
 }
 
 TEST(RoundSchedule, MinRoundShareStopsAfterTheFirstRound) {

@@ -270,6 +270,60 @@ for line in sys.stdin:
   EXPECT_TRUE(p->Finish().ok());
 }
 
+TEST(PipeProvider, ExtraPixelsFollowTheSamplesWhereAnnounced) {
+  // A child with capability `extra`: after the samples of an eval (L = x), the
+  // pixels of the row not asked for (L = 10 + x); with 'bad' in its argument an
+  // extra pixel outside the image.
+  auto child = [](const std::string& mode) {
+    return std::string(DCM_PYTHON3) + R"( -c "
+import struct, sys
+print('dcm-pipe 1 width=4 height=1 caps=extra', flush=True)
+inp, out = sys.stdin.buffer, sys.stdout.buffer
+while True:
+    t = inp.readline().split()
+    if not t or t[0] == b'quit':
+        break
+    if t[0] != b'eval':
+        continue
+    n = int(t[1])
+    xy = struct.unpack('<%di' % (2 * n), inp.read(8 * n))
+    asked = set(xy[0::2])
+    out.write(b'samples %d\n' % n)
+    for x in xy[0::2]:
+        out.write(struct.pack('<3f', x, x, x))
+    rest = [x for x in range(4) if x not in asked] + ([7] if ')" + mode + R"(' == 'bad' else [])
+    out.write(b'extra %d\n' % len(rest))
+    for x in rest:
+        out.write(struct.pack('<2i', x, 0))
+    for x in rest:
+        out.write(struct.pack('<3f', 10 + x, 10 + x, 10 + x))
+    out.flush()
+")";
+  };
+  std::unique_ptr<dcm::pipe::PipeProvider> p;
+  ASSERT_TRUE(Start(child("good"), &p).ok());
+  const std::vector<dcm::Point2i> px{{1, 0}, {3, 0}};
+  std::vector<dcm::ExactSample> s(px.size());
+  const dcm::Status good = p->Evaluate(px, {}, s);
+  ASSERT_TRUE(good.ok()) << good.message();
+  EXPECT_EQ(s[1].L.g, 3.f);
+  std::vector<dcm::Point2i> extra;
+  std::vector<dcm::ExactSample> values;
+  p->TakeExtraSamples(&extra, &values);
+  ASSERT_EQ(extra.size(), 2u);
+  ASSERT_EQ(values.size(), 2u);
+  EXPECT_EQ(extra[1].x, 2);
+  EXPECT_EQ(values[1].L.b, 12.f);
+  p->TakeExtraSamples(&extra, &values);
+  EXPECT_TRUE(extra.empty()) << "taken once";
+  EXPECT_TRUE(p->Finish().ok());
+
+  ASSERT_TRUE(Start(child("bad"), &p).ok());
+  const dcm::Status st = p->Evaluate(px, {}, s);
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.message().find("extra pixel (7, 0) outside the 4x1 image"), std::string::npos) << st.message();
+}
+
 /// Starts `command` and drives it through guides and one batch; returns the
 /// first error.
 dcm::Status Drive(const std::string& command, double timeout = 60) {

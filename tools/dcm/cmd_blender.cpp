@@ -133,11 +133,16 @@ class TimedProvider final : public SampleProvider {
     rounds.push_back({int64_t(pixels.size()), Since(t)});
     return st;
   }
+  void TakeExtraSamples(std::vector<Point2i>* pixels, std::vector<ExactSample>* samples) override {
+    p_.TakeExtraSamples(pixels, samples);
+    extraPixels += int64_t(pixels->size());
+  }
   struct Round {
     int64_t pixels;
     double seconds;
   };
   std::vector<Round> rounds;
+  int64_t extraPixels = 0;  ///< exact pixels the rounds gave besides those asked for
   double guidesS = 0;
   std::string step = "planning";  ///< what the last call did, for messages
 
@@ -165,6 +170,7 @@ class PooledVarianceProvider final : public SampleProvider {
   }
   Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what, std::span<ExactSample> out) override {
     DCM_RETURN_IF_ERROR(p_.Evaluate(pixels, what, out));
+    p_.TakeExtraSamples(&extraPixels_, &extraSamples_);
     if (!what.variance || pixels.empty()) return Status::Ok();
     const size_t n = size_t(caps_.width) * size_t(caps_.height);
     if (raw_.empty()) {
@@ -178,16 +184,28 @@ class PooledVarianceProvider final : public SampleProvider {
       value_ = raw_;
       rendered_.assign(n, 0);
     }
-    for (size_t i = 0; i < pixels.size(); ++i) {
-      const size_t k = size_t(pixels[i].y) * size_t(caps_.width) + size_t(pixels[i].x);
-      raw_[k] = out[i].variance;
-      value_[k] = out[i].L;
-      rendered_[k] = 1;
-    }
+    auto keep = [&](std::span<const Point2i> at, std::span<const ExactSample> got) {
+      for (size_t i = 0; i < at.size(); ++i) {
+        const size_t k = size_t(at[i].y) * size_t(caps_.width) + size_t(at[i].x);
+        raw_[k] = got[i].variance;
+        value_[k] = got[i].L;
+        rendered_[k] = 1;
+      }
+    };
+    keep(pixels, out);
+    keep(extraPixels_, extraSamples_);
     const std::vector<RGB> pooled =
         SurfaceWindowRelativeMean(raw_, value_, caps_.width, caps_.height, objectId_, shaderId_, radius_, pixels);
     for (size_t i = 0; i < pixels.size(); ++i) out[i].variance = pooled[i];
+    const std::vector<RGB> pooledExtra = SurfaceWindowRelativeMean(raw_, value_, caps_.width, caps_.height, objectId_,
+                                                                   shaderId_, radius_, extraPixels_);
+    for (size_t i = 0; i < extraSamples_.size(); ++i) extraSamples_[i].variance = pooledExtra[i];
     return Status::Ok();
+  }
+  /// The exact provider's extra pixels of the last Evaluate(), their variance pooled as the others'.
+  void TakeExtraSamples(std::vector<Point2i>* pixels, std::vector<ExactSample>* samples) override {
+    *pixels = std::exchange(extraPixels_, {});
+    *samples = std::exchange(extraSamples_, {});
   }
 
   /// The child's variance of each of `pixels` from that pixel alone where it
@@ -207,6 +225,8 @@ class PooledVarianceProvider final : public SampleProvider {
   std::vector<RGB> value_;         ///< the rendered pixels' values; NaN: not rendered
   std::vector<uint8_t> rendered_;  ///< 1 where the child rendered the pixel (its value may be NaN)
   std::vector<uint32_t> objectId_, shaderId_;
+  std::vector<Point2i> extraPixels_;
+  std::vector<ExactSample> extraSamples_;
 };
 
 /// Renders one frame (`frame` < 0: the file's current frame) to `output`.
@@ -524,6 +544,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     for (const auto& r : timed.rounds) rounds.push_back({{"pixels", r.pixels}, {"seconds", r.seconds}});
     b["rounds"] = rounds;
     b["preview_stand_ins"] = sched.previewStandIns;
+    b["extra_pixels"] = timed.extraPixels;
     if (schedule == RoundSchedule::kPreview && (!quality || targetFromPreview)) {  // the search's runs each make their own
       b["preview_corrected"] = sched.correction.pixels;
       b["preview_correction_weight"] = sched.correction.meanWeight;
@@ -576,10 +597,14 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
 
   std::printf("%s: %dx%d, %s, schedule %s, %zu render calls for exact pixels\n", output.c_str(), rec.width,
               rec.height, method.c_str(), std::string(ToString(schedule)).c_str(), timed.rounds.size());
-  std::printf("  exact pixels   %.2f %% (%lld of %lld)%s\n", 100.0 * stats_.exactFraction(),
+  std::printf("  exact pixels   %.2f %% (%lld of %lld)%s%s\n", 100.0 * stats_.exactFraction(),
               static_cast<long long>(stats_.exactPixels), static_cast<long long>(stats_.totalPixels),
               sched.previewStandIns ? (", " + std::to_string(sched.previewStandIns) + " preview stand-ins").c_str()
-                                    : "");
+                                    : "",
+              timed.extraPixels ? (", " + std::to_string(timed.extraPixels) +
+                                   " rendered without being asked for (the pixel filter's reach inside the mask)")
+                                      .c_str()
+                                : "");
   std::printf("  time           Blender start %.2f s, guides %.2f s, preview %.2f s, rounds %.2f s, DCM %.2f s, "
               "total %.2f s\n",
               handshakeS - guidesRenderS, guidesRenderS + timed.guidesS, previewS, roundsS, engineS, wallS);

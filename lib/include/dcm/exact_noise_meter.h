@@ -48,9 +48,12 @@ class ExactNoiseMeter final : public SampleProvider {
     return exact_.Guides(region, what, out);
   }
   Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what, std::span<ExactSample> out) override;
+  /// The exact provider's extra pixels, as the last Evaluate()'s caller asked for them.
+  void TakeExtraSamples(std::vector<Point2i>* pixels, std::vector<ExactSample>* samples) override;
 
  private:
   SampleProvider& exact_;
+  bool zeroExtraVariance_ = false;  ///< the last call asked for the variance its caller did not
   const std::vector<RGB>* own_ = nullptr;
   double share_ = std::numeric_limits<double>::quiet_NaN();
   int64_t pixels_ = 0;

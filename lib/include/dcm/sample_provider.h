@@ -97,6 +97,15 @@ class SampleProvider {
   /// (the engine then reports the requested pixels and stops).
   virtual Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what,
                           std::span<ExactSample> out) = 0;
+
+  /// Moves into `pixels` and `samples` the pixels that the last Evaluate()
+  /// computed exactly besides those asked for, as asked for (a renderer whose
+  /// call traces every ray of some other pixels too: Cycles with a wide pixel
+  /// filter). The same values as Evaluate() would give them. Default: none.
+  virtual void TakeExtraSamples(std::vector<Point2i>* pixels, std::vector<ExactSample>* samples) {
+    pixels->clear();
+    samples->clear();
+  }
 };
 
 }  // namespace dcm

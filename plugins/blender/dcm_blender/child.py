@@ -20,7 +20,7 @@ import numpy as np
 
 from . import scene
 
-CAPS = "object_id,shader_id,texture,normal,split,preview"
+CAPS = "object_id,shader_id,texture,normal,split,preview,extra"
 
 
 def parse_args(argv):
@@ -117,8 +117,13 @@ def serve(proto, session):
             if n and (xs.min() < 0 or ys.min() < 0 or xs.max() >= session.width or ys.max() >= session.height):
                 raise ValueError("eval: a pixel outside the %dx%d image" % (session.width, session.height))
             what = t[2].split(",")
-            L, Li, Lc, var = session.evaluate(xs, ys, "variance" in what) if n else (np.zeros((0, 3)),) * 4
+            none = np.zeros(0, np.int64), np.zeros(0, np.int64), *(np.zeros((0, 3), np.float32),) * 4
+            L, Li, Lc, var, extra = session.evaluate(xs, ys, "variance" in what) if n else (*none[2:], none)
             proto.send("samples %d" % n, _records(what, L, Li, Lc, var))
+            # Capability `extra`: the pixels the round rendered exactly besides.
+            ex, ey, eL, eLi, eLc, evar = extra
+            proto.send("extra %d" % len(ex), np.stack([ex, ey], axis=1).astype("<i4").tobytes()
+                       + _records(what, eL, eLi, eLc, evar))
         elif t[0] == "preview" and len(t) == 6:
             x0, y0, x1, y1 = (int(v) for v in t[1:5])
             g = session.guides()
@@ -193,7 +198,8 @@ def main(argv):
             print("dcm-blender: render %s %.2f s (Cycles: sync %.2f s, render %.2f s)" % (label, s, sync, render),
                   file=sys.stderr)
         print("dcm-blender: %d renders kept masked pixels for an eighth of the samples (an exact pixel might "
-              "have stopped early); %d exact pixels stopped early and were rendered again"
-              % (session.careful_renders, session.rendered_again), file=sys.stderr)
+              "have stopped early); %d exact pixels stopped early and were rendered again; %d pixels rendered "
+              "exactly besides those asked for (their pixel filter's reach inside the mask)"
+              % (session.careful_renders, session.rendered_again, session.extra_pixels), file=sys.stderr)
         print("dcm-blender: %.2f s in the child" % (time.monotonic() - t0), file=sys.stderr, flush=True)
     return status

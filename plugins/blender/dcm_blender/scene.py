@@ -120,6 +120,8 @@ class Session:
         self.noise_psnr = None  # of the exact pixels' samples, from the preview's halves
         self.render_seconds = []
         self.rendered_again = 0  # exact pixels that stopped early (_stopped_early)
+        self.extra_pixels = 0  # pixels rendered exactly without being asked for (evaluate)
+        self._known = None  # [height, width]: pixels asked for or given as extra so far
         self.careful_renders = 0  # renders of exact pixels whose masked pixels stopped late (_careful)
 
     # ------------------------------------------------------------- setup --
@@ -364,16 +366,18 @@ class Session:
                 texels[ty, tx] = 1.0
         return texels
 
-    def reached(self, texels):
-        """[height, width]: whether any camera ray of the pixel can meet a mask texel of 1."""
+    def reached(self, texels, every=False):
+        """[height, width]: whether any camera ray of the pixel can meet a mask
+        texel of 1; with `every`, whether all of them meet one."""
         k = self.args.mask_scale
         lo, hi = self._footprint()
         ys, xs = np.mgrid[0:self.height, 0:self.width]
-        out = np.zeros((self.height, self.width), bool)
+        out = np.full((self.height, self.width), every)
         for dy in range(lo, hi):
             ty = np.clip(ys * k + dy, 0, self.height * k - 1)
             for dx in range(lo, hi):
-                out |= texels[ty, np.clip(xs * k + dx, 0, self.width * k - 1)] > 0
+                hit = texels[ty, np.clip(xs * k + dx, 0, self.width * k - 1)] > 0
+                out = out & hit if every else out | hit
         return out
 
     # ----------------------------------------------------------- renders --
@@ -604,23 +608,36 @@ class Session:
         render call per rectangle of rectangles(), two with halves where the variance
         is asked for (var: the variance of L from the two halves at this pixel alone;
         None without halves). A round whose variance dcm does not weigh costs one
-        render call per rectangle, with the file's seed."""
+        render call per rectangle, with the file's seed. Then `extra`: (x, y, L, L_i,
+        L_c, var) of the pixels not asked for that the round rendered as a full
+        render does: every ray of theirs met the mask (a pixel filter wider than a
+        pixel), and they took every sample or are constant (_stopped_early)."""
         g = self.guides()
         if os.environ.get("DCM_BLENDER_TEST_FAULT") == "crash-on-eval":  # tests: Blender dies mid-round
             os.kill(os.getpid(), 9)
         texels = self.mask_of(xs, ys)
         self._write_mask(texels)
         reached = self.reached(texels)
+        if self._known is None:
+            self._known = np.zeros((self.height, self.width), bool)
+        self._known[ys, xs] = True
+        free = self.reached(texels, every=True) & ~self._known  # dcm has the others already
+        fy, fx = (a.astype(np.int64) for a in np.nonzero(free))
         # Samples per render: all of them, or two halves (the first takes the odd one).
         halves = self.halves and variance
         counts = [self.samples] if not halves else [self.samples - self.samples // 2, self.samples // 2]
         L = np.zeros((len(counts), len(xs), 3), np.float32)
         Li = np.zeros((len(counts), len(xs), 3), np.float32)
         done = np.zeros(len(xs), bool)
+        FL = np.zeros((len(counts), len(fx), 3), np.float32)
+        FLi = np.zeros((len(counts), len(fx), 3), np.float32)
+        fdone = np.zeros(len(fx), bool)
+        fshort = np.zeros(len(fx), bool)
         self._evals = getattr(self, "_evals", 0) + 1
         for rect in self.rectangles(xs, ys, len(counts)):
             self._set_border(rect)
             inside = self._inside(rect, xs, ys)
+            finside = self._inside(rect, fx, fy)
             for h, (n, seed) in enumerate(zip(counts, self.seeds)):
                 careful = self._careful(xs[inside], ys[inside], h, n)
                 self.careful_renders += careful
@@ -634,6 +651,8 @@ class Session:
                     raise SceneError("%d pixels outside the mask were rendered: the mask of this round did not "
                                      "reach Cycles" % int(stray.sum()))
                 L[h, inside], Li[h, inside] = self._exact_values(pl, xs[inside], ys[inside])
+                FL[h, finside], FLi[h, finside] = self._exact_values(pl, fx[finside], fy[finside])
+                fshort |= self._stopped_early(pl, n, fx, fy, finside)
                 early = np.flatnonzero(self._stopped_early(pl, n, xs, ys, inside))
                 if len(early):
                     self.rendered_again += len(early)
@@ -642,23 +661,30 @@ class Session:
                         L[h, early[in2]], Li[h, early[in2]] = self._exact_values(pl2, ex[in2], ey[in2])
                     self._set_border(rect)
             done |= inside
+            fdone |= finside
         self._set_border(None)
         self._masked_pixels_stop(0)
         self.scene.cycles.seed = self.seeds[0]
         if not done.all():
             raise SceneError("%d pixels fell outside every render border" % int((~done).sum()))
-        var = None
-        if halves:
-            # The mean weighted by samples; its variance (A - B)^2 nA nB / N^2 (dcm::HalvesVariance).
-            nA, nB = counts
-            N = float(self.samples)
-            var = ((L[0] - L[1]) ** 2 * (nA * nB / N ** 2)).astype(np.float32)
-            L = ((nA * L[0] + nB * L[1]) / N).astype(np.float32)
-            Li = ((nA * Li[0] + nB * Li[1]) / N).astype(np.float32)
-        else:
-            L, Li = L[0], Li[0]
-        Lc = L - Li * g["texture"][ys, xs]
-        return L, Li, Lc, var
+        keep = fdone & ~fshort
+        fx, fy, FL, FLi = fx[keep], fy[keep], FL[:, keep], FLi[:, keep]
+        self._known[fy, fx] = True
+
+        def combine(L, Li, x, y):
+            var = None
+            if halves:
+                # The mean weighted by samples; its variance (A - B)^2 nA nB / N^2 (dcm::HalvesVariance).
+                nA, nB = counts
+                N = float(self.samples)
+                var = ((L[0] - L[1]) ** 2 * (nA * nB / N ** 2)).astype(np.float32)
+                L = ((nA * L[0] + nB * L[1]) / N).astype(np.float32)
+                Li = ((nA * Li[0] + nB * Li[1]) / N).astype(np.float32)
+            else:
+                L, Li = L[0], Li[0]
+            return L, Li, L - Li * g["texture"][y, x], var
+        self.extra_pixels += len(fx)
+        return (*combine(L, Li, xs, ys), (fx, fy, *combine(FL, FLi, fx, fy)))
 
     def pixel_seconds(self):
         """What one pixel at full samples costs, from the guides render (its samples

@@ -218,6 +218,7 @@ Status PipeProvider::Handshake() {
         else if (c == "hard_shadows_guided") caps_.hardShadowsGuided = true;
         else if (c == "preview") preview_ = true;
         else if (c == "texture_covariance") textureCovariance_ = true;
+        else if (c == "extra") extra_ = true;
         // Unknown capabilities are ignored (newer providers).
       }
     } else if (key == "name") {
@@ -332,7 +333,60 @@ Status PipeProvider::Evaluate(std::span<const Point2i> pixels, const SampleReque
   }
   std::memcpy(message.data() + request.size() + 1, xy.data(), n * 8);
   ++evalRequests_;
-  return ReadSamples(request, message, n, split, variance, out.data());
+  extraPixels_.clear();
+  extraSamples_.clear();
+  DCM_RETURN_IF_ERROR(ReadSamples(request, message, n, split, variance, out.data()));
+  return extra_ ? ReadExtra(request, split, variance) : Status::Ok();
+}
+
+Status PipeProvider::ReadExtra(const std::string& request, bool split, bool variance) {
+  std::vector<std::string> t;
+  std::string failure;
+  if (!ReadAnswer(*child_, request, "extra", options_.timeoutSeconds, &t, &failure).ok()) return Fail(failure);
+  int64_t m = -1;
+  const int64_t most = int64_t(caps_.width) * int64_t(caps_.height);
+  if (t.size() != 2 || !ParseInt(t[1], &m) || m < 0 || m > most)
+    return Fail("sent a malformed 'extra' line after the samples of '" + request + "' (expected 'extra M', M from 0 to " +
+                std::to_string(most) + ")");
+  if (m == 0) return Status::Ok();
+  std::vector<int32_t> xy(size_t(m) * 2);
+  if (!ReadPayload(*child_, xy.data(), xy.size() * 4, request, options_.timeoutSeconds, &failure).ok())
+    return Fail(failure);
+  extraPixels_.resize(size_t(m));
+  for (size_t i = 0; i < size_t(m); ++i) {
+    const Point2i p{xy[2 * i], xy[2 * i + 1]};
+    if (p.x < 0 || p.y < 0 || p.x >= caps_.width || p.y >= caps_.height)
+      return Fail("sent an extra pixel (" + std::to_string(p.x) + ", " + std::to_string(p.y) + ") outside the " +
+                  std::to_string(caps_.width) + "x" + std::to_string(caps_.height) + " image after '" + request + "'");
+    extraPixels_[i] = p;
+  }
+  const size_t perPixel = 3 + (split ? 6 : 0) + (variance ? 3 : 0);
+  std::vector<float> f(size_t(m) * perPixel);
+  if (!ReadPayload(*child_, f.data(), f.size() * 4, request, options_.timeoutSeconds, &failure).ok())
+    return Fail(failure);
+  extraSamples_.resize(size_t(m));
+  for (size_t i = 0; i < size_t(m); ++i) {
+    const float* q = &f[i * perPixel];
+    ExactSample& e = extraSamples_[i];
+    e.L = {q[0], q[1], q[2]};
+    if (split) {
+      e.Li = {q[3], q[4], q[5]};
+      e.Lc = {q[6], q[7], q[8]};
+    }
+    if (variance) {
+      const float* v = q + (split ? 9 : 3);
+      e.variance = {v[0], v[1], v[2]};
+    }
+  }
+  return Status::Ok();
+}
+
+void PipeProvider::TakeExtraSamples(std::vector<Point2i>* pixels, std::vector<ExactSample>* samples) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  *pixels = std::move(extraPixels_);
+  *samples = std::move(extraSamples_);
+  extraPixels_.clear();
+  extraSamples_.clear();
 }
 
 Status PipeProvider::ReadSamples(const std::string& request, const std::vector<char>& message, size_t n, bool split,

@@ -7,6 +7,7 @@
 #include <mutex>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "dcm/round_schedule.h"
 #include "dcm/sample_provider.h"
@@ -68,6 +69,10 @@ class PipeProvider final : public SampleProvider {
   Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what,
                   std::span<ExactSample> out) override;
 
+  /// The pixels the child computed exactly besides those of the last "eval"
+  /// (capability `extra`: the line 'extra M' and M records after its samples).
+  void TakeExtraSamples(std::vector<Point2i>* pixels, std::vector<ExactSample>* samples) override;
+
   /// What a round costs, as the child announced it (round_latency=,
   /// sample_cost=; zero when it did not).
   const RoundCost& roundCost() const { return cost_; }
@@ -125,12 +130,17 @@ class PipeProvider final : public SampleProvider {
   /// with `textureCovariance` the part `texcov` into it.
   Status ReadSamples(const std::string& request, const std::vector<char>& message, size_t n, bool split,
                      bool variance, ExactSample* out, RGB* textureCovariance = nullptr);
+  /// Reads the answer 'extra M' to `request`, M pixels and their records, into extraPixels_/extraSamples_.
+  Status ReadExtra(const std::string& request, bool split, bool variance);
 
   ProviderCapabilities caps_;
   RoundCost cost_;
   std::map<std::string, std::string> keys_;
   bool preview_ = false;
   bool textureCovariance_ = false;  ///< capability `texture_covariance`
+  bool extra_ = false;              ///< capability `extra`
+  std::vector<Point2i> extraPixels_;      ///< the last eval's extra pixels
+  std::vector<ExactSample> extraSamples_;
   int64_t evalRequests_ = 0;
   int childVersion_ = 0;
   std::mutex mutex_;
