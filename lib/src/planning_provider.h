@@ -116,13 +116,9 @@ class PlanningProvider : public SampleProvider {
       if (known_[k]) continue;
       samples_[k] = extraSamples[i];
       known_[k] = 1;
-      ++extraCount_;
     }
     return Status::Ok();
   }
-
-  /// Pixels kept from TakeExtraSamples(): exact without being asked for.
-  int64_t ExtraCount() const { return extraCount_; }
 
  private:
   size_t Index(const Point2i& p) const { return size_t(p.y) * size_t(caps_.width) + size_t(p.x); }
@@ -136,7 +132,6 @@ class PlanningProvider : public SampleProvider {
   std::vector<ExactSample> samples_;
   std::vector<Point2i> wantedList_;
   std::vector<size_t> missing_;
-  int64_t extraCount_ = 0;
 };
 
 /// The schedule's options in range, and a preview of the image's size that
