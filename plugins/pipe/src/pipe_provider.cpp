@@ -360,25 +360,8 @@ Status PipeProvider::ReadExtra(const std::string& request, bool split, bool vari
                   std::to_string(caps_.width) + "x" + std::to_string(caps_.height) + " image after '" + request + "'");
     extraPixels_[i] = p;
   }
-  const size_t perPixel = 3 + (split ? 6 : 0) + (variance ? 3 : 0);
-  std::vector<float> f(size_t(m) * perPixel);
-  if (!ReadPayload(*child_, f.data(), f.size() * 4, request, options_.timeoutSeconds, &failure).ok())
-    return Fail(failure);
   extraSamples_.resize(size_t(m));
-  for (size_t i = 0; i < size_t(m); ++i) {
-    const float* q = &f[i * perPixel];
-    ExactSample& e = extraSamples_[i];
-    e.L = {q[0], q[1], q[2]};
-    if (split) {
-      e.Li = {q[3], q[4], q[5]};
-      e.Lc = {q[6], q[7], q[8]};
-    }
-    if (variance) {
-      const float* v = q + (split ? 9 : 3);
-      e.variance = {v[0], v[1], v[2]};
-    }
-  }
-  return Status::Ok();
+  return ReadRecords(request, size_t(m), split, variance, extraSamples_.data());
 }
 
 void PipeProvider::TakeExtraSamples(std::vector<Point2i>* pixels, std::vector<ExactSample>* samples) {
@@ -405,6 +388,12 @@ Status PipeProvider::ReadSamples(const std::string& request, const std::vector<c
     return Fail("answered 'samples " + std::to_string(count) + "' to '" + request + "', which asks for " +
                 std::to_string(n) + " pixels");
   }
+  return ReadRecords(request, n, split, variance, out, textureCovariance);
+}
+
+Status PipeProvider::ReadRecords(const std::string& request, size_t n, bool split, bool variance, ExactSample* out,
+                                 RGB* textureCovariance) {
+  std::string failure;
   const size_t perPixel = 3 + (split ? 6 : 0) + (variance ? 3 : 0) + (textureCovariance ? 3 : 0);
   std::vector<float> f(n * perPixel);
   if (!ReadPayload(*child_, f.data(), f.size() * 4, request, options_.timeoutSeconds, &failure).ok())

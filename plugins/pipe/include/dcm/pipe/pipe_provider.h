@@ -130,6 +130,10 @@ class PipeProvider final : public SampleProvider {
   /// with `textureCovariance` the part `texcov` into it.
   Status ReadSamples(const std::string& request, const std::vector<char>& message, size_t n, bool split,
                      bool variance, ExactSample* out, RGB* textureCovariance = nullptr);
+  /// Reads n records of the parts of `split`/`variance` (and `texcov` with
+  /// `textureCovariance`) that follow an answer to `request` into `out`.
+  Status ReadRecords(const std::string& request, size_t n, bool split, bool variance, ExactSample* out,
+                     RGB* textureCovariance = nullptr);
   /// Reads the answer 'extra M' to `request`, M pixels and their records, into extraPixels_/extraSamples_.
   Status ReadExtra(const std::string& request, bool split, bool variance);
 
