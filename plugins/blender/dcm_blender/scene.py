@@ -366,19 +366,20 @@ class Session:
                 texels[ty, tx] = 1.0
         return texels
 
-    def reached(self, texels, every=False):
-        """[height, width]: whether any camera ray of the pixel can meet a mask
-        texel of 1; with `every`, whether all of them meet one."""
+    def reached(self, texels):
+        """Two [height, width] masks: whether any camera ray of the pixel can meet
+        a mask texel of 1, and whether all of them do. One pass: the texels of 1
+        in each pixel's footprint, counted on a summed-area table (a texel off
+        the image reads the edge texel, as the texture's Extend does)."""
         k = self.args.mask_scale
         lo, hi = self._footprint()
-        ys, xs = np.mgrid[0:self.height, 0:self.width]
-        out = np.full((self.height, self.width), every)
-        for dy in range(lo, hi):
-            ty = np.clip(ys * k + dy, 0, self.height * k - 1)
-            for dx in range(lo, hi):
-                hit = texels[ty, np.clip(xs * k + dx, 0, self.width * k - 1)] > 0
-                out = out & hit if every else out | hit
-        return out
+        pad = max(-lo, hi - k, 0)
+        s = np.zeros((self.height * k + 2 * pad + 1, self.width * k + 2 * pad + 1), np.int64)
+        s[1:, 1:] = np.pad(texels > 0, pad, mode="edge").cumsum(0).cumsum(1)
+        y0, x0 = np.arange(self.height) * k + lo + pad, np.arange(self.width) * k + lo + pad
+        y1, x1 = y0 + hi - lo, x0 + hi - lo
+        count = s[y1][:, x1] - s[y0][:, x1] - s[y1][:, x0] + s[y0][:, x0]
+        return count > 0, count == (hi - lo) ** 2
 
     # ----------------------------------------------------------- renders --
     def _render(self, samples, label, seed=None):
@@ -617,11 +618,11 @@ class Session:
             os.kill(os.getpid(), 9)
         texels = self.mask_of(xs, ys)
         self._write_mask(texels)
-        reached = self.reached(texels)
+        reached, covered = self.reached(texels)
         if self._known is None:
             self._known = np.zeros((self.height, self.width), bool)
         self._known[ys, xs] = True
-        free = self.reached(texels, every=True) & ~self._known  # dcm has the others already
+        free = covered & ~self._known  # dcm has the others already
         fy, fx = (a.astype(np.int64) for a in np.nonzero(free))
         # Samples per render: all of them, or two halves (the first takes the odd one).
         halves = self.halves and variance
