@@ -9,7 +9,10 @@
 # REF.exr: the converged render (4x FULL's samples, another seed); FULL.exr:
 # the full render at SPP. The truth is MSE(x, REF) less REF's own noise,
 # MSE(FULL, REF) / 5. Environment: SPP (512), TARGET (40), THRESHOLDS
-# ("1.0 0.8 0.6 0.42 0.3 0.21 0.15 0.105 0.075 0.05"), DCM (build/tools/dcm/dcm).
+# ("1.0 0.8 0.6 0.42 0.3 0.21 0.15 0.105 0.075 0.05"), DCM (build/tools/dcm/dcm),
+# BUDGETS (none): `--budget B` for each B, judged by the preview and by
+# validation pixels, against the sweep's PSNR at the same exact fraction
+# (interpolated in log fraction; issue #22's bound: within 0.5 dB).
 set -euo pipefail
 here=$(cd "$(dirname "$0")/../.." && pwd)
 [ $# -eq 4 ] || { echo "usage: $0 OUT_DIR SCENE.blend REF.exr FULL.exr" >&2; exit 2; }
@@ -23,8 +26,14 @@ for t in $thresholds; do
 done
 "$dcm" blender "$blend" -o "$out/target.exr" --stats "$out/target.json" --samples "$spp" --target-psnr "$target" -q \
   >/dev/null
-/usr/bin/python3 - "$out" "$ref" "$full" "$target" $thresholds <<'PY'
-import json, sys
+for b in ${BUDGETS:-}; do
+  for judge in preview validation; do
+    "$dcm" blender "$blend" -o "$out/b${b}_$judge.exr" --stats "$out/b${b}_$judge.json" --samples "$spp" \
+      --budget "$b" --estimate-from "$judge" -q >/dev/null
+  done
+done
+BUDGETS="${BUDGETS:-}" /usr/bin/python3 - "$out" "$ref" "$full" "$target" $thresholds <<'PY'
+import json, os, sys
 import numpy as np
 import OpenImageIO as oiio
 
@@ -63,4 +72,14 @@ if best:
                                                                                      exact / best[1]))
 else:
     print("no threshold of the sweep reaches %g dB" % target)
+sweep = sorted(row("t" + t)[:2] for t in sys.argv[5:])
+for b in os.environ["BUDGETS"].split():
+    print("\n| --budget %s judged by | exact | true PSNR | estimated | the sweep at that fraction | render calls |" % b)
+    print("|---|---:|---:|---:|---:|---:|")
+    for judge in ("preview", "validation"):
+        exact, true, j = row("b%s_%s" % (b, judge))
+        at = next((p0 + (p1 - p0) * np.log(exact / f0) / np.log(f1 / f0)
+                   for (f0, p0), (f1, p1) in zip(sweep, sweep[1:]) if f0 <= exact <= f1 and f1 > f0), float("nan"))
+        print("| %s | %.2f %% | %.2f | %.2f | %.2f | %d |" % (judge, exact, true, j.get("estimated_psnr", float("nan")),
+                                                            at, len(j["blender"]["rounds"])))
 PY

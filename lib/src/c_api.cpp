@@ -596,9 +596,9 @@ DCM_API DCMError dcmExecute(DCMReconstructor r) {
       goal.budget = r->budget;
       goal.targetRender = r->targetRender;
       dcm::QualityReport report;
-      // A target alone, with a preview of known variance, noise-free exact
+      // A target or a budget, with a preview of known variance, noise-free exact
       // samples and rounds that cost: judged by the preview's estimate where it can tell.
-      const bool fromPreview = r->targetPsnr > 0 && !(r->budget > 0) && !r->noisySample &&
+      const bool fromPreview = !r->targetRender && !r->noisySample &&
                                !r->previewVariance.empty() &&
                                dcm::ChooseSchedule(r->roundCost) == dcm::RoundSchedule::kPreview;
       bool judged = false;
@@ -609,8 +609,8 @@ DCM_API DCMError dcmExecute(DCMReconstructor r) {
         schedule.maxRounds = r->maxRounds;
         if ((judged = dcm::CanTargetFromPreview(preview, schedule))) {
           dcm::PreviewTargetStats ladder;
-          st = dcm::ReconstructToTargetFromPreview(provider, preview, options, r->targetPsnr, schedule, &r->result,
-                                                   &report, &ladder);
+          st = dcm::ReconstructToTargetFromPreview(provider, preview, options, goal, schedule, &r->result, &report,
+                                                   &ladder);
           r->schedule = std::move(ladder.last);
           r->schedule.rounds = ladder.rounds;
         }

@@ -96,8 +96,9 @@ class PlanningProvider : public SampleProvider {
 
   /// Evaluates `pixels` with the exact provider in one call and keeps them,
   /// and the pixels it computed exactly besides (TakeExtraSamples) that are not
-  /// known yet: later runs get them without a call, and the result keeps them.
-  Status EvaluateExactly(const std::vector<Point2i>& pixels) {
+  /// known yet, while fewer than `maxKnown` pixels are known (0: no bound):
+  /// later runs get them without a call, and the result keeps them.
+  Status EvaluateExactly(const std::vector<Point2i>& pixels, int64_t maxKnown = 0) {
     std::vector<ExactSample> got(pixels.size());
     Status s = exact_.Evaluate(pixels, request_, got);
     if (!s.ok()) return s;
@@ -109,13 +110,15 @@ class PlanningProvider : public SampleProvider {
     std::vector<Point2i> extra;
     std::vector<ExactSample> extraSamples;
     exact_.TakeExtraSamples(&extra, &extraSamples);
-    for (size_t i = 0; i < extra.size() && i < extraSamples.size(); ++i) {
+    int64_t known = maxKnown > 0 ? KnownCount() : 0;
+    for (size_t i = 0; i < extra.size() && i < extraSamples.size() && (maxKnown <= 0 || known < maxKnown); ++i) {
       const Point2i p = extra[i];
       if (p.x < 0 || p.y < 0 || p.x >= caps_.width || p.y >= caps_.height) continue;
       const size_t k = Index(p);
       if (known_[k]) continue;
       samples_[k] = extraSamples[i];
       known_[k] = 1;
+      ++known;
     }
     return Status::Ok();
   }

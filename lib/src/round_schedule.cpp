@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cstdint>
 #include <cmath>
 #include <new>
 #include <string>
@@ -107,7 +108,10 @@ Status PlanAndRender(PlanningProvider& planning, const ReconstructionOptions& op
     if (!s.ok()) return s;
     std::vector<Point2i> wanted = planning.TakeWanted();
     const bool small = roundsBefore + rounds > 0 && double(wanted.size()) < schedule.minRoundShare * total;
-    if (wanted.empty() || rounds == schedule.maxRounds || small) {
+    const int64_t left = schedule.maxExactPixels > 0 ? schedule.maxExactPixels - planning.KnownCount() : INT64_MAX;
+    const bool spent = !wanted.empty() && left <= 0;
+    stats->budgetBound |= spent;
+    if (wanted.empty() || rounds == schedule.maxRounds || small || spent) {
       stats->previewStandIns = int64_t(wanted.size());
       // What was not rendered is not exact: the sample map and the counts say so.
       const int W = out->workWidth;
@@ -122,8 +126,12 @@ Status PlanAndRender(PlanningProvider& planning, const ReconstructionOptions& op
       }
       break;
     }
+    if (int64_t(wanted.size()) > left) {
+      wanted.resize(size_t(left));
+      stats->budgetBound = true;
+    }
     const auto exactStart = std::chrono::steady_clock::now();
-    s = planning.EvaluateExactly(wanted);
+    s = planning.EvaluateExactly(wanted, schedule.maxExactPixels);
     stats->timeExactS += Seconds(exactStart);
     if (!s.ok()) return s;
     ++rounds;

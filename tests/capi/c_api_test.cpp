@@ -416,11 +416,30 @@ TEST(CApi, ATargetWithAPreviewOfKnownVarianceIsJudgedByThePreview) {
   EXPECT_EQ(dcmGetStat(r, "target_reached"), 1.0);
   EXPECT_GE(dcmGetStat(r, "estimated_psnr_low"), 35.0);
   EXPECT_EQ(double(scene.evaluated.load()), dcmGetStat(r, "exact_pixels"));
-  // With a budget too, the validation search judges (whichever binds first).
-  dcmSetFloat(r, "budget", 0.5f);
+  // A budget alone (API version 8) is judged by the preview too: never passed.
+  const double total = double(scene.width) * scene.height;
+  dcmSetFloat(r, "target_psnr", 0.f);
+  dcmSetFloat(r, "budget", 0.2f);
+  scene.evaluated = 0;
   ASSERT_EQ(dcmExecute(r), DCM_ERROR_NONE) << TakeError(r);
-  EXPECT_EQ(dcmGetStat(r, "estimate_from_preview"), 0.0);
-  EXPECT_GT(dcmGetStat(r, "validation_pixels"), 0.0);
+  EXPECT_EQ(dcmGetStat(r, "estimate_from_preview"), 1.0);
+  EXPECT_EQ(dcmGetStat(r, "validation_pixels"), 0.0);
+  EXPECT_LE(dcmGetStat(r, "exact_pixels"), 0.2 * total);
+  EXPECT_EQ(double(scene.evaluated.load()), dcmGetStat(r, "exact_pixels"));
+  // With a target too: whichever binds first (here the ladder's plateau, at
+  // 1.3 % exact), judged by the preview.
+  dcmSetFloat(r, "target_psnr", 90.f);
+  ASSERT_EQ(dcmExecute(r), DCM_ERROR_NONE) << TakeError(r);
+  EXPECT_EQ(dcmGetStat(r, "estimate_from_preview"), 1.0);
+  EXPECT_EQ(dcmGetStat(r, "target_reached"), 0.0);
+  EXPECT_LE(dcmGetStat(r, "exact_pixels"), 0.2 * total);
+  // A budget below the plan at the coarsest threshold: an error naming it.
+  dcmSetFloat(r, "target_psnr", 0.f);
+  dcmSetFloat(r, "budget", 0.001f);
+  scene.evaluated = 0;
+  EXPECT_EQ(dcmExecute(r), DCM_ERROR_RECONSTRUCTION);
+  EXPECT_NE(TakeError(r).find("--budget"), std::string::npos);
+  EXPECT_EQ(scene.evaluated.load(), 0) << "before any pixel is rendered";
   dcmReleaseReconstructor(r);
 }
 

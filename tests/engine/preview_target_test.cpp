@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <string>
 #include <vector>
@@ -46,6 +47,13 @@ ImagePreviewProvider NoisyPreview(const std::vector<RGB>& truth, float sd, unsig
   return ImagePreviewProvider(M, M, M, M, std::move(L), {}, {}, std::move(var));
 }
 
+QualityGoal Goal(double targetPsnr, double budget = 0) {
+  QualityGoal g;
+  g.targetPsnr = targetPsnr;
+  g.budget = budget;
+  return g;
+}
+
 ReconstructionOptions Options() {
   ReconstructionOptions o;
   o.textureSplit = false;
@@ -67,7 +75,7 @@ TEST(PreviewTarget, TheTargetIsReachedAndEstimatedHonestlyRenderingEachPixelOnce
     Reconstruction r;
     QualityReport report;
     PreviewTargetStats stats;
-    const Status s = ReconstructToTargetFromPreview(exact, preview, Options(), target, schedule, &r, &report, &stats);
+    const Status s = ReconstructToTargetFromPreview(exact, preview, Options(), Goal(target), schedule, &r, &report, &stats);
     ASSERT_TRUE(s.ok()) << s.message();
     const double psnr = DisplayPsnr(r.image, ref);
     ASSERT_TRUE(report.targetReached) << target << " dB: estimated " << report.estimate.low;
@@ -104,7 +112,7 @@ TEST(PreviewTarget, ATargetTheLadderCannotReachIsReportedNotReached) {
   Reconstruction r;
   QualityReport report;
   PreviewTargetStats stats;
-  ASSERT_TRUE(ReconstructToTargetFromPreview(truth, preview, Options(), 80, {}, &r, &report, &stats).ok());
+  ASSERT_TRUE(ReconstructToTargetFromPreview(truth, preview, Options(), Goal(80), {}, &r, &report, &stats).ok());
   EXPECT_FALSE(report.targetReached);
   EXPECT_LT(report.estimate.low, 80);
   EXPECT_GE(stats.thresholds.size(), 3u) << "the ladder stops only at its end or a plateau";
@@ -123,7 +131,7 @@ TEST(PreviewTarget, ATargetBeyondTheRendersOwnNoiseIsNotSearchedFor) {
   Reconstruction r;
   QualityReport report;
   PreviewTargetStats stats;
-  ASSERT_TRUE(ReconstructToTargetFromPreview(truth, preview, Options(), 45, schedule, &r, &report, &stats).ok());
+  ASSERT_TRUE(ReconstructToTargetFromPreview(truth, preview, Options(), Goal(45), schedule, &r, &report, &stats).ok());
   EXPECT_TRUE(stats.beyondRender);
   EXPECT_NEAR(stats.renderPsnr, PreviewNoisePsnr(preview) + 10 * std::log10(2.0), 1e-9);
   EXPECT_LT(stats.renderPsnr, 45 + 0.5);
@@ -132,7 +140,7 @@ TEST(PreviewTarget, ATargetBeyondTheRendersOwnNoiseIsNotSearchedFor) {
   EXPECT_FALSE(report.targetReached);
   EXPECT_EQ(report.renderEstimate.psnr, stats.renderPsnr);
   // 35 dB leaves room: the ladder runs, from its coarse start.
-  ASSERT_TRUE(ReconstructToTargetFromPreview(truth, preview, Options(), 35, schedule, &r, &report, &stats).ok());
+  ASSERT_TRUE(ReconstructToTargetFromPreview(truth, preview, Options(), Goal(35), schedule, &r, &report, &stats).ok());
   EXPECT_FALSE(stats.beyondRender);
   EXPECT_GT(stats.thresholds[0], double(ResolveSettings(Options(), truth.Capabilities()).contrastThreshold));
 }
@@ -152,7 +160,7 @@ TEST(PreviewTarget, AShareMeasuredOnTheRoundsReplacesTheRatioOfSamples) {
   Reconstruction r;
   QualityReport report;
   PreviewTargetStats stats;
-  ASSERT_TRUE(ReconstructToTargetFromPreview(exact, preview, Options(), 45, schedule, &r, &report, &stats).ok());
+  ASSERT_TRUE(ReconstructToTargetFromPreview(exact, preview, Options(), Goal(45), schedule, &r, &report, &stats).ok());
   EXPECT_EQ(ExactVarianceShare(schedule), 0.05);
   const double own = PreviewNoisePsnr(preview);
   EXPECT_NEAR(stats.renderPsnrAtStart, own + 10 * std::log10(2.0), 1e-9);
@@ -164,7 +172,7 @@ TEST(PreviewTarget, AShareMeasuredOnTheRoundsReplacesTheRatioOfSamples) {
   assumed.exactVarianceShare = 0.5;
   Reconstruction r2;
   QualityReport report2;
-  ASSERT_TRUE(ReconstructToTargetFromPreview(truth, preview, Options(), 45, assumed, &r2, &report2).ok());
+  ASSERT_TRUE(ReconstructToTargetFromPreview(truth, preview, Options(), Goal(45), assumed, &r2, &report2).ok());
   EXPECT_EQ(r2.image, r.image) << "the same run: only the estimate differs";
   EXPECT_GT(report.estimate.psnr, report2.estimate.psnr);
   // Neither zero nor a negative or non-finite measurement replaces the ratio.
@@ -172,6 +180,103 @@ TEST(PreviewTarget, AShareMeasuredOnTheRoundsReplacesTheRatioOfSamples) {
     schedule.measuredExactVarianceShare = [bad] { return bad; };
     EXPECT_EQ(ExactVarianceShare(schedule), 0.5) << bad;
   }
+}
+
+TEST(PreviewTarget, ABudgetIsNeverExceededAndBuysWhatAThresholdBuysAtItsFraction) {
+  // A budget alone: one run at the threshold its plan on the preview affords.
+  // The bounds: never above the budget, and the PSNR within 0.5 dB of
+  // a sweep of single thresholds at the same exact fraction; the estimate
+  // within 1.5 dB of the truth, as for a target.
+  AnalyticProvider truth(M, M, FurnishedScene(M, M));
+  const std::vector<RGB> ref = truth.FullRender();
+  const double total = double(M) * M;
+  // The sweep: preview-planned runs at global thresholds from 1 down by x0.7.
+  std::vector<double> sweepFraction, sweepPsnr;
+  for (double t = 1; t > 0.004; t *= 0.7) {
+    ImagePreviewProvider preview = NoisyPreview(ref, 0.01f, 7);
+    ReconstructionOptions o = Options();
+    o.contrastThreshold = float(t);
+    Reconstruction r;
+    ASSERT_TRUE(ReconstructWithPreview(truth, preview, o, {}, &r).ok());
+    sweepFraction.push_back(r.stats.exactFraction());
+    sweepPsnr.push_back(DisplayPsnr(r.image, ref));
+  }
+  for (double budget : {0.06, 0.1, 0.2}) {
+    ImagePreviewProvider preview = NoisyPreview(ref, 0.01f, 7);
+    CountingProvider exact(truth);
+    Reconstruction r;
+    QualityReport report;
+    PreviewTargetStats stats;
+    const Status s = ReconstructToTargetFromPreview(exact, preview, Options(), Goal(0, budget), {}, &r, &report, &stats);
+    ASSERT_TRUE(s.ok()) << s.message();
+    EXPECT_LE(exact.pixelsAsked, budget * total) << budget;
+    EXPECT_LE(report.exactPixels, budget * total) << budget;
+    EXPECT_EQ(r.stats.exactPixels, report.exactPixels);
+    EXPECT_EQ(exact.maxAsked, 1);
+    ASSERT_EQ(stats.thresholds.size(), 1u) << "one run";
+    EXPECT_TRUE(report.targetReached) << "no target";
+    EXPECT_TRUE(report.budgetBound) << budget;
+    EXPECT_EQ(report.estimateSource, EstimateSource::kPreview);
+    EXPECT_EQ(report.validationPixels, 0);
+    const double psnr = DisplayPsnr(r.image, ref);
+    EXPECT_NEAR(report.estimate.psnr, psnr, 1.5) << budget;
+    // The sweep at this fraction, interpolated in log fraction between the
+    // runs around it.
+    const double f = report.exactFraction();
+    double atFraction = NAN;
+    for (size_t k = 1; k < sweepFraction.size(); ++k)
+      if (sweepFraction[k - 1] <= f && f <= sweepFraction[k]) {
+        const double a = sweepFraction[k] > sweepFraction[k - 1]
+                             ? std::log(f / sweepFraction[k - 1]) / std::log(sweepFraction[k] / sweepFraction[k - 1])
+                             : 0;
+        atFraction = sweepPsnr[k - 1] + a * (sweepPsnr[k] - sweepPsnr[k - 1]);
+      }
+    ASSERT_FALSE(std::isnan(atFraction)) << "the sweep spans " << f;
+    std::printf("budget %.2f: %.2f %% exact, threshold %.4f, %.2f dB (estimated %.2f), the sweep %.2f dB\n", budget,
+                100 * f, report.threshold, psnr, report.estimate.psnr, atFraction);
+    EXPECT_GE(psnr, atFraction - 0.5) << "budget " << budget << ", " << f << " exact";
+    // Most of the budget is spent: the plan may ask for 0.9 of it.
+    EXPECT_GE(report.exactPixels, 0.6 * budget * total) << budget;
+  }
+}
+
+TEST(PreviewTarget, WithATargetTheBudgetEndsTheLadderWhereItBinds) {
+  // 60 dB is beyond this scene's interpolation at 10 % exact: the ladder runs
+  // until a run would pass the budget, which then becomes the finest within it.
+  AnalyticProvider truth(M, M, FurnishedScene(M, M));
+  const std::vector<RGB> ref = truth.FullRender();
+  ImagePreviewProvider preview = NoisyPreview(ref, 0.01f, 8);
+  CountingProvider exact(truth);
+  Reconstruction r;
+  QualityReport report;
+  PreviewTargetStats stats;
+  ASSERT_TRUE(ReconstructToTargetFromPreview(exact, preview, Options(), Goal(60, 0.1), {}, &r, &report, &stats).ok());
+  EXPECT_FALSE(report.targetReached);
+  EXPECT_TRUE(report.budgetBound);
+  EXPECT_LE(exact.pixelsAsked, 0.1 * M * M);
+  EXPECT_EQ(exact.maxAsked, 1);
+  for (size_t k = 1; k < stats.thresholds.size(); ++k) EXPECT_LT(stats.thresholds[k], stats.thresholds[k - 1]);
+  // The same target without a budget spends more.
+  ImagePreviewProvider preview2 = NoisyPreview(ref, 0.01f, 8);
+  QualityReport free;
+  ASSERT_TRUE(ReconstructToTargetFromPreview(truth, preview2, Options(), Goal(60), {}, &r, &free).ok());
+  EXPECT_GT(free.exactPixels, report.exactPixels);
+}
+
+TEST(PreviewTarget, ABudgetBelowTheCoarsestPlanIsAnErrorBeforeAnyPixelIsRendered) {
+  AnalyticProvider truth(M, M, FurnishedScene(M, M));
+  ImagePreviewProvider preview = NoisyPreview(truth.FullRender(), 0.01f, 9);
+  CountingProvider exact(truth);
+  Reconstruction r;
+  QualityReport report;
+  const Status s = ReconstructToTargetFromPreview(exact, preview, Options(), Goal(0, 0.001), {}, &r, &report);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("--budget"), std::string::npos) << s.message();
+  EXPECT_EQ(exact.calls, 0);
+  QualityGoal render;
+  render.targetRender = true;
+  render.budget = 0.1;
+  EXPECT_FALSE(ReconstructToTargetFromPreview(exact, preview, Options(), render, {}, &r, &report).ok());
 }
 
 TEST(PreviewTarget, APreviewThatCannotTellIsRefusedWithTheReason) {
@@ -187,9 +292,9 @@ TEST(PreviewTarget, APreviewThatCannotTellIsRefusedWithTheReason) {
   // Out of range and without a preview variance: errors naming what.
   Reconstruction r;
   QualityReport report;
-  EXPECT_FALSE(ReconstructToTargetFromPreview(truth, clean, Options(), 0, {}, &r, &report).ok());
+  EXPECT_FALSE(ReconstructToTargetFromPreview(truth, clean, Options(), Goal(0), {}, &r, &report).ok());
   ImagePreviewProvider noVariance(M, M, M, M, ref);
-  const Status s = ReconstructToTargetFromPreview(truth, noVariance, Options(), 30, {}, &r, &report);
+  const Status s = ReconstructToTargetFromPreview(truth, noVariance, Options(), Goal(30), {}, &r, &report);
   EXPECT_FALSE(s.ok());
   EXPECT_NE(s.message().find("variance"), std::string::npos) << s.message();
 }

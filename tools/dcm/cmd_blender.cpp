@@ -314,12 +314,12 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   RoundSchedule schedule = RoundSchedule::kLevels;
   if (Status st = ScheduleFor(f.rounds, provider->roundCost(), provider->hasPreview(), &schedule); !st.ok())
     return Fail("'" + f.scene + "': " + st.message());
-  if (f.estimateFrom == "preview" &&
-      (schedule != RoundSchedule::kPreview || !f.pipe.engine.targetPsnr || f.pipe.engine.budget))
-    return Fail("--estimate-from preview: judges --target-psnr alone with the preview schedule (here " +
-                    std::string(!f.pipe.engine.targetPsnr ? "no --target-psnr"
-                                : f.pipe.engine.budget    ? "with --budget"
-                                                          : "schedule " + std::string(ToString(schedule))) +
+  const bool goalInDb = (f.pipe.engine.targetPsnr || f.pipe.engine.budget) && !f.pipe.engine.TargetsRender();
+  if (f.estimateFrom == "preview" && (schedule != RoundSchedule::kPreview || !goalInDb))
+    return Fail("--estimate-from preview: judges --target-psnr in dB or --budget with the preview schedule (here " +
+                    std::string(schedule != RoundSchedule::kPreview ? "schedule " + std::string(ToString(schedule))
+                                : f.pipe.engine.TargetsRender()     ? "--target-psnr render"
+                                                                    : "no --target-psnr or --budget") +
                     ")",
                 kExitUsage);
   if (options.fullEvaluation) {
@@ -393,9 +393,9 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     so.maxRounds = f.rounds.maxRounds;
     so.correctionRadius = f.rounds.previewCorrection;
     so.minRoundShare = f.rounds.minRoundShare;
-    // A target alone is judged by the preview's estimate where the preview can tell.
+    // A target in dB or a budget is judged by the preview's estimate where the preview can tell.
     const double target = f.pipe.engine.targetPsnr.value_or(defaultGoal ? kDefaultTargetPsnr : 0);
-    if (st.ok() && target > 0 && !f.pipe.engine.budget && f.estimateFrom != "validation") {
+    if (st.ok() && (target > 0 || goalInDb) && f.estimateFrom != "validation") {
       std::string why;
       if (so.correctionRadius < 1) why = "--preview-correction 0: the correction makes the estimate";
       else if (options.downsample != 1) why = "--downsample: the preview estimates at final resolution only";
@@ -404,7 +404,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       // The render's own noise bounds raw exact samples; the engine's denoising
       // of noisy ones can pass it, which only validation pixels tell.
       const double renderPsnr = targetFromPreview && useVariance ? ratioRenderPsnr : HUGE_VAL;
-      if (target > renderPsnr - kRenderNoiseMarginDb) {
+      if (target > 0 && target > renderPsnr - kRenderNoiseMarginDb) {
         targetFromPreview = false;
         char line[160];
         std::snprintf(line, sizeof line, "the render's own noise (about %.2f dB against the converged image), which "
@@ -421,19 +421,22 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
                                           "(--target-psnr " + DefaultTarget() + "): " + why)
                   << "\n";
       else if (f.pipe.engine.verbose)
-        std::cerr << "blender: --target-psnr judged by "
+        std::cerr << "blender: " << (target > 0 ? "--target-psnr" : "--budget") << " judged by "
                   << (targetFromPreview ? std::string("the preview's estimate") : "validation pixels: " + why) << "\n";
     }
     // The exact pixels' noise is measured (the first round in two halves: one
     // render call more, unless the engine weighs the variance) but for a
     // target judged by the preview that the render's own noise, from the
     // ratio of samples, lies kMeasureNoiseMarginDb or more beyond.
-    measureNoise = !(st.ok() && targetFromPreview && !useVariance && ratioRenderPsnr >= target + kMeasureNoiseMarginDb);
+    measureNoise =
+        !(st.ok() && targetFromPreview && !useVariance && target > 0 && ratioRenderPsnr >= target + kMeasureNoiseMarginDb);
     if (measureNoise) meter.SetPreviewVariance(&so.previewOwnVariance);
     if (targetFromPreview) {
       QualityReport report;
       const auto tq = Clock::now();
-      st = ReconstructToTargetFromPreview(timed, *preview, options, target, so, &rec, &report, &ptarget);
+      QualityGoal previewGoal = goal;
+      previewGoal.targetPsnr = std::max(0.0, target);
+      st = ReconstructToTargetFromPreview(timed, *preview, options, previewGoal, so, &rec, &report, &ptarget);
       goalS = Since(tq);
       if (st.ok()) quality = std::move(report);
       sched = ptarget.last;
@@ -686,10 +689,10 @@ Registration reg("blender", "Render a .blend with Cycles at the pixels DCM asks 
                        ->check(CLI::IsMember({"auto", "on", "off"}))
                        ->capture_default_str();
                    app->add_option("--estimate-from", f->estimateFrom,
-                                   "what judges --target-psnr: the preview's estimate at every pixel (against the "
-                                   "converged image; needs the preview's variance), validation pixels rendered "
-                                   "exactly, or auto (the preview where it can tell: its own noise under 25 dB "
-                                   "and no --budget). Without --target-psnr, --threshold or --budget the goal is "
+                                   "what judges --target-psnr and --budget: the preview's estimate at every pixel "
+                                   "(against the converged image; needs the preview's variance), validation pixels "
+                                   "rendered exactly, or auto (the preview where it can tell: its own noise under "
+                                   "25 dB). Without --target-psnr, --threshold or --budget the goal is "
                                    "--target-psnr 40 where the preview can judge it, else the default threshold")
                        ->check(CLI::IsMember({"auto", "preview", "validation"}))
                        ->capture_default_str();

@@ -49,8 +49,10 @@ extern "C" {
  *  Version 5 adds dcmSetPreviewVariance(). Version 6 adds DCM_REASON_RENDERED.
  *  Version 7: "target_psnr" with a preview of known variance is judged by the
  *  preview's estimate (the statistic "estimate_from_preview"), and a
- *  preview-planned run without a goal reports that estimate. */
-#define DCM_C_API_VERSION 7
+ *  preview-planned run without a goal reports that estimate. Version 8:
+ *  "budget" (alone or with "target_psnr") is judged by the preview's estimate
+ *  where "target_psnr" alone was. */
+#define DCM_C_API_VERSION 8
 
 /** A reconstructor: options, guides, the sample callback and the last result. */
 typedef struct DCMReconstructorImpl* DCMReconstructor;
@@ -324,8 +326,8 @@ DCM_API const uint8_t* dcmGetSampleMap(DCMReconstructor r, int* width, int* heig
  *  "estimated_render_psnr", "estimated_render_psnr_low",
  *  "estimated_render_psnr_high" (the full render's own PSNR against the
  *  converged image; NaN without variance), "estimate_from_preview" (1: the
- *  target was judged by the preview's estimate, dcm/preview_target.h: with
- *  "target_psnr" alone, a preview at the image size with its variance
+ *  goal was judged by the preview's estimate, dcm/preview_target.h: with
+ *  "target_psnr" or "budget" or both, a preview at the image size with its variance
  *  (dcmSetPreviewVariance), rounds that cost (dcmSetRoundCost) and noise-free
  *  samples, where the preview's own noise costs less than 25 dB; against the
  *  converged image, no validation pixels), and "exact_pixels" counts every

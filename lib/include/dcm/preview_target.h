@@ -54,30 +54,45 @@ inline constexpr double kRenderNoiseMarginDb = 0.5;
 /// engine's denoising of noisy samples (ResolvedSettings::noisy) can.
 double RenderPsnrFromPreview(SampleProvider& preview, const PreviewScheduleOptions& schedule);
 
-/// Reconstructs `exact`'s image at the coarsest threshold of a ladder whose
-/// result, as the preview correction estimates it against the converged
-/// image, reaches `targetPsnr` at the estimate's lower bound (the one-sided
-/// 95 % bound). The ladder starts at three times the options' threshold (unset: the
+/// Reconstructs `exact`'s image to `goal` (its targetPsnr and budget; the
+/// other fields are the validation search's, and targetRender is refused),
+/// judged by the preview correction's estimate against the converged image.
+///
+/// A target: the coarsest threshold of a ladder whose result reaches
+/// goal.targetPsnr at the estimate's lower bound (the one-sided 95 % bound).
+/// The ladder starts at three times the options' threshold (unset: the
 /// regime's default) and halves it per run, at most 7 runs; it stops early
 /// where the estimate stops rising. Each run is ReconstructWithPreview with
 /// `schedule` (which needs the preview's variance, and its own variance and
 /// the exact share for the estimate), planned on the preview and on every
 /// exact sample earlier runs rendered: a pixel is rendered once, and what an
 /// earlier run rendered that this one interpolates keeps its exact value.
+///
+/// A budget: at most goal.budget of the working pixels exact
+/// (PreviewScheduleOptions::maxExactPixels). Alone, one run, at the smallest
+/// threshold whose plan on the preview (the engine run on the preview before
+/// any pixel is rendered) asks for at most 0.9 of the budget: the rounds after
+/// the first add the pixels whose choice the exact values changed. With a
+/// target, the ladder's run that would pass that share is bisected the same
+/// way between its threshold and the one before, and ends the ladder
+/// (`report->budgetBound`). A budget below the plan at threshold 1 is an error
+/// naming --budget, before any pixel is rendered.
+///
 /// `report` is that of ReconstructToQuality (estimate against the converged
 /// image, from the preview: `estimateSource` kPreview, no validation pixels;
 /// exactPixels every pixel rendered, as the result's stats.exactPixels; its
-/// byReason and sample map are the last run's). A target not reached is no error:
-/// `report->targetReached` says so and the result is the last run's. A
+/// byReason and sample map are the last run's). A target not reached is no
+/// error: `report->targetReached` says so and the result is the last run's. A
 /// target the render's own noise leaves no room for (the exact samples keep
 /// `schedule.exactVarianceShare` of the preview's noise: what every pixel
 /// rendered would reach, less 0.5 dB) is not searched for: one run at the
-/// options' threshold, `stats->beyondRender`, reported not reached (more
+/// options' threshold (with a budget: the threshold the budget allows, if
+/// that is coarser), `stats->beyondRender`, reported not reached (more
 /// samples are the remedy, not more exact pixels). That is decided before
 /// any exact pixel is rendered, with the share known then
 /// (PreviewTargetStats::renderPsnrAtStart).
 Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& preview,
-                                      const ReconstructionOptions& options, double targetPsnr,
+                                      const ReconstructionOptions& options, const QualityGoal& goal,
                                       const PreviewScheduleOptions& schedule, Reconstruction* out,
                                       QualityReport* report, PreviewTargetStats* stats = nullptr);
 

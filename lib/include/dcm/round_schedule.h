@@ -91,6 +91,12 @@ struct PreviewScheduleOptions {
   /// and the estimate takes that out (CorrectTowardPreview). Empty: the
   /// texture guide is independent of the preview's noise.
   std::vector<RGB> previewTextureCovariance;
+  /// At most this many working pixels exact over the planner's runs, those
+  /// asked for and those the provider returns besides (TakeExtraSamples)
+  /// alike; a round that would pass it renders the first pixels it asks for
+  /// (the engine's order, coarse levels first) and the rest keep their
+  /// preview value. 0: no bound.
+  int64_t maxExactPixels = 0;
 };
 
 /// The exact samples' variance as a share of the preview's: the measured
@@ -106,6 +112,7 @@ struct PreviewScheduleStats {
   double timeEngineS = 0;               ///< in the engine runs (preview evaluation included)
   double timeExactS = 0;                ///< in the exact provider's Evaluate()
   PreviewCorrectionStats correction;    ///< the preview correction (pixels 0: not made)
+  bool budgetBound = false;             ///< maxExactPixels left wanted pixels at their preview value
 };
 
 /// Reconstructs `exact`'s image, choosing the exact pixels from `preview`
