@@ -22,14 +22,17 @@ spp=${SPP:-512} target=${TARGET:-40}
 thresholds=${THRESHOLDS:-1.0 0.8 0.6 0.42 0.3 0.21 0.15 0.105 0.075 0.05}
 mkdir -p "$out"
 for t in $thresholds; do
+  # RESUME=1 keeps the sweep's runs already in OUT_DIR (the same build and scene only).
+  [ "${RESUME:-0}" = 1 ] && [ -f "$out/t$t.json" ] && continue
   "$dcm" blender "$blend" -o "$out/t$t.exr" --stats "$out/t$t.json" --samples "$spp" --threshold "$t" -q >/dev/null
 done
 "$dcm" blender "$blend" -o "$out/target.exr" --stats "$out/target.json" --samples "$spp" --target-psnr "$target" -q \
   >/dev/null
 for b in ${BUDGETS:-}; do
   for judge in preview validation; do
+    rm -f "$out/b${b}_$judge.json"
     "$dcm" blender "$blend" -o "$out/b${b}_$judge.exr" --stats "$out/b${b}_$judge.json" --samples "$spp" \
-      --budget "$b" --estimate-from "$judge" -q >/dev/null
+      --budget "$b" --estimate-from "$judge" -q >/dev/null || true
   done
 done
 BUDGETS="${BUDGETS:-}" /usr/bin/python3 - "$out" "$ref" "$full" "$target" $thresholds <<'PY'
@@ -77,6 +80,9 @@ for b in os.environ["BUDGETS"].split():
     print("\n| --budget %s judged by | exact | true PSNR | estimated | the sweep at that fraction | render calls |" % b)
     print("|---|---:|---:|---:|---:|---:|")
     for judge in ("preview", "validation"):
+        if not os.path.exists("%s/b%s_%s.json" % (out, b, judge)):
+            print("| %s | refused (stderr above) | | | | |" % judge)
+            continue
         exact, true, j = row("b%s_%s" % (b, judge))
         at = next((p0 + (p1 - p0) * np.log(exact / f0) / np.log(f1 / f0)
                    for (f0, p0), (f1, p1) in zip(sweep, sweep[1:]) if f0 <= exact <= f1 and f1 > f0), float("nan"))

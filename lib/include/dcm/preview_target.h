@@ -75,7 +75,7 @@ double RenderPsnrFromPreview(SampleProvider& preview, const PreviewScheduleOptio
 /// the first add the pixels whose choice the exact values changed. With a
 /// target, the ladder's run that would pass that share is bisected the same
 /// way between its threshold and the one before, and ends the ladder
-/// (`report->budgetBound`). A budget below the plan at threshold 1 is an error
+/// (`report->budgetBound`). A budget below the plan at threshold 16 is an error
 /// naming --budget, before any pixel is rendered.
 ///
 /// `report` is that of ReconstructToQuality (estimate against the converged
