@@ -72,16 +72,12 @@ Status PlannedPixels(PlanningProvider& planning, ReconstructionOptions o, double
   return Status::Ok();
 }
 
-/// The smallest threshold in [lo, hi] whose plan asks for at most `allowed`
-/// pixels, bisected in log threshold (the plan shrinks as the threshold
-/// grows); `*fits` false where even `hi`'s plan asks for more.
+/// The smallest threshold in (lo, hi] whose plan asks for at most `allowed`
+/// pixels, where `lo`'s asks for more: bisected in log threshold (the plan
+/// shrinks as the threshold grows); `*fits` false where even `hi`'s does.
 Status FitThreshold(PlanningProvider& planning, const ReconstructionOptions& o, double lo, double hi,
                     int64_t allowed, double* engineS, double* threshold, bool* fits) {
   int64_t n = 0;
-  DCM_RETURN_IF_ERROR(PlannedPixels(planning, o, lo, engineS, &n));
-  *fits = true;
-  *threshold = lo;
-  if (n <= allowed) return Status::Ok();
   DCM_RETURN_IF_ERROR(PlannedPixels(planning, o, hi, engineS, &n));
   *threshold = hi;
   *fits = n <= allowed;
