@@ -159,8 +159,33 @@ class RoundKeeper : public SampleProvider {
       samples_[k] = got[i];
       mask_[k] = Mask(what);
     }
+    // The pixels the call computed besides are kept as rendered (never
+    // rendered again) and passed on once, to the cache above.
+    std::vector<Point2i> extra;
+    std::vector<ExactSample> extraSamples;
+    exact_.TakeExtraSamples(&extra, &extraSamples);
+    pendingExtra_.clear();
+    pendingExtraSamples_.clear();
+    for (size_t i = 0; i < extra.size() && i < extraSamples.size(); ++i) {
+      const Point2i p = extra[i];
+      if (p.x < 0 || p.y < 0 || p.x >= caps_.width || p.y >= caps_.height || epoch_[Index(p)] >= 0) continue;
+      const size_t k = Index(p);
+      epoch_[k] = epoch;
+      samples_[k] = extraSamples[i];
+      mask_[k] = Mask(what);
+      pendingExtra_.push_back(p);
+      pendingExtraSamples_.push_back(extraSamples[i]);
+    }
     return Status::Ok();
   }
+
+ public:
+  void TakeExtraSamples(std::vector<Point2i>* pixels, std::vector<ExactSample>* samples) override {
+    *pixels = std::exchange(pendingExtra_, {});
+    *samples = std::exchange(pendingExtraSamples_, {});
+  }
+
+ private:
 
   SampleProvider& exact_;
   SampleProvider& preview_;
@@ -174,6 +199,8 @@ class RoundKeeper : public SampleProvider {
   std::vector<uint8_t> owedMark_;
   SampleRequest owedRequest_;
   SampleRequest request_;  ///< the union of the requests rendered
+  std::vector<Point2i> pendingExtra_;  ///< the last call's extra pixels, for TakeExtraSamples
+  std::vector<ExactSample> pendingExtraSamples_;
   int runs_ = 0, run_ = 0;
   bool roundDue_ = false;
 };

@@ -10,6 +10,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "dcm/downsample.h"
 
@@ -142,10 +143,29 @@ class CachingProvider : public SampleProvider {
     for (size_t k = 0; k < misses.size(); ++k) ask[k] = pixels[misses[k]];
     std::vector<ExactSample> got(misses.size());
     const Status st = ask.empty() ? Status::Ok() : inner_.Evaluate(ask, what, got);
+    std::vector<Point2i> extra;
+    std::vector<ExactSample> extraSamples;
+    if (st.ok() && !ask.empty()) inner_.TakeExtraSamples(&extra, &extraSamples);
     std::lock_guard<std::mutex> lock(mutex_);
     if (!st.ok()) {
       distinct_ -= fresh;
       return st;
+    }
+    // Pixels the call computed besides, cached and counted as evaluated while
+    // the budget lasts; TakeExtraSamples passes them on.
+    pendingExtra_.clear();
+    pendingExtraSamples_.clear();
+    for (size_t k = 0; k < extra.size() && k < extraSamples.size(); ++k) {
+      const Point2i p = extra[k];
+      if (p.x < 0 || p.y < 0 || p.x >= caps_.width || p.y >= caps_.height) continue;
+      int32_t& i = index_[Index(p)];
+      if (i >= 0 || (limit_ > 0 && distinct_ >= limit_)) continue;
+      i = int32_t(samples_.size());
+      samples_.push_back(extraSamples[k]);
+      masks_.push_back(need);
+      ++distinct_;
+      pendingExtra_.push_back(p);
+      pendingExtraSamples_.push_back(extraSamples[k]);
     }
     for (size_t k = 0; k < misses.size(); ++k) {
       int32_t& i = index_[Index(ask[k])];
@@ -160,6 +180,13 @@ class CachingProvider : public SampleProvider {
     }
     for (size_t k = 0; k < pixels.size(); ++k) out[k] = samples_[size_t(index_[Index(pixels[k])])];
     return Status::Ok();
+  }
+
+  /// The extra pixels of the last call that evaluated something, once.
+  void TakeExtraSamples(std::vector<Point2i>* pixels, std::vector<ExactSample>* samples) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    *pixels = std::exchange(pendingExtra_, {});
+    *samples = std::exchange(pendingExtraSamples_, {});
   }
 
   int64_t Distinct() const {
@@ -206,6 +233,8 @@ class CachingProvider : public SampleProvider {
   bool budgetHit_ = false;
   bool marking_ = false;
   std::vector<uint8_t> engine_;  ///< per working pixel: asked by the engine's run (MarkEngine)
+  std::vector<Point2i> pendingExtra_;  ///< TakeExtraSamples's
+  std::vector<ExactSample> pendingExtraSamples_;
   std::mutex guideMutex_;
   std::optional<GuideImage> guides_;
   GuideRequest guideRequest_;

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include "dcm/quality_preview.h"
 #include "run_helpers.h"
@@ -65,6 +66,46 @@ TEST(QualityPreview, TargetIsMetInAboutTwoRoundsPerRun) {
     // confirming draws.
     EXPECT_LE(r.rounds.rounds, 2 * r.report.runs + 6);
     EXPECT_EQ(int64_t(r.rounds.pixelsPerRound.size()), r.rounds.rounds);
+  }
+}
+
+TEST(QualityPreview, ExtraPixelsAreCachedKeptAndCounted) {
+  // A renderer whose rounds render the pixel right of each asked for besides
+  // (Cycles with a wide pixel filter): the search's cache keeps them, no later
+  // run or validation draw asks for them, and the result shows them exact.
+  const int N = 128;
+  for (double budget : {0.0, 0.15}) {
+    AnalyticProvider truth(N, N, FurnishedScene(N, N)), values(N, N, FurnishedScene(N, N));
+    ExtraRightProvider exact(truth, values);
+    ImagePreviewProvider preview = LowResolutionPreview(truth, N, N, 4);
+    PreviewScheduleOptions schedule;
+    schedule.maxRounds = 2;
+    QualityGoal goal;
+    goal.targetPsnr = 40;
+    goal.budget = budget;
+    Reconstruction r;
+    QualityReport report;
+    ASSERT_TRUE(ReconstructToQualityWithPreview(exact, preview, {}, goal, schedule, &r, &report).ok());
+    std::vector<uint8_t> offered(size_t(N) * N, 0);
+    int64_t asked = 0, kept = 0;
+    for (size_t call = 0; call < exact.asked.size(); ++call) {
+      for (const Point2i& q : exact.asked[call]) {
+        if (budget == 0) {
+          EXPECT_FALSE(offered[size_t(q.y) * N + size_t(q.x)]) << q.x << ", " << q.y << " asked after it was offered";
+        }
+        ++asked;
+      }
+      for (const Point2i& q : exact.offered[call]) offered[size_t(q.y) * N + size_t(q.x)] = 1;
+    }
+    for (size_t k = 0; k < r.sampleMap.size(); ++k) kept += r.sampleMap[k] == SampleReason::kRendered;
+    EXPECT_GT(kept, 0) << "extra pixels the final run interpolates stay exact";
+    EXPECT_GT(report.exactPixels, asked) << "the kept extra pixels count as evaluated";
+    EXPECT_EQ(truth.MaxEvaluationsOfOnePixel(), 1);
+    if (budget > 0) {
+      EXPECT_LE(report.exactPixels, budget * N * N);
+    }
+    std::printf("budget %.2f: %lld asked, %lld exact, %lld kept as rendered\n", budget, (long long)asked,
+                (long long)report.exactPixels, (long long)kept);
   }
 }
 

@@ -223,37 +223,6 @@ TEST(RoundSchedule, ThePreviewCorrectionCostsLittleWhereThePreviewIsMuchNoisier)
   EXPECT_GE(psnr[1], psnr[0] - 0.6);
 }
 
-/// Offers, after every Evaluate(), the pixels right of those asked for as extra
-/// samples (TakeExtraSamples), with the values of `extraValues`: a renderer whose
-/// round renders some pixels besides (Cycles with a wide pixel filter).
-class ExtraRightProvider : public SampleProvider {
- public:
-  ExtraRightProvider(SampleProvider& inner, SampleProvider& extraValues) : inner_(inner), values_(extraValues) {}
-  ProviderCapabilities Capabilities() const override { return inner_.Capabilities(); }
-  Status Guides(const Bounds2i& r, const GuideRequest& w, GuideImage* out) override { return inner_.Guides(r, w, out); }
-  Status Evaluate(std::span<const Point2i> p, const SampleRequest& w, std::span<ExactSample> out) override {
-    asked.emplace_back(p.begin(), p.end());
-    DCM_RETURN_IF_ERROR(inner_.Evaluate(p, w, out));
-    extra_.clear();
-    for (const Point2i& q : p)
-      if (q.x + 1 < inner_.Capabilities().width) extra_.push_back({q.x + 1, q.y});
-    extraSamples_.resize(extra_.size());
-    offered.push_back(extra_);
-    return values_.Evaluate(extra_, w, extraSamples_);
-  }
-  void TakeExtraSamples(std::vector<Point2i>* pixels, std::vector<ExactSample>* samples) override {
-    *pixels = std::exchange(extra_, {});
-    *samples = std::exchange(extraSamples_, {});
-  }
-  std::vector<std::vector<Point2i>> asked, offered;  ///< per call
-
- private:
-  SampleProvider& inner_;
-  SampleProvider& values_;
-  std::vector<Point2i> extra_;
-  std::vector<ExactSample> extraSamples_;
-};
-
 TEST(RoundSchedule, ExtraSamplesAreKeptExactAndNeverAskedForAgain) {
   const int N = 128;
   AnalyticProvider truth(N, N, FurnishedScene(N, N)), values(N, N, FurnishedScene(N, N)),
