@@ -151,15 +151,17 @@ class CachingProvider : public SampleProvider {
       distinct_ -= fresh;
       return st;
     }
-    // Pixels the call computed besides, cached and counted as evaluated while
-    // the budget lasts; TakeExtraSamples passes them on.
+    // Without a budget, the pixels the call computed besides are cached and
+    // counted as evaluated; TakeExtraSamples passes them on. A budget does
+    // not take them: counted at par they crowd out the pixels the runs ask
+    // for, which are worth more (docs/QUALITY.md).
     pendingExtra_.clear();
     pendingExtraSamples_.clear();
-    for (size_t k = 0; k < extra.size() && k < extraSamples.size(); ++k) {
+    for (size_t k = 0; k < extra.size() && k < extraSamples.size() && limit_ <= 0; ++k) {
       const Point2i p = extra[k];
       if (p.x < 0 || p.y < 0 || p.x >= caps_.width || p.y >= caps_.height) continue;
       int32_t& i = index_[Index(p)];
-      if (i >= 0 || (limit_ > 0 && distinct_ >= limit_)) continue;
+      if (i >= 0) continue;
       i = int32_t(samples_.size());
       samples_.push_back(extraSamples[k]);
       masks_.push_back(need);
