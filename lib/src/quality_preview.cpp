@@ -82,6 +82,12 @@ class RoundKeeper : public SampleProvider {
     return Status::Ok();
   }
 
+  /// The pixels the last render call computed besides those asked for, once.
+  void TakeExtraSamples(std::vector<Point2i>* pixels, std::vector<ExactSample>* samples) override {
+    *pixels = std::exchange(pendingExtra_, {});
+    *samples = std::exchange(pendingExtraSamples_, {});
+  }
+
   /// A new search: no run yet (what was owed is rendered by then).
   void BeginPass() {
     runs_ = 0;
@@ -178,14 +184,6 @@ class RoundKeeper : public SampleProvider {
     }
     return Status::Ok();
   }
-
- public:
-  void TakeExtraSamples(std::vector<Point2i>* pixels, std::vector<ExactSample>* samples) override {
-    *pixels = std::exchange(pendingExtra_, {});
-    *samples = std::exchange(pendingExtraSamples_, {});
-  }
-
- private:
 
   SampleProvider& exact_;
   SampleProvider& preview_;
