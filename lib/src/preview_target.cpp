@@ -11,6 +11,7 @@
 #include <string>
 #include <utility>
 
+#include "number_text.h"
 #include "planning_provider.h"
 
 namespace dcm {
@@ -48,12 +49,6 @@ double RenderPsnr(double previewPsnr, const PreviewScheduleOptions& schedule) {
 std::string Db(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.2f dB", v);
-  return buf;
-}
-
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
   return buf;
 }
 

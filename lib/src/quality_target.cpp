@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <functional>
 #include <limits>
 #include <mutex>
@@ -13,6 +12,7 @@
 #include <utility>
 
 #include "dcm/downsample.h"
+#include "number_text.h"
 
 namespace dcm {
 
@@ -76,13 +76,6 @@ struct SplitMix64 {
   /// Uniform in [0, n).
   int Below(int n) { return int(Next() % uint64_t(n)); }
 };
-
-/// A number as a message shows it ("0.03", "40").
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
 
 double PsnrOf(double mse) { return mse > 0 ? 10.0 * std::log10(1.0 / mse) : kInf; }
 
