@@ -134,11 +134,11 @@ Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& pre
     ReconstructionOptions o = options;
     const double defaultThreshold = double(ResolveSettings(options, caps).contrastThreshold);
     // A budget alone is one run at the finest threshold it affords.
-    double threshold = targetPsnr <= 0    ? kMinThreshold
-                       : s.beyondRender ? defaultThreshold
-                                        : kStartFactor * defaultThreshold;
-    const int maxRuns = targetPsnr <= 0 || s.beyondRender ? 1 : kMaxRuns;
+    const bool oneRun = s.beyondRender && !goal.searchBeyondRender;
+    double threshold = targetPsnr <= 0 ? kMinThreshold : oneRun ? defaultThreshold : kStartFactor * defaultThreshold;
+    const int maxRuns = targetPsnr <= 0 || oneRun ? 1 : kMaxRuns;
     Reconstruction best;
+    size_t kept = 0;  ///< the run whose result is kept
     bool reached = false, budgetBound = false;
     int flat = 0;
     for (int run = 0; run < maxRuns && !reached && !budgetBound; ++run, threshold *= kStep) {
@@ -179,10 +179,15 @@ Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& pre
       s.pixelsPerRound.insert(s.pixelsPerRound.end(), runStats.pixelsPerRound.begin(), runStats.pixelsPerRound.end());
       s.timeEngineS += runStats.timeEngineS;
       s.timeExactS += runStats.timeExactS;
-      s.last = std::move(runStats);
-      best = std::move(rec);
       reached = targetPsnr > 0 && e.low >= targetPsnr;
-      budgetBound |= s.last.budgetBound;
+      budgetBound |= runStats.budgetBound;
+      // The run that reaches the target, else the one estimated best: with
+      // noisy exact samples more of them can estimate worse than interpolation.
+      if (s.estimates.size() == 1 || reached || e.psnr > s.estimates[kept].psnr) {
+        kept = s.estimates.size() - 1;
+        s.last = std::move(runStats);
+        best = std::move(rec);
+      }
       if (flat >= 2) break;
     }
     // With the exact pixels' noise measured on the rounds, where it was.
@@ -195,14 +200,14 @@ Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& pre
     best.stats.providerCalls = s.rounds;
 
     QualityReport r;
-    r.estimate = s.estimates.back();
+    r.estimate = s.estimates[kept];
     r.estimateSource = EstimateSource::kPreview;
     r.againstConverged = true;
     r.renderEstimate = {s.renderPsnr, NAN, NAN};
     r.targetPsnr = targetPsnr;
     r.exactPixels = s.renderedPixels;
     r.totalPixels = int64_t(caps.width) * int64_t(caps.height);
-    r.threshold = s.thresholds.back();
+    r.threshold = s.thresholds[kept];
     r.runs = int(s.thresholds.size());
     r.targetReached = targetPsnr <= 0 || reached;
     r.budgetBound = budgetBound && !reached;

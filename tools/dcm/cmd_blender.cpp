@@ -436,6 +436,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       const auto tq = Clock::now();
       QualityGoal previewGoal = goal;
       previewGoal.targetPsnr = std::max(0.0, target);
+      previewGoal.searchBeyondRender = !defaultGoal;
       st = ReconstructToTargetFromPreview(timed, *preview, options, previewGoal, so, &rec, &report, &ptarget);
       goalS = Since(tq);
       if (st.ok()) quality = std::move(report);
@@ -445,11 +446,12 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
                   << std::setprecision(2) << ptarget.renderPsnrAtStart << std::defaultfloat
                   << " dB from the converged image, too close to the default goal (--target-psnr " << DefaultTarget()
                   << ") to search for it\n";
-      else if (st.ok() && ptarget.beyondRender && !defaultGoal)
-        std::cerr << "dcm " << cmd << ": warning: --target-psnr " << target << ": beyond what these samples give: the "
-                  << "render itself is about " << std::fixed << std::setprecision(2) << ptarget.renderPsnrAtStart
-                  << std::defaultfloat << " dB from the converged image (from the preview); reconstructed at the "
-                  << "default threshold. More --samples raise it, more exact pixels do not\n";
+      else if (st.ok() && ptarget.beyondRender && !defaultGoal && !quality->targetReached)
+        std::cerr << "dcm " << cmd << ": warning: --target-psnr " << target << ": at or beyond the render's own noise: "
+                  << "the render itself is about " << std::fixed << std::setprecision(2) << ptarget.renderPsnr
+                  << std::defaultfloat << " dB from the converged image (the preview's estimate, which can err low by "
+                  << "decibels), and no result from these samples is closer than the render: more --samples raise "
+                  << "both\n";
     } else if (st.ok() && haveGoal) {
       so.minRoundShare = 0;  // the search validates what each run asks for
       // Each run of the search in two rounds at most: its validation pixels go

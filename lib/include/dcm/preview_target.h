@@ -24,10 +24,11 @@ struct PreviewTargetStats {
   int64_t renderedPixels = 0;            ///< distinct working pixels the exact provider evaluated
   double timeEngineS = 0;                ///< engine runs and corrections of every run
   double timeExactS = 0;                 ///< in the exact provider's Evaluate()
-  PreviewScheduleStats last;             ///< the run whose result was kept
+  PreviewScheduleStats last;             ///< the run whose result was kept (not always the last)
   /// The target lies within 0.5 dB of what every pixel rendered exactly
-  /// would reach, or beyond it (the render's own noise): one run at the
-  /// options' threshold was made, and the target is reported not reached.
+  /// would reach, or beyond it (the render's own noise, as estimated before
+  /// the first round): without QualityGoal::searchBeyondRender one run at the
+  /// options' threshold was made.
   bool beyondRender = false;
   /// That limit: the full render's own PSNR against the converged image, as
   /// the preview estimates it with the exact share known at the end
@@ -81,16 +82,18 @@ double RenderPsnrFromPreview(SampleProvider& preview, const PreviewScheduleOptio
 /// `report` is that of ReconstructToQuality (estimate against the converged
 /// image, from the preview: `estimateSource` kPreview, no validation pixels;
 /// exactPixels every pixel rendered, as the result's stats.exactPixels; its
-/// byReason and sample map are the last run's). A target not reached is no
-/// error: `report->targetReached` says so and the result is the last run's. A
+/// byReason and sample map are the kept run's). A target not reached is no
+/// error: `report->targetReached` says so, and the result kept is the run
+/// with the highest estimate (with noisy exact samples, more of them can
+/// estimate worse than the interpolation they replace). A
 /// target the render's own noise leaves no room for (the exact samples keep
 /// `schedule.exactVarianceShare` of the preview's noise: what every pixel
-/// rendered would reach, less 0.5 dB) is not searched for: one run at the
-/// options' threshold (with a budget: the threshold the budget allows, if
-/// that is coarser), `stats->beyondRender`, reported not reached (more
-/// samples are the remedy, not more exact pixels). That is decided before
-/// any exact pixel is rendered, with the share known then
-/// (PreviewTargetStats::renderPsnrAtStart).
+/// rendered would reach, less 0.5 dB; decided before any exact pixel is
+/// rendered, with the share known then, PreviewTargetStats::renderPsnrAtStart)
+/// sets `stats->beyondRender`. It is searched for all the same where
+/// goal.searchBeyondRender (the estimate of that limit can err low by
+/// decibels), else it gets one run at the options' threshold (with a budget:
+/// the threshold the budget allows, if that is coarser).
 Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& preview,
                                       const ReconstructionOptions& options, const QualityGoal& goal,
                                       const PreviewScheduleOptions& schedule, Reconstruction* out,
