@@ -145,18 +145,16 @@ Status CheckPreviewSchedule(SampleProvider& exact, SampleProvider& preview, cons
 
 /// Runs the engine on `planning` and evaluates what it asks for that is not
 /// known, one call per round, until nothing is asked, `schedule.maxRounds`
-/// calls were made, or a round would evaluate fewer than
+/// calls were made, a round would evaluate fewer than
 /// `schedule.minRoundShare` of the pixels (not the first of all: `roundsBefore`
-/// calls made on `planning` by earlier runs); what is still asked becomes a
-/// preview stand-in. Counts into `stats` (rounds, pixels, stand-ins, times).
-Status PlanAndRender(PlanningProvider& planning, const ReconstructionOptions& options,
-                     const PreviewScheduleOptions& schedule, int roundsBefore, Reconstruction* out,
-                     PreviewScheduleStats* stats);
-
-/// After PlanAndRender: the rendered pixels kept (not with noisy samples), the
-/// interpolated ones corrected toward `preview` where it carries a variance,
-/// then the rendered values filled in.
-Status FinishPreviewRun(PlanningProvider& planning, SampleProvider& preview, const ReconstructionOptions& options,
-                        const PreviewScheduleOptions& schedule, Reconstruction* out, PreviewScheduleStats* stats);
+/// calls made on `planning` by earlier runs), or the result without that round
+/// estimates at `schedule.stopAtPsnr` or above; what is still asked becomes a
+/// preview stand-in. Then finishes the run: the rendered pixels kept (not with
+/// noisy samples), the interpolated ones corrected toward `preview` where it
+/// carries a variance, the rendered values filled in. Counts into `stats`
+/// (rounds, pixels, stand-ins, times, the correction and its estimate).
+Status PlanRenderAndFinish(PlanningProvider& planning, SampleProvider& preview, const ReconstructionOptions& options,
+                           const PreviewScheduleOptions& schedule, int roundsBefore, Reconstruction* out,
+                           PreviewScheduleStats* stats);
 
 }  // namespace dcm

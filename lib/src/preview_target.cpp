@@ -130,6 +130,7 @@ Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& pre
     s.beyondRender = targetPsnr > 0 && !(targetPsnr <= s.renderPsnrAtStart - kRenderNoiseMarginDb);
     const int64_t total = int64_t(caps.width) * int64_t(caps.height);
     schedule.maxExactPixels = goal.budget > 0 ? std::max<int64_t>(1, int64_t(goal.budget * double(total))) : 0;
+    schedule.stopAtPsnr = std::max(0.0, targetPsnr);  // a run's rounds end where it reaches the target
     PlanningProvider planning(exact, preview);
     ReconstructionOptions o = options;
     const double defaultThreshold = double(ResolveSettings(options, caps).contrastThreshold);
@@ -166,8 +167,7 @@ Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& pre
       o.contrastThreshold = float(threshold);
       PreviewScheduleStats runStats;
       Reconstruction rec;
-      DCM_RETURN_IF_ERROR(PlanAndRender(planning, o, schedule, s.rounds, &rec, &runStats));
-      DCM_RETURN_IF_ERROR(FinishPreviewRun(planning, preview, o, schedule, &rec, &runStats));
+      DCM_RETURN_IF_ERROR(PlanRenderAndFinish(planning, preview, o, schedule, s.rounds, &rec, &runStats));
       const PsnrEstimate& e = runStats.correction.estimate;
       if (std::isnan(e.psnr))
         return Status::Error("target from the preview: the preview made no estimate (its own PSNR " +

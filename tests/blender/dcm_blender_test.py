@@ -330,9 +330,13 @@ def preview_target(dcm, blender, src, tmp):
     # The T - 0.5 dB, less what the reference's own noise (about 48 dB) takes from the
     # PSNR measured against it at 40 dB (0.64 dB).
     assert true >= 40 - 0.5 - 0.64, (true, j["estimated_psnr"])
-    print("default goal at 256 spp: estimated %.2f dB (low %.2f), true %.2f dB, %.1f %% exact, thresholds %s"
-          % (j["estimated_psnr"], j["estimated_psnr_low"], true, 100 * j["exact_fraction"],
-             [round(r["threshold"], 4) for r in q["ladder"]]))
+    # A round the target did not need is not rendered: its pixels keep their preview value.
+    b = j["blender"]
+    assert not b["stopped_at_target"] or b["preview_stand_ins"] > 0, b
+    print("default goal at 256 spp: estimated %.2f dB (low %.2f), true %.2f dB, %.1f %% exact, thresholds %s, "
+          "rounds %s%s" % (j["estimated_psnr"], j["estimated_psnr_low"], true, 100 * j["exact_fraction"],
+                           [round(r["threshold"], 4) for r in q["ladder"]], [r["pixels"] for r in b["rounds"]],
+                           ", the last round not rendered" if b["stopped_at_target"] else ""))
     # The published methods and an explicit threshold keep the threshold: no goal.
     for flags in (["--method", "paper"], ["--threshold", "0.14"], ["--estimate-from", "validation"]):
         code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--blender", blender, "--samples", "256",

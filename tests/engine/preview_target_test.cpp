@@ -182,6 +182,55 @@ TEST(PreviewTarget, ATargetBeyondTheRendersOwnNoiseIsSearchedForUnlessADefaultGo
   EXPECT_GT(stats.thresholds[0], defaultThreshold);
 }
 
+TEST(PreviewTarget, ARoundTheTargetDoesNotNeedIsNotRendered) {
+  // The rounds after the first ask for the pixels whose choice the exact
+  // values changed. Where the result without such a round, its pixels left at
+  // their preview value, already estimates at the target, the round's render
+  // call buys nothing: the run stops with that very result.
+  AnalyticProvider truth(M, M, FurnishedScene(M, M));
+  const std::vector<RGB> ref = truth.FullRender();
+  ImagePreviewProvider preview = NoisyPreview(ref, 0.01f, 8);
+  auto run = [&](int maxRounds, double stopAtPsnr, Reconstruction* r, PreviewScheduleStats* stats) {
+    CountingProvider exact(truth);
+    PreviewScheduleOptions schedule;
+    schedule.maxRounds = maxRounds;
+    schedule.stopAtPsnr = stopAtPsnr;
+    ASSERT_TRUE(ReconstructWithPreview(exact, preview, Options(), schedule, r, stats).ok());
+    EXPECT_EQ(exact.calls, stats->rounds);
+  };
+  Reconstruction all, one, stopped, unreachable;
+  PreviewScheduleStats allStats, oneStats, stoppedStats, unreachableStats;
+  run(3, 0, &all, &allStats);
+  ASSERT_GE(allStats.rounds, 2) << "the scene must want a second round";
+  run(1, 0, &one, &oneStats);
+  ASSERT_GT(oneStats.previewStandIns, 0);
+  // The round's pixels are taken at a display error of 0.1 each besides the
+  // estimate: the target that the first round's result meets so.
+  const double met = -10 * std::log10(std::pow(10.0, -oneStats.correction.estimate.low / 10) +
+                                      double(oneStats.previewStandIns) / (double(M) * M) * 0.01);
+  ASSERT_LT(met, oneStats.correction.estimate.low);
+  // A little more: the round is rendered.
+  Reconstruction more;
+  PreviewScheduleStats moreStats;
+  run(3, met + 0.01, &more, &moreStats);
+  EXPECT_GE(moreStats.rounds, 2);
+  // That target: one round, the first round's result bit for bit.
+  run(3, met - 1e-9, &stopped, &stoppedStats);
+  EXPECT_EQ(stoppedStats.rounds, 1);
+  EXPECT_TRUE(stoppedStats.stoppedAtTarget);
+  EXPECT_EQ(stoppedStats.previewStandIns, oneStats.previewStandIns);
+  EXPECT_EQ(stopped.image, one.image);
+  EXPECT_GE(stoppedStats.correction.estimate.low, oneStats.correction.estimate.low);
+  // A target no result meets: every round, as without one.
+  run(3, 99, &unreachable, &unreachableStats);
+  EXPECT_EQ(unreachableStats.rounds, allStats.rounds);
+  EXPECT_FALSE(unreachableStats.stoppedAtTarget);
+  EXPECT_EQ(unreachable.image, all.image);
+  std::printf("%d rounds without a target; one at %.2f dB (estimated %.2f, low %.2f, %lld stand-ins)\n",
+              allStats.rounds, met, oneStats.correction.estimate.psnr, oneStats.correction.estimate.low,
+              static_cast<long long>(oneStats.previewStandIns));
+}
+
 TEST(PreviewTarget, AShareMeasuredOnTheRoundsReplacesTheRatioOfSamples) {
   // The ratio of samples says the exact pixels keep half the preview's
   // variance; the rounds measure a tenth of that (as a stratified sampler's

@@ -549,6 +549,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     for (const auto& r : timed.rounds) rounds.push_back({{"pixels", r.pixels}, {"seconds", r.seconds}});
     b["rounds"] = rounds;
     b["preview_stand_ins"] = sched.previewStandIns;
+    b["stopped_at_target"] = sched.stoppedAtTarget;  // the stand-ins' round not rendered: the goal was met without it
     b["extra_pixels"] = timed.extraPixels;
     if (schedule == RoundSchedule::kPreview && (!quality || targetFromPreview)) {  // the search's runs each make their own
       b["preview_corrected"] = sched.correction.pixels;
@@ -604,7 +605,11 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
               rec.height, method.c_str(), std::string(ToString(schedule)).c_str(), timed.rounds.size());
   std::printf("  exact pixels   %.2f %% (%lld of %lld)%s%s\n", 100.0 * stats_.exactFraction(),
               static_cast<long long>(stats_.exactPixels), static_cast<long long>(stats_.totalPixels),
-              sched.previewStandIns ? (", " + std::to_string(sched.previewStandIns) + " preview stand-ins").c_str()
+              sched.previewStandIns ? (", " + std::to_string(sched.previewStandIns) + " preview stand-ins" +
+                                       (sched.stoppedAtTarget ? " (their round not rendered: the target was met "
+                                                                "without it)"
+                                                              : ""))
+                                          .c_str()
                                     : "",
               timed.extraPixels ? (", " + std::to_string(timed.extraPixels) +
                                    " rendered without being asked for (the pixel filter's reach inside the mask)")

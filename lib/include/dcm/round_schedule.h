@@ -97,6 +97,13 @@ struct PreviewScheduleOptions {
   /// (the engine's order, coarse levels first) and the rest keep their
   /// preview value. 0: no bound.
   int64_t maxExactPixels = 0;
+  /// A goal's target in dB (> 0): before each round after the first of all,
+  /// the result with the pixels that round would render left at their preview
+  /// value is finished and estimated; where its lower bound reaches this with
+  /// each of those pixels taken at a display error of 0.1 besides, that result
+  /// is the run's and the round is not rendered (a render call buys nothing
+  /// the goal needs). Needs the preview correction. 0: off.
+  double stopAtPsnr = 0;
 };
 
 /// The exact samples' variance as a share of the preview's: the measured
@@ -113,6 +120,7 @@ struct PreviewScheduleStats {
   double timeExactS = 0;                ///< in the exact provider's Evaluate()
   PreviewCorrectionStats correction;    ///< the preview correction (pixels 0: not made)
   bool budgetBound = false;             ///< maxExactPixels left wanted pixels at their preview value
+  bool stoppedAtTarget = false;         ///< stopAtPsnr left wanted pixels at their preview value
 };
 
 /// Reconstructs `exact`'s image, choosing the exact pixels from `preview`
