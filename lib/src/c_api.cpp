@@ -704,6 +704,7 @@ DCM_API double dcmGetStat(DCMReconstructor r, const char* name) {
   if (n == "rounds") return double(r->schedule.rounds);
   if (n == "preview_stand_ins") return double(r->schedule.previewStandIns);
   if (n == "preview_corrected") return double(r->schedule.correction.pixels);
+  if (n == "stopped_at_target") return r->schedule.stoppedAtTarget ? 1.0 : 0.0;
   if (r->quality) {
     const dcm::QualityReport& q = *r->quality;
     if (n == "estimate_from_preview") return q.estimateSource == dcm::EstimateSource::kPreview ? 1.0 : 0.0;

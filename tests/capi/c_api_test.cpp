@@ -415,6 +415,9 @@ TEST(CApi, ATargetWithAPreviewOfKnownVarianceIsJudgedByThePreview) {
   EXPECT_EQ(dcmGetStat(r, "validation_pixels"), 0.0);
   EXPECT_EQ(dcmGetStat(r, "target_reached"), 1.0);
   EXPECT_GE(dcmGetStat(r, "estimated_psnr_low"), 35.0);
+  // A round the target did not need leaves its pixels at their preview value.
+  const double stopped = dcmGetStat(r, "stopped_at_target");
+  EXPECT_TRUE(stopped == 0.0 || (stopped == 1.0 && dcmGetStat(r, "preview_stand_ins") > 0)) << stopped;
   EXPECT_EQ(double(scene.evaluated.load()), dcmGetStat(r, "exact_pixels"));
   // A budget alone (API version 8) is judged by the preview too: never passed.
   const double total = double(scene.width) * scene.height;

@@ -51,8 +51,10 @@ extern "C" {
  *  preview's estimate (the statistic "estimate_from_preview"), and a
  *  preview-planned run without a goal reports that estimate. Version 8:
  *  "budget" (alone or with "target_psnr") is judged by the preview's estimate
- *  where "target_psnr" alone was. */
-#define DCM_C_API_VERSION 8
+ *  where "target_psnr" alone was. Version 9: a target judged by the preview
+ *  leaves a round after the first unrendered where the result reaches the
+ *  target without it (the statistic "stopped_at_target"). */
+#define DCM_C_API_VERSION 9
 
 /** A reconstructor: options, guides, the sample callback and the last result. */
 typedef struct DCMReconstructorImpl* DCMReconstructor;
@@ -318,7 +320,9 @@ DCM_API const uint8_t* dcmGetSampleMap(DCMReconstructor r, int* width, int* heig
  *  "smooth_blocks", "simple_edge_blocks", "complex_edge_blocks",
  *  "fallback_blocks", "time_provider_s", "time_guides_s", "time_engine_s",
  *  "rounds" (calls planned on the preview; 0 without), "preview_stand_ins"
- *  (since API version 3), "preview_corrected" (since API version 5); with "target_psnr" or "budget" set also
+ *  (since API version 3), "preview_corrected" (since API version 5),
+ *  "stopped_at_target" (0/1: the stand-ins' round was not rendered, a target
+ *  judged by the preview being met without it; since API version 9); with "target_psnr" or "budget" set also
  *  "estimated_psnr", "estimated_psnr_low", "estimated_psnr_high" (the 90 %
  *  interval), "validation_pixels", "quality_runs", "target_reached" and
  *  "budget_bound" (0/1), "estimate_against_converged" (1: the provider
