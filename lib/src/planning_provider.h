@@ -148,7 +148,8 @@ Status CheckPreviewSchedule(SampleProvider& exact, SampleProvider& preview, cons
 /// calls were made, a round would evaluate fewer than
 /// `schedule.minRoundShare` of the pixels (not the first of all: `roundsBefore`
 /// calls made on `planning` by earlier runs), or the result without that round
-/// estimates at `schedule.stopAtPsnr` or above; what is still asked becomes a
+/// reaches `schedule.stopAtPsnr` (as PreviewScheduleOptions::stopAtPsnr says);
+/// what is still asked becomes a
 /// preview stand-in. Then finishes the run: the rendered pixels kept (not with
 /// noisy samples), the interpolated ones corrected toward `preview` where it
 /// carries a variance, the rendered values filled in. Counts into `stats`
