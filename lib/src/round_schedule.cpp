@@ -151,6 +151,8 @@ Status PlanRenderAndFinish(PlanningProvider& planning, SampleProvider& preview, 
   const ProviderCapabilities caps = planning.Capabilities();
   const double total = double(caps.width) * double(caps.height);
   const bool canStop = schedule.stopAtPsnr > 0 && schedule.correctionRadius > 0 && preview.Capabilities().variance;
+  const double allowed = std::pow(10.0, -schedule.stopAtPsnr / 10);  // the target's squared error
+  bool finished = false;  ///< the run ended with a result already finished without its round
   for (int rounds = 0;;) {
     const auto engineStart = std::chrono::steady_clock::now();
     Status s = Reconstruct(planning, options, out);
@@ -167,28 +169,27 @@ Status PlanRenderAndFinish(PlanningProvider& planning, SampleProvider& preview, 
       MarkStandIns(wanted, out);
       break;
     }
-    if (canStop && roundsBefore + rounds > 0) {
+    // The round's pixels count at the preview's noise in the estimate, as
+    // their halves tell it, and the engine wants them where those halves
+    // look significant, which biases it low (8x on tests/blender's scene).
+    // So they are taken at kWorstStandInError each: the round is skipped
+    // only where the target holds even so.
+    const double worstOfRound = double(wanted.size()) / total * kWorstStandInError;
+    if (canStop && roundsBefore + rounds > 0 && worstOfRound < allowed) {
       // The result without this round, finished as it would be: where its
       // estimate reaches the goal already, the round's render call buys nothing.
       Reconstruction without = *out;
       PreviewScheduleStats withoutStats = *stats;
       MarkStandIns(wanted, &without);
       DCM_RETURN_IF_ERROR(Finish(planning, preview, options, schedule, &without, &withoutStats));
-      // The round's pixels count at the preview's noise in that estimate, as
-      // their halves tell it, and the engine wants them where those halves
-      // look significant, which biases it low (8x on tests/blender's scene).
-      // So they are taken at kWorstStandInError each: the round is skipped
-      // only where the target holds even so.
-      const double allowed = std::pow(10.0, -schedule.stopAtPsnr / 10);
       const double atLow = std::pow(10.0, -withoutStats.correction.estimate.low / 10);
-      if (atLow + double(wanted.size()) / total * kWorstStandInError <= allowed) {
+      if (atLow + worstOfRound <= allowed) {
         withoutStats.previewStandIns = int64_t(wanted.size());
         withoutStats.stoppedAtTarget = true;
         *out = std::move(without);
         *stats = std::move(withoutStats);
-        out->stats.timeProviderS = stats->timeExactS;
-        out->stats.providerCalls = stats->rounds;
-        return Status::Ok();
+        finished = true;
+        break;
       }
       stats->timeEngineS = withoutStats.timeEngineS;  // the trial's time is spent all the same
     }
@@ -207,7 +208,7 @@ Status PlanRenderAndFinish(PlanningProvider& planning, SampleProvider& preview, 
   // The final run's engine time excludes the rounds; the provider time is the rounds'.
   out->stats.timeProviderS = stats->timeExactS;
   out->stats.providerCalls = stats->rounds;
-  return Finish(planning, preview, options, schedule, out, stats);
+  return finished ? Status::Ok() : Finish(planning, preview, options, schedule, out, stats);
 }
 
 ImagePreviewProvider::ImagePreviewProvider(int workWidth, int workHeight, int previewWidth,
