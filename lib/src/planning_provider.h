@@ -158,4 +158,18 @@ Status PlanRenderAndFinish(PlanningProvider& planning, SampleProvider& preview, 
                            const PreviewScheduleOptions& schedule, int roundsBefore, Reconstruction* out,
                            PreviewScheduleStats* stats);
 
+/// The preview's estimate of a run at `options` whose first round is rendered
+/// and no other, made before anything is: the engine run on what `planning`
+/// knows, the `pixels` it asks for counted at the exact share of the preview's
+/// noise though they hold the preview's values, finished as PlanRenderAndFinish
+/// finishes a run. The interpolation from those noisier values errs more than
+/// from the rendered ones, and a later round only adds exact pixels: so it
+/// tends to err low (docs/QUALITY.md, *A coarser start*). Where the plan asks
+/// for `fewerThan` pixels or more, no estimate is made (NaN). Nothing is
+/// rendered; the record of wanted pixels is cleared. Adds the engine's time
+/// to `engineS`.
+Status PredictFirstRound(PlanningProvider& planning, SampleProvider& preview, const ReconstructionOptions& options,
+                         const PreviewScheduleOptions& schedule, int64_t fewerThan, PsnrEstimate* estimate,
+                         int64_t* pixels, double* engineS);
+
 }  // namespace dcm

@@ -24,6 +24,11 @@ namespace {
 /// step costs a render call per run).
 constexpr double kStartFactor = 3, kStep = 0.5;
 constexpr int kMaxRuns = 7;
+/// The ladder starts an octave coarser, and again, while the preview predicts
+/// that run's first round alone reaches the target by this much
+/// (PredictFirstRound) and the plan shrinks: where the target lies far below
+/// what the start gives, its pixels were spent for nothing (docs/TUNING.md).
+constexpr double kPredictMarginDb = 1;
 /// Two runs in a row that each raise the estimate by less than this have
 /// reached what the threshold can give (the exact samples' noise, stand-ins).
 constexpr double kPlateauDb = 0.1;
@@ -137,7 +142,24 @@ Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& pre
     // A budget alone is one run at the finest threshold it affords.
     const bool oneRun = s.beyondRender && !goal.searchBeyondRender;
     double threshold = targetPsnr <= 0 ? kMinThreshold : oneRun ? defaultThreshold : kStartFactor * defaultThreshold;
-    const int maxRuns = targetPsnr <= 0 || oneRun ? 1 : kMaxRuns;
+    int maxRuns = targetPsnr <= 0 || oneRun ? 1 : kMaxRuns;
+    if (maxRuns > 1) {
+      // Planned on the preview alone: a run predicted short of the margin, or
+      // one that asks for no fewer pixels, ends the climb. A prediction that
+      // erred high costs a run: the ladder descends from there.
+      int64_t fewest = INT64_MAX;
+      for (double t = 2 * threshold; t <= kMaxThreshold; t *= 2) {
+        o.contrastThreshold = float(t);
+        PreviewTargetStats::Prediction p{t, {}, 0};
+        DCM_RETURN_IF_ERROR(
+            PredictFirstRound(planning, preview, o, schedule, fewest, &p.estimate, &p.pixels, &s.timeEngineS));
+        s.predictions.push_back(p);
+        if (!(p.pixels < fewest && p.estimate.low >= targetPsnr + kPredictMarginDb)) break;
+        fewest = p.pixels;
+        threshold = t;
+        ++maxRuns;  // the ladder still reaches as fine a threshold
+      }
+    }
     Reconstruction best;
     size_t kept = 0;  ///< the run whose result is kept
     bool reached = false, budgetBound = false;

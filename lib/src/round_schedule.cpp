@@ -145,6 +145,28 @@ Status Finish(PlanningProvider& planning, SampleProvider& preview, const Reconst
 
 }  // namespace
 
+Status PredictFirstRound(PlanningProvider& planning, SampleProvider& preview, const ReconstructionOptions& options,
+                         const PreviewScheduleOptions& schedule, int64_t fewerThan, PsnrEstimate* estimate,
+                         int64_t* pixels, double* engineS) {
+  ReconstructionOptions o = options;
+  o.progress = nullptr;  // a prediction is no step of the result
+  o.onLevel = nullptr;
+  Reconstruction dry;
+  PreviewScheduleStats stats;
+  const auto start = std::chrono::steady_clock::now();
+  DCM_RETURN_IF_ERROR(Reconstruct(planning, o, &dry));
+  *pixels = int64_t(planning.TakeWanted().size());
+  *estimate = stats.correction.estimate;  // NaN: not made
+  if (*pixels < fewerThan) {
+    // The pixels asked for keep their reasons: the estimate counts them at
+    // the exact share of the preview's noise, as once rendered.
+    DCM_RETURN_IF_ERROR(Finish(planning, preview, o, schedule, &dry, &stats));
+    *estimate = stats.correction.estimate;
+  }
+  *engineS += Seconds(start) - dry.stats.timeGuidesS;
+  return Status::Ok();
+}
+
 Status PlanRenderAndFinish(PlanningProvider& planning, SampleProvider& preview, const ReconstructionOptions& options,
                            const PreviewScheduleOptions& schedule, int roundsBefore, Reconstruction* out,
                            PreviewScheduleStats* stats) {

@@ -248,14 +248,20 @@ def preview_target(dcm, blender, src, tmp):
         # rendered besides (the test scene's Blackman-Harris filter: extra pixels).
         ladder = [r["threshold"] for r in q["ladder"]]
         assert ladder == sorted(ladder, reverse=True) and len(ladder) == q["runs"], q["ladder"]
+        # It starts an octave above 0.42 for each prediction on the preview 1 dB past the target.
+        preds = q["start_predictions"]
+        passed = [p for p in preds if p["low"] is not None and p["low"] >= target + 1]
+        assert preds and abs(preds[0]["threshold"] - 0.84) < 1e-6 and preds[:len(passed)] == passed, preds
+        assert abs(ladder[0] / (0.42 * 2 ** len(passed)) - 1) < 1e-6, (ladder, preds)
         assert b["extra_pixels"] > 0, b
         assert sum(r["pixels"] for r in b["rounds"]) + b["extra_pixels"] == q["exact_pixels"] == j["exact_pixels"], \
             (b["rounds"], b["extra_pixels"], q)
         runs[target] = (true, j)
         print("--target-psnr %g from the preview: estimated %.2f dB (low %.2f), true %.2f dB against 1024 spp, "
-              "%.1f %% exact, thresholds %s, %d render calls"
+              "%.1f %% exact, thresholds %s, %d render calls; predicted %s"
               % (target, j["estimated_psnr"], j["estimated_psnr_low"], true, 100 * j["exact_fraction"], ladder,
-                 len(b["rounds"])))
+                 len(b["rounds"]), [(round(p["threshold"], 2), p["pixels"], p["low"] and round(p["low"], 2))
+                                    for p in preds]))
     # A higher target costs at least as many exact pixels.
     assert runs[34.0][1]["exact_fraction"] >= runs[30.0][1]["exact_fraction"], runs
     # Where the engine does not weigh the exact pixels' variance (at 1024 samples their noise costs

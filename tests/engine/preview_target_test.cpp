@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <random>
 #include <string>
@@ -101,6 +102,66 @@ TEST(PreviewTarget, TheTargetIsReachedAndEstimatedHonestlyRenderingEachPixelOnce
     // A higher target costs at least as many exact pixels.
     EXPECT_GE(report.exactFraction(), lastFraction) << target << " dB";
     lastFraction = report.exactFraction();
+  }
+}
+
+TEST(PreviewTarget, ATargetFarBelowTheStartStartsWhereThePreviewPredictsIt) {
+  // A clean preview (sd 0.002, its own PSNR about 54 dB) judges the plans
+  // well. 30 dB lies far below what the ladder's start (three times the
+  // default threshold) gives: the ladder climbs an octave at a time while
+  // the preview predicts the first round's result 1 dB above the target and
+  // the plan shrinks, and starts there, with fewer exact pixels than the
+  // start would render, still at the target in truth. 50 dB: no climb.
+  AnalyticProvider truth(M, M, FurnishedScene(M, M));
+  const std::vector<RGB> ref = truth.FullRender();
+  const double start = 3 * double(0.14f);  // kStartFactor times the final-resolution default (a float)
+  for (double target : {30.0, 50.0}) {
+    ImagePreviewProvider preview = NoisyPreview(ref, 0.002f, 9);
+    PreviewScheduleOptions schedule;
+    CountingProvider exact(truth);
+    Reconstruction r;
+    QualityReport report;
+    PreviewTargetStats stats;
+    const Status s = ReconstructToTargetFromPreview(exact, preview, Options(), Goal(target), schedule, &r, &report, &stats);
+    ASSERT_TRUE(s.ok()) << s.message();
+    ASSERT_FALSE(stats.predictions.empty()) << target << " dB";
+    EXPECT_DOUBLE_EQ(stats.predictions.front().threshold, 2 * start);
+    // The climb: each accepted prediction passed by the margin with fewer
+    // pixels than the one below it; the one that ended it did not.
+    double climbed = start;
+    int64_t fewest = INT64_MAX;
+    for (const PreviewTargetStats::Prediction& p : stats.predictions) {
+      if (p.estimate.low >= target + 1 && p.pixels < fewest) {
+        EXPECT_EQ(climbed, p.threshold / 2) << "a prediction past one that failed";
+        climbed = p.threshold;
+        fewest = p.pixels;
+      }
+    }
+    EXPECT_EQ(stats.thresholds.front(), climbed) << target << " dB";
+    EXPECT_EQ(exact.maxAsked, 1);
+    const double psnr = DisplayPsnr(r.image, ref);
+    EXPECT_TRUE(report.targetReached);
+    EXPECT_GE(psnr, target) << target << " dB: estimated " << report.estimate.psnr;
+    // What the start alone would have rendered (the ladder's first run, as before the climb).
+    CountingProvider atStart(truth);
+    PreviewScheduleOptions first = schedule;
+    first.stopAtPsnr = target;
+    ReconstructionOptions o = Options();
+    o.contrastThreshold = float(start);
+    Reconstruction startRun;
+    ASSERT_TRUE(ReconstructWithPreview(atStart, preview, o, first, &startRun).ok());
+    if (target == 30) {
+      EXPECT_GT(climbed, start);
+      EXPECT_LT(report.exactPixels, atStart.pixelsAsked);
+    } else {
+      EXPECT_EQ(climbed, start) << "the preview predicted " << stats.predictions.front().estimate.low;
+      EXPECT_GE(report.exactPixels, atStart.pixelsAsked);
+    }
+    std::printf("target %.0f dB: start %.2f, %lld exact pixels (the start: %lld), %.2f dB true, estimated %.2f; "
+                "predicted at %.2f: %.2f dB\n",
+                target, climbed, static_cast<long long>(report.exactPixels),
+                static_cast<long long>(atStart.pixelsAsked), psnr, report.estimate.psnr,
+                stats.predictions.front().threshold, stats.predictions.front().estimate.psnr);
   }
 }
 

@@ -441,6 +441,15 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       goalS = Since(tq);
       if (st.ok()) quality = std::move(report);
       sched = ptarget.last;
+      if (st.ok() && f.pipe.engine.verbose)
+        for (const PreviewTargetStats::Prediction& p : ptarget.predictions)
+          if (std::isnan(p.estimate.psnr))
+            std::cerr << "blender: predicted on the preview at threshold " << p.threshold << ": " << p.pixels
+                      << " pixels in the first round, no fewer than an octave finer\n";
+          else
+            std::cerr << "blender: predicted on the preview at threshold " << p.threshold << ": " << p.pixels
+                      << " pixels in the first round, estimated PSNR " << std::fixed << std::setprecision(2)
+                      << p.estimate.psnr << " dB (low " << p.estimate.low << ")" << std::defaultfloat << "\n";
       if (st.ok() && ptarget.beyondRender && defaultGoal && f.pipe.engine.verbose)
         std::cerr << "blender: the default threshold: the render itself is about " << std::fixed
                   << std::setprecision(2) << ptarget.renderPsnrAtStart << std::defaultfloat
@@ -593,6 +602,14 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
                             {"low", ptarget.estimates[k].low},
                             {"high", ptarget.estimates[k].high}});
         j["quality"]["ladder"] = ladder;
+        nlohmann::json predictions = nlohmann::json::array();
+        for (const PreviewTargetStats::Prediction& p : ptarget.predictions)
+          predictions.push_back({{"threshold", p.threshold},
+                                 {"pixels", p.pixels},
+                                 {"psnr", p.estimate.psnr},
+                                 {"low", p.estimate.low},
+                                 {"high", p.estimate.high}});
+        j["quality"]["start_predictions"] = predictions;
       } else if (schedule == RoundSchedule::kPreview) {
         j["quality"]["searches"] = qrounds.passes;
       }

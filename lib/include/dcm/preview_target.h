@@ -25,6 +25,17 @@ struct PreviewTargetStats {
   double timeEngineS = 0;                ///< engine runs and corrections of every run
   double timeExactS = 0;                 ///< in the exact provider's Evaluate()
   PreviewScheduleStats last;             ///< the run whose result was kept (not always the last)
+  /// A threshold coarser than the ladder's start, predicted before any pixel
+  /// is rendered (PredictFirstRound): the preview's estimate of its first
+  /// round's result, and the pixels that round asks for.
+  struct Prediction {
+    double threshold = 0;
+    PsnrEstimate estimate;
+    int64_t pixels = 0;
+  };
+  /// The predictions made, each an octave above the last; the ladder starts
+  /// at the coarsest that passed (none: three times the options' threshold).
+  std::vector<Prediction> predictions;
   /// The target lies within 0.5 dB of what every pixel rendered exactly
   /// would reach, or beyond it (the render's own noise, as estimated before
   /// the first round): without QualityGoal::searchBeyondRender one run at the
@@ -62,8 +73,11 @@ double RenderPsnrFromPreview(SampleProvider& preview, const PreviewScheduleOptio
 /// A target: the coarsest threshold of a ladder whose result reaches
 /// goal.targetPsnr at the estimate's lower bound (the one-sided 95 % bound).
 /// The ladder starts at three times the options' threshold (unset: the
-/// regime's default) and halves it per run, at most 7 runs; it stops early
-/// where the estimate stops rising. Each run is ReconstructWithPreview with
+/// regime's default), or octaves coarser where the preview predicts the
+/// first round's result there 1 dB above the target with fewer pixels
+/// (PreviewTargetStats::predictions), and halves it per run, at most 7 runs
+/// below three times the options' threshold; it stops early where the
+/// estimate stops rising. Each run is ReconstructWithPreview with
 /// `schedule` (which needs the preview's variance, and its own variance and
 /// the exact share for the estimate), planned on the preview and on every
 /// exact sample earlier runs rendered: a pixel is rendered once, and what an
