@@ -158,6 +158,12 @@ Status PlanRenderAndFinish(PlanningProvider& planning, SampleProvider& preview, 
                            const PreviewScheduleOptions& schedule, int roundsBefore, Reconstruction* out,
                            PreviewScheduleStats* stats);
 
+/// The engine run at `options` on what `planning` knows, as a plan (no
+/// progress, no progressive level): `pixels` it asks for that are not known
+/// (their record cleared). Adds its time to `engineS`.
+Status Plan(PlanningProvider& planning, ReconstructionOptions options, Reconstruction* out, int64_t* pixels,
+            double* engineS);
+
 /// The preview's estimate of a run at `options` whose first round is rendered
 /// and no other, made before anything is: the engine run on what `planning`
 /// knows, the `pixels` it asks for counted at the exact share of the preview's

@@ -62,14 +62,8 @@ std::string Db(double v) {
 Status PlannedPixels(PlanningProvider& planning, ReconstructionOptions o, double threshold, double* engineS,
                      int64_t* pixels) {
   o.contrastThreshold = float(threshold);
-  o.progress = nullptr;  // a plan is no step of the result: no progress, no progressive level
-  o.onLevel = nullptr;
   Reconstruction dry;
-  const auto start = std::chrono::steady_clock::now();
-  DCM_RETURN_IF_ERROR(Reconstruct(planning, o, &dry));
-  *engineS += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  *pixels = int64_t(planning.TakeWanted().size());
-  return Status::Ok();
+  return Plan(planning, o, &dry, pixels, engineS);
 }
 
 /// The smallest threshold in (lo, hi] whose plan asks for at most `allowed`

@@ -145,25 +145,30 @@ Status Finish(PlanningProvider& planning, SampleProvider& preview, const Reconst
 
 }  // namespace
 
+Status Plan(PlanningProvider& planning, ReconstructionOptions options, Reconstruction* out, int64_t* pixels,
+            double* engineS) {
+  options.progress = nullptr;  // a plan is no step of the result: no progress, no progressive level
+  options.onLevel = nullptr;
+  const auto start = std::chrono::steady_clock::now();
+  Status s = Reconstruct(planning, options, out);
+  *engineS += Seconds(start) - out->stats.timeGuidesS;
+  *pixels = int64_t(planning.TakeWanted().size());
+  return s;
+}
+
 Status PredictFirstRound(PlanningProvider& planning, SampleProvider& preview, const ReconstructionOptions& options,
                          const PreviewScheduleOptions& schedule, int64_t fewerThan, PsnrEstimate* estimate,
                          int64_t* pixels, double* engineS) {
-  ReconstructionOptions o = options;
-  o.progress = nullptr;  // a prediction is no step of the result
-  o.onLevel = nullptr;
   Reconstruction dry;
+  DCM_RETURN_IF_ERROR(Plan(planning, options, &dry, pixels, engineS));
   PreviewScheduleStats stats;
-  const auto start = std::chrono::steady_clock::now();
-  DCM_RETURN_IF_ERROR(Reconstruct(planning, o, &dry));
-  *pixels = int64_t(planning.TakeWanted().size());
   *estimate = stats.correction.estimate;  // NaN: not made
-  if (*pixels < fewerThan) {
-    // The pixels asked for keep their reasons: the estimate counts them at
-    // the exact share of the preview's noise, as once rendered.
-    DCM_RETURN_IF_ERROR(Finish(planning, preview, o, schedule, &dry, &stats));
-    *estimate = stats.correction.estimate;
-  }
-  *engineS += Seconds(start) - dry.stats.timeGuidesS;
+  if (*pixels >= fewerThan) return Status::Ok();
+  // The pixels asked for keep their reasons: the estimate counts them at the
+  // exact share of the preview's noise, as once rendered.
+  DCM_RETURN_IF_ERROR(Finish(planning, preview, options, schedule, &dry, &stats));
+  *engineS += stats.timeEngineS;
+  *estimate = stats.correction.estimate;
   return Status::Ok();
 }
 

@@ -441,15 +441,16 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       goalS = Since(tq);
       if (st.ok()) quality = std::move(report);
       sched = ptarget.last;
-      if (st.ok() && f.pipe.engine.verbose)
-        for (const PreviewTargetStats::Prediction& p : ptarget.predictions)
-          if (std::isnan(p.estimate.psnr))
-            std::cerr << "blender: predicted on the preview at threshold " << p.threshold << ": " << p.pixels
-                      << " pixels in the first round, no fewer than an octave finer\n";
-          else
-            std::cerr << "blender: predicted on the preview at threshold " << p.threshold << ": " << p.pixels
-                      << " pixels in the first round, estimated PSNR " << std::fixed << std::setprecision(2)
-                      << p.estimate.psnr << " dB (low " << p.estimate.low << ")" << std::defaultfloat << "\n";
+      for (const PreviewTargetStats::Prediction& p : ptarget.predictions) {
+        if (!st.ok() || !f.pipe.engine.verbose) break;
+        std::cerr << "blender: predicted on the preview at threshold " << p.threshold << ": " << p.pixels
+                  << " pixels in the first round, ";
+        if (std::isnan(p.estimate.psnr))
+          std::cerr << "no fewer than an octave finer\n";
+        else
+          std::cerr << "estimated PSNR " << std::fixed << std::setprecision(2) << p.estimate.psnr << " dB (low "
+                    << p.estimate.low << ")" << std::defaultfloat << "\n";
+      }
       if (st.ok() && ptarget.beyondRender && defaultGoal && f.pipe.engine.verbose)
         std::cerr << "blender: the default threshold: the render itself is about " << std::fixed
                   << std::setprecision(2) << ptarget.renderPsnrAtStart << std::defaultfloat
