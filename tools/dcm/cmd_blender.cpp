@@ -443,13 +443,15 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       sched = ptarget.last;
       for (const PreviewTargetStats::Prediction& p : ptarget.predictions) {
         if (!st.ok() || !f.pipe.engine.verbose) break;
-        std::cerr << "blender: predicted on the preview at threshold " << p.threshold << ": " << p.pixels
-                  << " pixels in the first round, ";
+        char line[200];
+        const int n = std::snprintf(line, sizeof line, "blender: predicted on the preview at threshold %.3g: %lld "
+                                    "pixels in the first round, ", p.threshold, static_cast<long long>(p.pixels));
         if (std::isnan(p.estimate.psnr))
-          std::cerr << "no fewer than an octave finer\n";
+          std::snprintf(line + n, sizeof line - size_t(n), "no fewer than an octave finer");
         else
-          std::cerr << "estimated PSNR " << std::fixed << std::setprecision(2) << p.estimate.psnr << " dB (low "
-                    << p.estimate.low << ")" << std::defaultfloat << "\n";
+          std::snprintf(line + n, sizeof line - size_t(n), "estimated PSNR %.2f dB (low %.2f)", p.estimate.psnr,
+                        p.estimate.low);
+        std::cerr << line << "\n";
       }
       if (st.ok() && ptarget.beyondRender && defaultGoal && f.pipe.engine.verbose)
         std::cerr << "blender: the default threshold: the render itself is about " << std::fixed
