@@ -441,17 +441,18 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       goalS = Since(tq);
       if (st.ok()) quality = std::move(report);
       sched = ptarget.last;
-      for (const PreviewTargetStats::Prediction& p : ptarget.predictions) {
-        if (!st.ok() || !f.pipe.engine.verbose) break;
-        char line[200];
-        const int n = std::snprintf(line, sizeof line, "blender: predicted on the preview at threshold %.3g: %lld "
-                                    "pixels in the first round, ", p.threshold, static_cast<long long>(p.pixels));
-        if (std::isnan(p.estimate.psnr))
-          std::snprintf(line + n, sizeof line - size_t(n), "no fewer than an octave finer");
-        else
-          std::snprintf(line + n, sizeof line - size_t(n), "estimated PSNR %.2f dB (low %.2f)", p.estimate.psnr,
-                        p.estimate.low);
-        std::cerr << line << "\n";
+      if (st.ok() && f.pipe.engine.verbose) {
+        for (const PreviewTargetStats::Prediction& p : ptarget.predictions) {
+          char line[200];
+          const int n = std::snprintf(line, sizeof line, "blender: predicted on the preview at threshold %.3g: %lld "
+                                      "pixels in the first round, ", p.threshold, static_cast<long long>(p.pixels));
+          if (std::isnan(p.estimate.psnr))
+            std::snprintf(line + n, sizeof line - size_t(n), "no fewer than an octave finer");
+          else
+            std::snprintf(line + n, sizeof line - size_t(n), "estimated PSNR %.2f dB (low %.2f)", p.estimate.psnr,
+                          p.estimate.low);
+          std::cerr << line << "\n";
+        }
       }
       if (st.ok() && ptarget.beyondRender && defaultGoal && f.pipe.engine.verbose)
         std::cerr << "blender: the default threshold: the render itself is about " << std::fixed
