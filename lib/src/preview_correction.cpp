@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <new>
 #include <string>
 #include <vector>
@@ -19,6 +20,16 @@ namespace {
 /// a path tracer's noise is heavy-tailed, and one bright outlier is not a
 /// bias of its window); below it, a weight would only let the noise in.
 constexpr double kSignificance = 1.5;
+
+/// Where the preview's variance is measured on its own halves (each pixel's
+/// own is given), an interpolated pixel takes the share k of its difference d
+/// (none, the Wiener share or all) whose cross-fit error between the halves,
+/// (1 - k)^2 d^2 + (1 + k)^2 v per channel (v the preview's variance), summed
+/// over this window, is least: the 11 x 11 mean dilutes a bias that a few
+/// pixels carry (a texture's lines, a lost dot) and lets the noise in beside
+/// one that stops. An assumed variance does not show a firefly, which would
+/// pass for such a bias. Chosen on the tuning set (docs/TUNING.md).
+constexpr int kChoiceRadius = 3;
 
 /// Sums of `v` (W x H) over the window of radius r around each pixel,
 /// clipped to the grid: a horizontal then a vertical pass, each summed
@@ -147,8 +158,8 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample,
     auto own = [&](size_t i, int c) {
       return ownVariance.empty() ? double(p[i].variance[c]) : double(ownVariance[i][c]);
     };
-    // Per pixel, the estimated squared display error of the result (a sum over channels).
-    std::vector<double> error(downsample == 1 ? n : 0, 0.0);
+    // The Wiener share of each interpolated pixel and channel.
+    std::vector<float> wiener(3 * n, 0.0f);
     for (int c = 0; c < 3; ++c) {
       // Linear: a noisy preview's mean is the truth there, not after the display's clip and curve.
       for (size_t i = 0; i < n; ++i) {
@@ -167,15 +178,45 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample,
           const double meanV = sv[i] / m;
           const double bias2 = se[i] / m;
           const double sdE = std::sqrt(std::max(se2[i] / m - bias2 * bias2, 0.0));
-          const double k = bias2 > 0 && bias2 > kSignificance * sdE / std::sqrt(m) ? bias2 / (bias2 + meanV) : 0.0;
-          if (!error.empty())
-            error[i] += DisplayError(p[i].L[c], own(i, c), rec->workImage[i][c], k,
-                                     shared ? double(p[i].Li[c]) * double(textureCovariance[i][c]) : 0.0);
-          if (k <= 0) continue;
-          corrected[i][c] = float(double(rec->workImage[i][c]) + k * (double(p[i].L[c]) - double(rec->workImage[i][c])));
-          moved[i] = 1;
-          weightSum += k;
+          if (bias2 > 0 && bias2 > kSignificance * sdE / std::sqrt(m)) wiener[3 * i + size_t(c)] = float(bias2 / (bias2 + meanV));
         }
+    }
+    e = {};
+    e2 = {};
+    v = {};
+    // Which share each pixel takes: 0 the Wiener share, 1 none, 2 all.
+    std::vector<uint8_t> choice(n, 0);
+    if (!ownVariance.empty()) {
+      std::vector<double> best(n, std::numeric_limits<double>::infinity()), fit(n);
+      for (uint8_t j = 0; j < 3; ++j) {
+        for (size_t i = 0; i < n; ++i) {
+          fit[i] = 0;
+          if (!usable[i]) continue;
+          for (int c = 0; c < 3; ++c) {
+            const double k = j == 0 ? double(wiener[3 * i + size_t(c)]) : j == 1 ? 0.0 : 1.0;
+            const double d = double(p[i].L[c]) - double(rec->workImage[i][c]);
+            fit[i] += (1 - k) * (1 - k) * d * d + (1 + k) * (1 + k) * double(p[i].variance[c]);
+          }
+        }
+        const std::vector<double> sums = WindowSums(fit, W, H, kChoiceRadius);
+        for (size_t i = 0; i < n; ++i)
+          if (sums[i] < best[i]) best[i] = sums[i], choice[i] = j;
+      }
+    }
+    // Per pixel, the estimated squared display error of the result (a sum over channels).
+    std::vector<double> error(downsample == 1 ? n : 0, 0.0);
+    for (size_t i = 0; i < n; ++i) {
+      if (rec->sampleMap[i] != SampleReason::kInterpolated || !usable[i]) continue;
+      for (int c = 0; c < 3; ++c) {
+        const double k = choice[i] == 0 ? double(wiener[3 * i + size_t(c)]) : choice[i] == 1 ? 0.0 : 1.0;
+        if (!error.empty())
+          error[i] += DisplayError(p[i].L[c], own(i, c), rec->workImage[i][c], k,
+                                   shared ? double(p[i].Li[c]) * double(textureCovariance[i][c]) : 0.0);
+        if (k <= 0) continue;
+        corrected[i][c] = float(double(rec->workImage[i][c]) + k * (double(p[i].L[c]) - double(rec->workImage[i][c])));
+        moved[i] = 1;
+        weightSum += k;
+      }
     }
     if (!error.empty()) {
       // A stand-in keeps the preview's value, so its error is the preview's

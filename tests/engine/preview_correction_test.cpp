@@ -328,5 +328,53 @@ TEST(PreviewCorrection, APreviewPlannedRunWithANoisyPreviewGetsCloserToTheTruth)
   EXPECT_LE(mse[1], mse[0]) << "without " << mse[0] << ", with " << mse[1];
 }
 
+TEST(PreviewCorrection, WithEachPixelsOwnVarianceIsolatedMissesComeBackAndTheirSurroundsStayClean) {
+  // The interpolation lost isolated dots (1.0 = 20 sd, every 16 pixels) and a
+  // thin line (one column, 0.5). In an 11 x 11 window a dot is one pixel of
+  // 121: the window's excess is 1 / 121, less than 1.5 standard errors (its
+  // sd measured in the window, about 1 / 11, over 11), so the Wiener share
+  // alone leaves the dot lost. Over 7 x 7 its d^2 of 1 outweighs what taking
+  // the preview costs, 3 v more per pixel (0.37). The line passes that test, and its
+  // Wiener share (0.96) lets the noise into every pixel of its window, also
+  // 4 and 5 pixels from it, where the interpolation is right. With each
+  // pixel's own variance, the share is chosen over 7 x 7 windows among none,
+  // the Wiener share and all: the dots take the preview, the pixels 4 and 5
+  // columns from the line keep the interpolation.
+  auto lost = +[](int x, int y) {
+    const bool dot = x % 16 == 8 && y % 16 == 8 && x < 40;
+    return dot ? Truth(x, y) - RGB::Gray(1.0f) : x == 52 ? Truth(x, y) - RGB::Gray(0.5f) : Truth(x, y);
+  };
+  auto dotError = [](const Reconstruction& r) {
+    double s = 0;
+    for (int y = 8; y < N; y += 16)
+      for (int x = 8; x < 40; x += 16) s += std::fabs(r.workImage[size_t(y) * N + x].r - Truth(x, y).r);
+    return s / 8;
+  };
+  auto besideLineMse = [](const Reconstruction& r) {  // columns 4 and 5 from the line, both sides
+    double s = 0;
+    int n = 0;
+    for (int y = 0; y < N; ++y)
+      for (int x : {47, 48, 56, 57}) {
+        const double d = r.workImage[size_t(y) * N + x].g - Truth(x, y).g;
+        s += d * d;
+        ++n;
+      }
+    return s / n;
+  };
+  Reconstruction wiener = Interpolated(lost), chosen = Interpolated(lost);
+  ImagePreviewProvider preview = NoisyPreview(4);
+  ASSERT_TRUE(CorrectTowardPreview(preview, 5, 1, &wiener).ok());
+  const std::vector<RGB> own(size_t(N) * N, RGB::Gray(kSd * kSd));
+  ASSERT_TRUE(CorrectTowardPreview(preview, 5, 1, &chosen, nullptr, own).ok());
+  // A dot that took the preview is off by its noise (sd 0.05; the mean
+  // |error| of 8 such is about 0.04): a tenth of the loss at most.
+  EXPECT_GT(dotError(wiener), 0.9) << "the Wiener share alone keeps the dots lost";
+  EXPECT_LT(dotError(chosen), 0.1);
+  // Beside the line the Wiener share lets in 0.96^2 of the preview's variance;
+  // the chosen share keeps the interpolation, which is exact there.
+  EXPECT_GT(besideLineMse(wiener), 0.5 * kSd * kSd);
+  EXPECT_LT(besideLineMse(chosen), 0.1 * kSd * kSd);
+}
+
 }  // namespace
 }  // namespace dcm::testing

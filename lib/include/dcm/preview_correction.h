@@ -58,7 +58,10 @@ double PreviewNoisePsnr(SampleProvider& preview, std::span<const RGB> ownVarianc
 /// preview's variance, averaged over the (2 radius + 1)^2 window around the
 /// pixel: b = max(mean d^2 - mean v, 0) is the squared bias the noise does not
 /// explain, and the pixel moves by b / (b + mean v) of its d where b stands
-/// out of the chance fluctuation of that difference. Exact pixels and
+/// out of the chance fluctuation of that difference. Where `ownVariance` is
+/// given (the preview's variance measured on its halves), each pixel then
+/// takes, of none, that share and all of its d, the one whose cross-fit error
+/// between the halves is least over a 7 x 7 window. Exact pixels and
 /// preview stand-ins keep their values; a pixel whose preview or variance is
 /// not finite neither counts in a window nor moves. `rec->image` is made again
 /// from the corrected working image, downsampled by `downsample` (the
