@@ -51,6 +51,9 @@ double RenderPsnr(double previewPsnr, const PreviewScheduleOptions& schedule) {
   return share > 0 ? previewPsnr - 10 * std::log10(share) : HUGE_VAL;
 }
 
+/// The display-referred squared error of a PSNR (peak 1).
+double Mse(double psnr) { return std::pow(10.0, -psnr / 10); }
+
 std::string Db(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.2f dB", v);
@@ -154,6 +157,23 @@ Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& pre
         ++maxRuns;  // the ladder still reaches as fine a threshold
       }
     }
+    if (maxRuns > 1 && schedule.halveExactSamples && schedule.maxExactSampleHalvings > 0) {
+      // Each halving adds the exact pixels' noise once more; spread by the
+      // interpolation (weights of sum 1) it costs at most what the full
+      // render loses at half its samples, its own noise once more.
+      const double perHalving = Mse(s.renderPsnrAtStart);
+      const double allowed = (1 - std::pow(10.0, -kPredictMarginDb / 10)) * Mse(targetPsnr);
+      const double share = ExactVarianceShare(schedule);
+      int j = 0;
+      while (j < schedule.maxExactSampleHalvings && share * double(2 << j) <= 1 &&
+             double((2 << j) - 1) * perHalving <= allowed)
+        ++j;
+      if (j > 0) {
+        DCM_RETURN_IF_ERROR(schedule.halveExactSamples(j));
+        schedule.exactVarianceShare *= double(1 << j);
+        s.exactSampleHalvings = j;
+      }
+    }
     Reconstruction best;
     size_t kept = 0;  ///< the run whose result is kept
     bool reached = false, budgetBound = false;
@@ -206,8 +226,9 @@ Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& pre
       }
       if (flat >= 2) break;
     }
-    // With the exact pixels' noise measured on the rounds, where it was.
-    s.renderPsnr = RenderPsnr(previewPsnr, schedule);
+    // With the exact pixels' noise measured on the rounds, where it was; the
+    // full render's has all of their samples.
+    s.renderPsnr = RenderPsnr(previewPsnr, schedule) + 10 * std::log10(double(1 << s.exactSampleHalvings));
     s.renderedPixels = planning.KnownCount();
     // As ReconstructToQuality's: the cost of every run (with noisy samples a
     // pixel an earlier run rendered is interpolated again, and still paid for).

@@ -11,6 +11,7 @@ the file and the step, exit 1, no output and no Blender left; a signal to dcm
 Exit 77 (skipped) when Blender is missing."""
 import hashlib
 import json
+import math
 import os
 import signal
 import subprocess
@@ -277,6 +278,17 @@ def preview_target(dcm, blender, src, tmp):
         assert code == 0 and "judged by the preview's estimate" in se, se
         b = json.load(open(stats))["blender"]
         assert b["variance"] == "halves, not used", b
+        # The exact pixels at half, a quarter, ... of the samples while a full render at as few would
+        # lose at most a fifth of the target's squared error (the render's own noise from the ratio),
+        # no fewer than the preview's, and their noise left clean (42 dB) as the engine takes it.
+        j = 0
+        while (1024 >> (j + 1)) >= 64 and b["noise_psnr"] - 10 * math.log10(2 << j) >= 42 and \
+                ((2 << j) - 1) * 10 ** (-b["render_psnr_from_ratio"] / 10) <= (1 - 10 ** -0.1) * 10 ** (-target / 10):
+            j += 1
+        assert b["samples"] == 1024 and b["exact_samples"] == 1024 >> j, (target, b)
+        assert ("blender: exact pixels at %d of 1024 samples" % (1024 >> j) in se) == (j > 0), se
+        print("--target-psnr %g at 1024 samples: exact pixels at %d (the render from the ratio %.2f dB)"
+              % (target, b["exact_samples"], b["render_psnr_from_ratio"]))
         meas[target] = (b, se.count("dcm-blender: render eval1 "), se)
     (low, low_calls, low_se), (high, high_calls, _) = meas[40.0], meas[44.0]
     assert low["exact_noise_share"]["pixels"] == 0 and low["exact_noise_share"]["measured"] is None, low
@@ -286,6 +298,11 @@ def preview_target(dcm, blender, src, tmp):
     assert high["exact_noise_share"]["pixels"] == high["rounds"][0]["pixels"] >= 256, high
     assert low["rounds"][0]["pixels"] == high["rounds"][0]["pixels"], (low["rounds"], high["rounds"])
     assert high_calls == 2 * low_calls > 0, (low_calls, high_calls)
+    assert high["exact_samples"] == 1024, high  # 44 dB: a fifth of its error is less than the render's
+    # --fixed-samples: every exact pixel at --samples whatever the goal.
+    code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--blender", blender, "--samples", "1024",
+                             "--preview-samples", "64", "--target-psnr", "40", "--fixed-samples"])
+    assert code == 0 and json.load(open(stats))["blender"]["exact_samples"] == 1024, se
     # --schedule auto (the default) plans on the preview, which the guides render gives (preview_cost=0),
     # also where a render call costs fewer than the 1000 samples of the rule for an unknown preview cost:
     # at 4096 samples a call (its fixed time, the masked pixels until they stop at 16) costs a few hundred.

@@ -331,6 +331,87 @@ TEST(PreviewTarget, AShareMeasuredOnTheRoundsReplacesTheRatioOfSamples) {
   }
 }
 
+/// The truth plus Gaussian noise of sd `sd` * 2^(halvings / 2), fixed per
+/// pixel and halving: a renderer's exact pixels at 1/2^halvings of their
+/// samples (without the variance capability: the engine takes them as clean).
+class HalvingProvider : public SampleProvider {
+ public:
+  HalvingProvider(SampleProvider& truth, float sd) : truth_(truth), sd_(sd) {}
+  ProviderCapabilities Capabilities() const override { return truth_.Capabilities(); }
+  Status Guides(const Bounds2i& r, const GuideRequest& w, GuideImage* out) override { return truth_.Guides(r, w, out); }
+  Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what, std::span<ExactSample> out) override {
+    DCM_RETURN_IF_ERROR(truth_.Evaluate(pixels, what, out));
+    const float sd = sd_ * std::sqrt(float(1 << halvings));
+    for (size_t i = 0; i < pixels.size(); ++i) {
+      std::mt19937 rng(uint32_t(pixels[i].y * M + pixels[i].x) * 16u + uint32_t(halvings));
+      std::normal_distribution<float> noise(0.f, sd);
+      out[i].L = {out[i].L.r + noise(rng), out[i].L.g + noise(rng), out[i].L.b + noise(rng)};
+    }
+    return Status::Ok();
+  }
+  int halvings = 0;
+  int calls = 0;  ///< of the halving callback
+
+ private:
+  SampleProvider& truth_;
+  float sd_;
+};
+
+TEST(PreviewTarget, ExactPixelsTakeFewerSamplesWhereAFullRenderAtAsFewWouldStillLeaveTheTargetItsMargin) {
+  // A preview of sd 0.01 (about 40 dB) and exact pixels at 1/64 of its
+  // variance (a render of 64 times its samples: about 58 dB with every pixel
+  // exact). Each halving of the exact samples adds that render's own squared
+  // error once more; a goal allows the halvings whose sum stays within a
+  // fifth of its own squared error (1 - 10^-0.1), never noisier than the preview.
+  AnalyticProvider truth(M, M, FurnishedScene(M, M));
+  const std::vector<RGB> ref = truth.FullRender();
+  ImagePreviewProvider preview = NoisyPreview(ref, 0.01f, 8);
+  auto expected = [](double renderPsnr, double target, double share, int most) {
+    int j = 0;
+    while (j < most && share * double(2 << j) <= 1 &&
+           double((2 << j) - 1) * std::pow(10.0, -renderPsnr / 10) <= (1 - std::pow(10.0, -0.1)) * std::pow(10.0, -target / 10))
+      ++j;
+    return j;
+  };
+  for (const auto& [target, most] : std::vector<std::pair<double, int>>{{36, 8}, {36, 2}, {47, 8}}) {
+    HalvingProvider exact(truth, 0.01f / 8);
+    PreviewScheduleOptions schedule;
+    schedule.exactVarianceShare = 1.0 / 64;
+    schedule.maxExactSampleHalvings = most;
+    schedule.halveExactSamples = [&exact](int j) {
+      ++exact.calls;
+      exact.halvings = j;
+      return Status::Ok();
+    };
+    Reconstruction r;
+    QualityReport report;
+    PreviewTargetStats stats;
+    ASSERT_TRUE(ReconstructToTargetFromPreview(exact, preview, Options(), Goal(target), schedule, &r, &report, &stats).ok());
+    EXPECT_NEAR(stats.renderPsnrAtStart, PreviewNoisePsnr(preview) + 10 * std::log10(64.0), 1e-9);
+    const int j = expected(stats.renderPsnrAtStart, target, 1.0 / 64, most);
+    EXPECT_EQ(stats.exactSampleHalvings, j) << target << " dB, at most " << most;
+    EXPECT_EQ(exact.calls, j > 0 ? 1 : 0);
+    EXPECT_EQ(exact.halvings, j);
+    // 36 dB leaves room for at least two (the render about 53 dB from the
+    // converged image, display-referred); 47 dB, within reach of the render,
+    // for none: a fifth of its squared error is less than the render's.
+    EXPECT_FALSE(stats.beyondRender);
+    std::printf("target %.0f dB, at most %d: %d halvings (the render %.2f dB)\n", target, most, j,
+                stats.renderPsnrAtStart);
+    if (target == 36) EXPECT_GE(j, 2);
+    else EXPECT_EQ(j, 0);
+    // The noisier exact pixels still give the target (less the 0.5
+    // dB) and an estimate within 1.5 dB of the truth, the render's own
+    // noise reported for all of the samples.
+    const double psnr = DisplayPsnr(r.image, ref);
+    if (report.targetReached) {
+      EXPECT_GE(psnr, target - 0.5) << "estimated " << report.estimate.psnr;
+    }
+    EXPECT_NEAR(report.estimate.psnr, psnr, 1.5);
+    EXPECT_NEAR(stats.renderPsnr, stats.renderPsnrAtStart, 1e-9);
+  }
+}
+
 TEST(PreviewTarget, ABudgetIsNeverExceededAndBuysWhatAThresholdBuysAtItsFraction) {
   // A budget alone: one run at the threshold its plan on the preview affords.
   // The bounds: never above the budget, and the PSNR within 0.5 dB of

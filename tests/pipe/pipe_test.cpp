@@ -324,6 +324,59 @@ while True:
   EXPECT_NE(st.message().find("extra pixel (7, 0) outside the 4x1 image"), std::string::npos) << st.message();
 }
 
+TEST(PipeProvider, ExactSamplesAreSetWhereAnnounced) {
+  // A child with capability `exact_samples` whose eval answers L = its
+  // samples per pixel (64 until told otherwise; 'bad' answers another count);
+  // one without the capability is not asked.
+  auto child = [](const std::string& caps, const std::string& mode) {
+    return std::string(DCM_PYTHON3) + R"( -c "
+import struct, sys
+print('dcm-pipe 1 width=4 height=1 samples=64 caps=)" + caps + R"(', flush=True)
+inp, out = sys.stdin.buffer, sys.stdout.buffer
+spp = 64
+while True:
+    t = inp.readline().split()
+    if not t or t[0] == b'quit':
+        break
+    if t[0] == b'exact_samples':
+        spp = int(t[1])
+        out.write(b'exact_samples %d\n' % (spp + (1 if ')" + mode + R"(' == 'bad' else 0)))
+    elif t[0] == b'eval':
+        n = int(t[1])
+        inp.read(8 * n)
+        out.write(b'samples %d\n' % n)
+        for _ in range(n):
+            out.write(struct.pack('<3f', spp, spp, spp))
+    out.flush()
+")";
+  };
+  const std::vector<dcm::Point2i> px{{1, 0}};
+  std::vector<dcm::ExactSample> s(px.size());
+  std::unique_ptr<dcm::pipe::PipeProvider> p;
+  ASSERT_TRUE(Start(child("exact_samples", "good"), &p).ok());
+  ASSERT_TRUE(p->hasExactSamples());
+  ASSERT_TRUE(p->Evaluate(px, {}, s).ok());
+  EXPECT_EQ(s[0].L.r, 64.f);
+  const dcm::Status set = p->SetExactSamples(16);
+  ASSERT_TRUE(set.ok()) << set.message();
+  ASSERT_TRUE(p->Evaluate(px, {}, s).ok());
+  EXPECT_EQ(s[0].L.r, 16.f) << "later evals at the samples set";
+  EXPECT_FALSE(p->SetExactSamples(0).ok());
+  EXPECT_TRUE(p->Finish().ok());
+
+  ASSERT_TRUE(Start(child("", "good"), &p).ok());
+  EXPECT_FALSE(p->hasExactSamples());
+  const dcm::Status refused = p->SetExactSamples(16);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.message().find("did not announce exact_samples"), std::string::npos) << refused.message();
+  EXPECT_TRUE(p->Finish().ok());
+
+  ASSERT_TRUE(Start(child("exact_samples", "bad"), &p).ok());
+  const dcm::Status wrong = p->SetExactSamples(16);
+  ASSERT_FALSE(wrong.ok());
+  EXPECT_NE(wrong.message().find("malformed answer to 'exact_samples 16'"), std::string::npos) << wrong.message();
+}
+
 /// Starts `command` and drives it through guides and one batch; returns the
 /// first error.
 dcm::Status Drive(const std::string& command, double timeout = 60) {

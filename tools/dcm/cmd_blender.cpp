@@ -83,6 +83,8 @@ struct BlenderFlags {
   std::string viewLayer;   ///< empty: the first that renders
   int samples = 0;         ///< 0: the file's
   int previewSamples = 0;  ///< 0: samples / 16, at least 8
+  /// Every exact pixel at `samples`, also where a goal in dB needs fewer.
+  bool fixedSamples = false;
   RoundFlags rounds;       ///< --schedule, --max-rounds
   int renderThreads = 0;
   /// Exact pixels as two halves with two seeds; their variance to the engine:
@@ -391,6 +393,23 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     assumedShare = so.exactVarianceShare;
     so.measuredExactVarianceShare = [&meter] { return meter.share(); };
     so.maxRounds = f.rounds.maxRounds;
+    // Fewer samples for the exact pixels where a goal does not need them all:
+    // never noisier than the preview, nor, with their variance not weighed,
+    // past the noise the regime was chosen for.
+    if (!f.fixedSamples && !options.fullEvaluation && provider->hasExactSamples() && samples > 0 &&
+        previewSamples > 0) {
+      int most = 0;
+      auto fits = [&](int j) {
+        const double fewer = std::floor(samples / double(1 << j));
+        return fewer >= previewSamples && fewer >= 2 &&
+               (useVariance || (std::isfinite(noisePsnr) && noisePsnr - 10 * std::log10(double(1 << j)) >= kNoisyPsnr));
+      };
+      while (most < 16 && fits(most + 1)) ++most;
+      so.maxExactSampleHalvings = most;
+      so.halveExactSamples = [&provider, samples](int j) {
+        return provider->SetExactSamples(int64_t(samples) >> j);
+      };
+    }
     so.correctionRadius = f.rounds.previewCorrection;
     so.minRoundShare = f.rounds.minRoundShare;
     // A target in dB or a budget is judged by the preview's estimate where the preview can tell.
@@ -454,6 +473,12 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
           std::cerr << line << "\n";
         }
       }
+      if (st.ok() && f.pipe.engine.verbose && ptarget.exactSampleHalvings > 0)
+        std::cerr << "blender: exact pixels at " << (int64_t(samples) >> ptarget.exactSampleHalvings) << " of "
+                  << int64_t(samples) << " samples: a full render at as few would lose at most a fifth of the "
+                     "target's squared error (the render's own noise about "
+                  << std::fixed << std::setprecision(2) << ptarget.renderPsnrAtStart << std::defaultfloat
+                  << " dB against the converged image)\n";
       if (st.ok() && ptarget.beyondRender && defaultGoal && f.pipe.engine.verbose)
         std::cerr << "blender: the default threshold: the render itself is about " << std::fixed
                   << std::setprecision(2) << ptarget.renderPsnrAtStart << std::defaultfloat
@@ -582,6 +607,12 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       }
     }
     b["seeds"] = seeds;
+    if (keys.count("samples")) {
+      // The run's samples, and those of its exact pixels (fewer where a goal did not need them all).
+      const int64_t all = std::atoll(keys.at("samples").c_str());
+      b["samples"] = all;
+      b["exact_samples"] = all >> ptarget.exactSampleHalvings;
+    }
     b["variance"] = useVariance ? "halves" : provider->Capabilities().variance ? "halves, not used" : "none";
     if (!std::isnan(noisePsnr)) b["noise_psnr"] = noisePsnr;
     if (std::isfinite(assumedShare))
@@ -706,6 +737,10 @@ Registration reg("blender", "Render a .blend with Cycles at the pixels DCM asks 
                    app->option_defaults()->group(kGroupQuality);
                    app->add_option("--samples", f->samples, "Cycles samples of the exact pixels (0: the file's)")
                        ->transform(Integer(0, 1 << 24));
+                   app->add_flag("--fixed-samples", f->fixedSamples,
+                                 "every exact pixel at --samples; without it a goal in dB (the default goal too) "
+                                 "renders them at half, a quarter, ... where a full render at as few samples would "
+                                 "lose at most a fifth of the target's squared error (docs/BLENDER.md)");
                    app->add_option("--preview-samples", f->previewSamples,
                                    "samples of the guides and preview render (0: a sixteenth of --samples, at least 8)")
                        ->transform(Integer(0, 1 << 24));

@@ -6,6 +6,7 @@
 // lower bound reaches the target.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -41,6 +42,9 @@ struct PreviewTargetStats {
   /// the first round): without QualityGoal::searchBeyondRender one run at the
   /// options' threshold was made.
   bool beyondRender = false;
+  /// The exact pixels were rendered at 1/2^this of their samples
+  /// (PreviewScheduleOptions::halveExactSamples; 0: all of them).
+  int exactSampleHalvings = 0;
   /// That limit: the full render's own PSNR against the converged image, as
   /// the preview estimates it with the exact share known at the end
   /// (ExactVarianceShare; +inf with noise-free exact samples).

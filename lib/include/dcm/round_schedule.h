@@ -104,6 +104,16 @@ struct PreviewScheduleOptions {
   /// is the run's and the round is not rendered (a render call buys nothing
   /// the goal needs). Needs the preview correction. 0: off.
   double stopAtPsnr = 0;
+  /// Where set, a goal in dB (ReconstructToTargetFromPreview) may render the
+  /// exact pixels at 1/2^j of their samples, 0 < j <= maxExactSampleHalvings,
+  /// their variance 2^j times exactVarianceShare (at most the preview's):
+  /// before the first round it calls this with the largest j for which a full
+  /// render at 1/2^j of the samples would lose at most what a prediction's
+  /// margin is worth against one with all (the target's squared error times
+  /// 1 - 10^(-1/10), a fifth; the render's own noise from the preview), a
+  /// bound on what interpolation spreads of the exact pixels' added noise.
+  std::function<Status(int)> halveExactSamples;
+  int maxExactSampleHalvings = 0;
 };
 
 /// The exact samples' variance as a share of the preview's: the measured

@@ -20,7 +20,7 @@ import numpy as np
 
 from . import scene
 
-CAPS = "object_id,shader_id,texture,normal,split,preview,extra"
+CAPS = "object_id,shader_id,texture,normal,split,preview,extra,exact_samples"
 
 
 def parse_args(argv):
@@ -124,6 +124,9 @@ def serve(proto, session):
             ex, ey, eL, eLi, eLc, evar = extra
             proto.send("extra %d" % len(ex), np.stack([ex, ey], axis=1).astype("<i4").tobytes()
                        + _records(what, eL, eLi, eLc, evar))
+        elif t[0] == "exact_samples" and len(t) == 2:
+            session.set_exact_samples(int(t[1]))
+            proto.send("exact_samples %d" % session.samples)
         elif t[0] == "preview" and len(t) == 6:
             x0, y0, x1, y1 = (int(v) for v in t[1:5])
             g = session.guides()

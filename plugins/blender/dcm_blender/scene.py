@@ -183,6 +183,7 @@ class Session:
 
         cy = sc.cycles
         self.samples = a.samples if a.samples > 0 else cy.samples
+        self.file_samples = self.samples  # the run's: exact_samples may lower self.samples
         # At least 8: the preview's error estimate squares differences through the sRGB
         # curve, whose bias at 4 samples alone costs 35-42 dB (docs/BLENDER.md).
         self.preview_samples = min(self.samples, a.preview_samples or max(8, self.samples // 16))
@@ -686,6 +687,13 @@ class Session:
             return L, Li, L - Li * g["texture"][y, x], var
         self.extra_pixels += len(fx)
         return (*combine(L, Li, xs, ys), (fx, fy, *combine(FL, FLi, fx, fy)))
+
+    def set_exact_samples(self, n):
+        """Later rounds render their exact pixels at n samples, at most the run's
+        (a goal that does not need them all; with halves, at least 2)."""
+        if not (2 if self.halves else 1) <= n <= self.file_samples:
+            raise ValueError("exact_samples %d: outside 1 to %d" % (n, self.file_samples))
+        self.samples = n
 
     def pixel_seconds(self):
         """What one pixel at full samples costs, from the guides render (its samples

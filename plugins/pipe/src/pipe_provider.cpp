@@ -219,6 +219,7 @@ Status PipeProvider::Handshake() {
         else if (c == "preview") preview_ = true;
         else if (c == "texture_covariance") textureCovariance_ = true;
         else if (c == "extra") extra_ = true;
+        else if (c == "exact_samples") exactSamples_ = true;
         // Unknown capabilities are ignored (newer providers).
       }
     } else if (key == "name") {
@@ -337,6 +338,26 @@ Status PipeProvider::Evaluate(std::span<const Point2i> pixels, const SampleReque
   extraSamples_.clear();
   DCM_RETURN_IF_ERROR(ReadSamples(request, message, n, split, variance, out.data()));
   return extra_ ? ReadExtra(request, split, variance) : Status::Ok();
+}
+
+Status PipeProvider::SetExactSamples(int64_t samples) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!broken_.ok()) return broken_;
+  if (finished_) return Status::Error(Prefix() + ": exact_samples requested after Finish()");
+  if (!exactSamples_) return Status::Error(Prefix() + ": the provider did not announce exact_samples");
+  if (samples < 1) return Status::Error(Prefix() + ": exact_samples " + std::to_string(samples) + " is below 1");
+  const std::string request = "exact_samples " + std::to_string(samples);
+  const auto deadline =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.timeoutSeconds));
+  const std::string line = request + "\n";
+  Status written = child_->Write(line.data(), line.size(), deadline);
+  std::vector<std::string> t;
+  std::string failure;
+  if (!ReadAnswer(*child_, request, "exact_samples", options_.timeoutSeconds, &t, &failure).ok()) return Fail(failure);
+  if (!written.ok()) return Fail("request '" + request + "': " + written.message());
+  if (t.size() != 2 || t[1] != std::to_string(samples))
+    return Fail("sent a malformed answer to '" + request + "' (expected '" + request + "')");
+  return Status::Ok();
 }
 
 Status PipeProvider::ReadExtra(const std::string& request, bool split, bool variance) {

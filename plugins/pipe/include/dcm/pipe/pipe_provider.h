@@ -100,6 +100,15 @@ class PipeProvider final : public SampleProvider {
   Status FetchPreview(const SampleRequest& what, std::unique_ptr<SampleProvider>* out, int varianceRadius = 0,
                       std::vector<RGB>* ownVariance = nullptr, std::vector<RGB>* textureCovariance = nullptr);
 
+  /// Whether the child can render later exact samples at fewer samples per
+  /// pixel (capability `exact_samples`).
+  bool hasExactSamples() const { return exactSamples_; }
+
+  /// Asks the child to render every later "eval" at `samples` per pixel
+  /// ("exact_samples N" request; only when hasExactSamples()): fewer than
+  /// the handshake's `samples=` where a goal does not need them all.
+  Status SetExactSamples(int64_t samples);
+
   /// Sends "quit", closes the child's stdin and waits for it to exit. An exit
   /// status other than 0 (or a signal) is an error. Idempotent: returns the
   /// first outcome again.
@@ -143,6 +152,7 @@ class PipeProvider final : public SampleProvider {
   bool preview_ = false;
   bool textureCovariance_ = false;  ///< capability `texture_covariance`
   bool extra_ = false;              ///< capability `extra`
+  bool exactSamples_ = false;       ///< capability `exact_samples`
   std::vector<Point2i> extraPixels_;      ///< the last eval's extra pixels
   std::vector<ExactSample> extraSamples_;
   int64_t evalRequests_ = 0;
