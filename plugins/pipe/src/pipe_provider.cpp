@@ -267,14 +267,9 @@ Status PipeProvider::Guides(const Bounds2i& region, const GuideRequest& what, Gu
 
   const std::string request = "guides " + std::to_string(region.min.x) + " " + std::to_string(region.min.y) + " " +
                               std::to_string(region.max.x) + " " + std::to_string(region.max.y) + " " + kinds;
-  const auto deadline =
-      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.timeoutSeconds));
-  const std::string line = request + "\n";
-  Status written = child_->Write(line.data(), line.size(), deadline);
   std::vector<std::string> t;
+  DCM_RETURN_IF_ERROR(Ask(request, "guides", &t));
   std::string failure;
-  if (!ReadAnswer(*child_, request, "guides", options_.timeoutSeconds, &t, &failure).ok()) return Fail(failure);
-  if (!written.ok()) return Fail("request '" + request + "': " + written.message());
   const int64_t n = region.area();
   int64_t count = -1;
   if (t.size() != 2 || !ParseInt(t[1], &count))
@@ -340,6 +335,17 @@ Status PipeProvider::Evaluate(std::span<const Point2i> pixels, const SampleReque
   return extra_ ? ReadExtra(request, split, variance) : Status::Ok();
 }
 
+Status PipeProvider::Ask(const std::string& request, const std::string& keyword, std::vector<std::string>* answer) {
+  const auto deadline =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.timeoutSeconds));
+  const std::string line = request + "\n";
+  Status written = child_->Write(line.data(), line.size(), deadline);
+  std::string failure;
+  if (!ReadAnswer(*child_, request, keyword, options_.timeoutSeconds, answer, &failure).ok()) return Fail(failure);
+  if (!written.ok()) return Fail("request '" + request + "': " + written.message());
+  return Status::Ok();
+}
+
 Status PipeProvider::SetExactSamples(int64_t samples) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!broken_.ok()) return broken_;
@@ -347,14 +353,8 @@ Status PipeProvider::SetExactSamples(int64_t samples) {
   if (!exactSamples_) return Status::Error(Prefix() + ": the provider did not announce exact_samples");
   if (samples < 1) return Status::Error(Prefix() + ": exact_samples " + std::to_string(samples) + " is below 1");
   const std::string request = "exact_samples " + std::to_string(samples);
-  const auto deadline =
-      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.timeoutSeconds));
-  const std::string line = request + "\n";
-  Status written = child_->Write(line.data(), line.size(), deadline);
   std::vector<std::string> t;
-  std::string failure;
-  if (!ReadAnswer(*child_, request, "exact_samples", options_.timeoutSeconds, &t, &failure).ok()) return Fail(failure);
-  if (!written.ok()) return Fail("request '" + request + "': " + written.message());
+  DCM_RETURN_IF_ERROR(Ask(request, "exact_samples", &t));
   if (t.size() != 2 || t[1] != std::to_string(samples))
     return Fail("sent a malformed answer to '" + request + "' (expected '" + request + "')");
   return Status::Ok();

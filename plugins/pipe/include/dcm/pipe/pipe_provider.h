@@ -129,6 +129,9 @@ class PipeProvider final : public SampleProvider {
   Status Handshake();
   /// Records the first failure, kills the child and returns the failure.
   Status Fail(const std::string& what);
+  /// Sends the one-line `request` and reads the answer line, which must begin
+  /// with `keyword`, split into `answer`; a failure kills the child.
+  Status Ask(const std::string& request, const std::string& keyword, std::vector<std::string>* answer);
   /// Prefixes messages with the provider's command.
   std::string Prefix() const;
 
