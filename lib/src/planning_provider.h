@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -13,6 +14,9 @@
 #include "guide_cache.h"
 
 namespace dcm {
+
+/// The display-referred squared error of a PSNR (peak 1).
+inline double Mse(double psnr) { return std::pow(10.0, -psnr / 10); }
 
 /// What the engine sees during planning: the exact provider's guides (asked
 /// once per region and kind), exact samples where they are known, preview

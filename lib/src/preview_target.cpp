@@ -51,9 +51,6 @@ double RenderPsnr(double previewPsnr, const PreviewScheduleOptions& schedule) {
   return share > 0 ? previewPsnr - 10 * std::log10(share) : HUGE_VAL;
 }
 
-/// The display-referred squared error of a PSNR (peak 1).
-double Mse(double psnr) { return std::pow(10.0, -psnr / 10); }
-
 std::string Db(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.2f dB", v);
@@ -162,7 +159,7 @@ Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& pre
       // interpolation (weights of sum 1) it costs at most what the full
       // render loses at half its samples, its own noise once more.
       const double perHalving = Mse(s.renderPsnrAtStart);
-      const double allowed = (1 - std::pow(10.0, -kPredictMarginDb / 10)) * Mse(targetPsnr);
+      const double allowed = (1 - Mse(kPredictMarginDb)) * Mse(targetPsnr);
       const double share = ExactVarianceShare(schedule);
       int j = 0;
       while (j < schedule.maxExactSampleHalvings && share * double(2 << j) <= 1 &&

@@ -178,7 +178,7 @@ Status PlanRenderAndFinish(PlanningProvider& planning, SampleProvider& preview, 
   const ProviderCapabilities caps = planning.Capabilities();
   const double total = double(caps.width) * double(caps.height);
   const bool canStop = schedule.stopAtPsnr > 0 && schedule.correctionRadius > 0 && preview.Capabilities().variance;
-  const double allowed = std::pow(10.0, -schedule.stopAtPsnr / 10);  // the target's squared error
+  const double allowed = Mse(schedule.stopAtPsnr);  // the target's squared error
   bool finished = false;  ///< the run ended with a result already finished without its round
   for (int rounds = 0;;) {
     const auto engineStart = std::chrono::steady_clock::now();
@@ -209,7 +209,7 @@ Status PlanRenderAndFinish(PlanningProvider& planning, SampleProvider& preview, 
       PreviewScheduleStats withoutStats = *stats;
       MarkStandIns(wanted, &without);
       DCM_RETURN_IF_ERROR(Finish(planning, preview, options, schedule, &without, &withoutStats));
-      const double atLow = std::pow(10.0, -withoutStats.correction.estimate.low / 10);
+      const double atLow = Mse(withoutStats.correction.estimate.low);
       if (atLow + worstOfRound <= allowed) {
         withoutStats.previewStandIns = int64_t(wanted.size());
         withoutStats.stoppedAtTarget = true;

@@ -393,15 +393,14 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     assumedShare = so.exactVarianceShare;
     so.measuredExactVarianceShare = [&meter] { return meter.share(); };
     so.maxRounds = f.rounds.maxRounds;
-    // Fewer samples for the exact pixels where a goal does not need them all:
-    // never noisier than the preview, nor, with their variance not weighed,
-    // past the noise the regime was chosen for.
+    // Fewer samples for the exact pixels where a goal does not need them all
+    // (never noisier than the preview: the library's bound on the share), nor,
+    // with their variance not weighed, past the noise the regime was chosen for.
     if (!f.fixedSamples && !options.fullEvaluation && provider->hasExactSamples() && samples > 0 &&
         previewSamples > 0) {
       int most = 0;
       auto fits = [&](int j) {
-        const double fewer = std::floor(samples / double(1 << j));
-        return fewer >= previewSamples && fewer >= 2 &&
+        return (int64_t(samples) >> j) >= 2 &&
                (useVariance || (std::isfinite(noisePsnr) && noisePsnr - 10 * std::log10(double(1 << j)) >= kNoisyPsnr));
       };
       while (most < 16 && fits(most + 1)) ++most;

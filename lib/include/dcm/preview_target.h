@@ -6,7 +6,6 @@
 // lower bound reaches the target.
 #pragma once
 
-#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
