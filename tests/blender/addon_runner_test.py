@@ -30,6 +30,9 @@ check(t[t.index("--target-psnr") + 1] == "40.0" and "--threshold" not in t, "a t
 check("--preview-correction" not in runner.command_line("d", "s", "o") and
       runner.command_line("d", "s", "o", preview_correction=False)[-2:] == ["--preview-correction", "0"],
       "the preview correction: dcm's default, or off")
+check("--fixed-samples" not in runner.command_line("d", "s", "o") and
+      "--fixed-samples" in runner.command_line("d", "s", "o", fixed_samples=True),
+      "the exact pixels' samples: dcm's choice, or every sample")
 check(runner.parse_progress("rounds  42% (3.5 s)") == ("rounds", 0.42), "a progress line")
 check(runner.parse_progress("\r\x1b[Kengine 100% (0.1 s)") == ("engine", 1.0), "a terminal progress line")
 check(runner.parse_progress("dcm blender: error: x") is None, "an error line is no progress")

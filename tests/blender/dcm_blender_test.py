@@ -286,6 +286,8 @@ def preview_target(dcm, blender, src, tmp):
                 ((2 << j) - 1) * 10 ** (-b["render_psnr_from_ratio"] / 10) <= (1 - 10 ** -0.1) * 10 ** (-target / 10):
             j += 1
         assert b["samples"] == 1024 and b["exact_samples"] == 1024 >> j, (target, b)
+        # The exact pixels' variance against the preview's, as the ratio of their samples says.
+        assert b["exact_noise_share"]["assumed"] == 64 / (1024 >> j), (target, b)
         assert ("blender: exact pixels at %d of 1024 samples" % (1024 >> j) in se) == (j > 0), se
         print("--target-psnr %g at 1024 samples: exact pixels at %d (the render from the ratio %.2f dB)"
               % (target, b["exact_samples"], b["render_psnr_from_ratio"]))

@@ -459,6 +459,8 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       goalS = Since(tq);
       if (st.ok()) quality = std::move(report);
       sched = ptarget.last;
+      // Halved samples: the exact pixels' variance is a larger share of the preview's.
+      assumedShare = std::min(1.0, std::ldexp(assumedShare, ptarget.exactSampleHalvings));
       if (st.ok() && f.pipe.engine.verbose) {
         for (const PreviewTargetStats::Prediction& p : ptarget.predictions) {
           char line[200];

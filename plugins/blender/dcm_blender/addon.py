@@ -75,6 +75,10 @@ class DCMSettings(bpy.types.PropertyGroup):
         description="Move interpolated pixels toward the preview where they differ from it by more than its "
                     "noise explains",
         default=True)
+    fixed_samples: BoolProperty(
+        name="Every sample",
+        description="Render the exact pixels at every sample, also where the goal would leave them fewer",
+        default=False)
     output: StringProperty(name="Output", description="Keep the EXR here (empty: a temporary file)",
                            subtype="FILE_PATH", default="")
     sample_map: BoolProperty(name="Sample map", description="Also load the sample map as 'DCM Sample Map'",
@@ -115,7 +119,8 @@ def _build(context, workdir):
         threshold=s.threshold if s.threshold > 0 and s.target_psnr <= 0 and not s.full else None,
         target_psnr=s.target_psnr if s.target_psnr > 0 and not s.full else None,
         schedule=s.schedule, max_rounds=s.max_rounds, preview_correction=s.preview_correction,
-        view_layer=context.view_layer.name, frame=context.scene.frame_current, extra=s.extra)
+        fixed_samples=s.fixed_samples, view_layer=context.view_layer.name, frame=context.scene.frame_current,
+        extra=s.extra)
     return cmd, out
 
 
@@ -262,6 +267,7 @@ class RENDER_PT_dcm(bpy.types.Panel):
         col.prop(s, "schedule", text="Schedule")
         col.prop(s, "max_rounds")
         col.prop(s, "preview_correction")
+        col.prop(s, "fixed_samples")
         layout.prop(s, "output")
         layout.prop(s, "sample_map")
         layout.prop(s, "extra")
