@@ -9,6 +9,7 @@ the plot, and that bad input or a signal leaves no output and no Blender.
 Exit 77 (skipped) when Blender is missing."""
 import csv
 import json
+import math
 import os
 import shutil
 import signal
@@ -34,18 +35,19 @@ def bench(dcm, args, env=None):
 def run(dcm, blender, src, tmp):
     blend = bs.make_scene(blender, src, tmp)  # 64x48, 16 spp, adaptive sampling and denoising off
     out = os.path.join(tmp, "out")
-    code, so, se = bench(dcm, [blend, "--spp", "4,16", "--reference-spp", "64", "--adaptive", "0.05",
+    code, so, se = bench(dcm, [blend, "--spp", "4,16", "--reference-spp", "64", "--adaptive", "0.05,0.2",
                                "--out", out, "--blender", blender])
     assert code == 0, se
     d = os.path.join(out, "scene")
     for f in ("reference.exr", "full_4.exr", "full_16.exr", "dcm_4.exr", "dcm_16.exr", "dcm_4.json", "dcm_16.json",
-              "adaptive_0.05.exr"):
+              "adaptive_0.05.exr", "adaptive_0.2.exr"):
         assert os.path.isfile(os.path.join(d, f)), (f, os.listdir(d))
     rows = list(csv.DictReader(open(os.path.join(out, "bench.csv"))))
     assert [(r["method"], r["spp"]) for r in rows] == [
-        ("full", "4"), ("dcm blender", "4"), ("full", "16"), ("dcm blender", "16"), ("adaptive", "16")], rows
+        ("full", "4"), ("dcm blender", "4"), ("full", "16"), ("dcm blender", "16"), ("adaptive", "16"),
+        ("adaptive", "16")], rows
     ref = bs.read_exr(os.path.join(d, "reference.exr"))[0]
-    files = ["full_4", "dcm_4", "full_16", "dcm_16", "adaptive_0.05"]
+    files = ["full_4", "dcm_4", "full_16", "dcm_16", "adaptive_0.05", "adaptive_0.2"]
     for r, f in zip(rows, files):
         # The table's PSNR is its EXR's against the reference: dcm's (float) and
         # numpy's (double) sums differ far below 0.01 dB.
@@ -73,7 +75,25 @@ def run(dcm, blender, src, tmp):
     assert "| 16 | dcm blender |" in summary and "| 16 | adaptive 0.05 |" in summary, summary
     j = json.load(open(os.path.join(out, "bench.json")))
     assert j["inputs"][0]["kind"] == "blend" and j["inputs"][0]["reference_spp"] == 64, j["inputs"]
-    assert [p.get("adaptive_threshold") for p in j["points"]][-1] == 0.05, j["points"][-1]
+    assert [p.get("adaptive_threshold") for p in j["points"]][-2:] == [0.05, 0.2], j["points"][-2:]
+    # Each dcm run beside the full renders and the adaptive runs at its wall time:
+    # their PSNR linear in log time between the two runs around it.
+    def at_time(curve, t):
+        curve = sorted(curve, key=lambda p: p["time_total_s"])
+        for a, b in zip(curve, curve[1:]):
+            if a["time_total_s"] <= t <= b["time_total_s"]:
+                x = math.log(t / a["time_total_s"]) / math.log(b["time_total_s"] / a["time_total_s"])
+                return a["psnr_db"] + x * (b["psnr_db"] - a["psnr_db"])
+        return None
+    for kind, key in (("full", "full_psnr_at_time"), ("adaptive", "adaptive_psnr_at_time")):
+        curve = [p for p in j["points"] if p["method"] == kind]
+        for p in (p for p in j["points"] if p["method"] == "dcm blender"):
+            want = at_time(curve, p["time_total_s"])
+            assert (p[key] is None) == (want is None) and (want is None or abs(p[key] - want) < 1e-9), (key, p, want)
+            row = next(r for r in summary.splitlines() if r.startswith("| %d | dcm blender |" % p["spp"]))
+            cell = row.split("|")[8 if kind == "full" else 9].strip()
+            assert (cell.startswith("%.2f dB" % want) if want is not None else
+                    cell.startswith("faster than") or cell.startswith("slower than")), (kind, row)
     try:
         import matplotlib  # noqa: F401
         assert os.path.isfile(os.path.join(out, "scene_cycles.png")), os.listdir(out)
