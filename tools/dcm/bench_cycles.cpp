@@ -95,7 +95,8 @@ std::string AtTimeCell(const std::vector<Point>& curve, const Point& p) {
       curve.begin(), curve.end(), [](const Point& a, const Point& b) { return a.timeTotalS < b.timeTotalS; });
   const bool faster = p.timeTotalS < fastest->timeTotalS;
   const Point& end = faster ? *fastest : *slowest;
-  const std::string what = end.config.method == "adaptive" ? end.config.label : std::to_string(end.config.spp) + "-spp render";
+  const std::string what = end.config.method == "adaptive" ? end.config.label.substr(0, end.config.label.rfind(" spp="))
+                                                           : std::to_string(end.config.spp) + "-spp render";
   return std::string(faster ? "faster" : "slower") + " than the " + what + "'s " + Fixed(end.timeTotalS, 2) + " s";
 }
 
