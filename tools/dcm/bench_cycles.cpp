@@ -90,7 +90,8 @@ double PsnrAtTime(std::vector<Point> curve, double t) {
 std::string AtTimeCell(const std::vector<Point>& curve, const Point& p) {
   if (curve.empty()) return "";
   const double at = PsnrAtTime(curve, p.timeTotalS);
-  if (std::isfinite(at)) return Fixed(at, 2) + " dB (" + (p.error.psnr >= at ? "+" : "") + Fixed(p.error.psnr - at, 2) + ")";
+  if (std::isfinite(at))
+    return Fixed(at, 2) + " dB (" + (p.error.psnr >= at ? "+" : "") + Fixed(p.error.psnr - at, 2) + ")";
   const auto [fastest, slowest] = std::minmax_element(
       curve.begin(), curve.end(), [](const Point& a, const Point& b) { return a.timeTotalS < b.timeTotalS; });
   const bool faster = p.timeTotalS < fastest->timeTotalS;
