@@ -9,9 +9,7 @@ render, each beside its true display-referred MSE as a PSNR.
 KEEP_DIR holds the renders of a `dcm blender` child run with --keep-renders; its
 first two (01_guides.npz, 02_guides.npz) are the preview's halves. To keep them:
 
-  printf 'import os, runpy, sys\\nsys.argv += ["--keep-renders", os.environ["KEEP_DIR"]]\\nrunpy.run_path("%s", run_name="__main__")\\n' \\
-      "$PWD/plugins/blender/child_main.py" > keep.py
-  KEEP_DIR=KEEP DCM_BLENDER_CHILD=$PWD/keep.py dcm blender SCENE.blend -o OUT.exr --samples 64
+  KEEP_DIR=KEEP DCM_BLENDER_CHILD=$PWD/examples/blender/keep_renders_child.py dcm blender SCENE.blend -o OUT.exr --samples 64
 
 Reads Blender's multilayer EXRs (…Combined.R/G/B) and plain R, G, B files."""
 import os
