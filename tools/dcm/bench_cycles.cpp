@@ -70,11 +70,15 @@ Status ReadImage(const std::string& path, const std::string& what, int* w, int* 
   return Status::Ok();
 }
 
-/// The PSNR of a curve of runs (the full renders, the adaptive ones) at wall
-/// time `t`: linear in log time between the two runs around it; NaN outside
-/// their range.
-double PsnrAtTime(std::vector<Point> curve, double t) {
+/// The runs of a curve (the full renders, the adaptive ones) in order of wall time.
+std::vector<Point> ByTime(std::vector<Point> curve) {
   std::sort(curve.begin(), curve.end(), [](const Point& a, const Point& b) { return a.timeTotalS < b.timeTotalS; });
+  return curve;
+}
+
+/// The PSNR of a curve sorted by ByTime at wall time `t`: linear in log time
+/// between the two runs around it; NaN outside their range.
+double PsnrAtTime(const std::vector<Point>& curve, double t) {
   if (curve.size() == 1 && t == curve[0].timeTotalS) return curve[0].error.psnr;
   for (size_t i = 0; i + 1 < curve.size(); ++i) {
     const double t0 = curve[i].timeTotalS, t1 = curve[i + 1].timeTotalS;
@@ -85,17 +89,15 @@ double PsnrAtTime(std::vector<Point> curve, double t) {
   return std::nan("");
 }
 
-/// A run beside a curve at its wall time: "the curve's PSNR (the run's less
-/// it)", or, outside the curve's times, that it is faster or slower than all.
-std::string AtTimeCell(const std::vector<Point>& curve, const Point& p) {
+/// A run beside a curve sorted by ByTime, whose PSNR at the run's wall time is
+/// `at`: "at (the run's less it)", or, outside the curve's times, that the run
+/// is faster or slower than all of it.
+std::string AtTimeCell(const std::vector<Point>& curve, const Point& p, double at) {
   if (curve.empty()) return "";
-  const double at = PsnrAtTime(curve, p.timeTotalS);
   if (std::isfinite(at))
     return Fixed(at, 2) + " dB (" + (p.error.psnr >= at ? "+" : "") + Fixed(p.error.psnr - at, 2) + ")";
-  const auto [fastest, slowest] = std::minmax_element(
-      curve.begin(), curve.end(), [](const Point& a, const Point& b) { return a.timeTotalS < b.timeTotalS; });
-  const bool faster = p.timeTotalS < fastest->timeTotalS;
-  const Point& end = faster ? *fastest : *slowest;
+  const bool faster = p.timeTotalS < curve.front().timeTotalS;
+  const Point& end = faster ? curve.front() : curve.back();
   const std::string what = end.config.method == "adaptive" ? end.config.label.substr(0, end.config.label.rfind(" spp="))
                                                            : std::to_string(end.config.spp) + "-spp render";
   return std::string(faster ? "faster" : "slower") + " than the " + what + "'s " + Fixed(end.timeTotalS, 2) + " s";
@@ -283,22 +285,25 @@ Status MeasureCycles(const BenchFlags& f, const std::string& input, const std::s
            << "| spp | method | exact % | PSNR dB | SSIM | wall s | speed-up | the full render at this wall time |"
            << (adaptive.empty() ? "" : " adaptive sampling at this wall time |") << "\n"
            << "|---|---|---|---|---|---|---|---|" << (adaptive.empty() ? "" : "---|") << "\n";
+  const std::vector<Point> fullByTime = ByTime(full), adaptiveByTime = ByTime(adaptive);
   for (Point& p : pts) {
     const Point* same = nullptr;
     for (const Point& q : full)
       if (q.config.spp == p.config.spp) same = &q;
     const bool dcm = p.config.method != "full" && p.config.method != "adaptive";
+    const double fullAt = PsnrAtTime(fullByTime, p.timeTotalS), adaptiveAt = PsnrAtTime(adaptiveByTime, p.timeTotalS);
     if (dcm) {
       // The comparison a user makes: the other two ways to spend the same wall time.
-      p.extra["full_psnr_at_time"] = PsnrAtTime(full, p.timeTotalS);
-      if (!adaptive.empty()) p.extra["adaptive_psnr_at_time"] = PsnrAtTime(adaptive, p.timeTotalS);
+      p.extra["full_psnr_at_time"] = fullAt;
+      if (!adaptive.empty()) p.extra["adaptive_psnr_at_time"] = adaptiveAt;
     }
     *summary << "| " << p.config.spp << " | " << p.config.label.substr(0, p.config.label.rfind(" spp=")) << " | "
              << (std::isfinite(p.exactFraction) ? Fixed(100 * p.exactFraction, 2) : "adaptive") << " | "
              << Fixed(p.error.psnr, 2) << " | " << Fixed(p.error.ssim, 4) << " | " << Fixed(p.timeTotalS, 2) << " | "
              << (same && p.timeTotalS > 0 ? Fixed(same->timeTotalS / p.timeTotalS, 2) + "x" : "") << " | "
-             << (p.config.method != "full" ? AtTimeCell(full, p) : "") << " |"
-             << (adaptive.empty() ? "" : " " + (dcm ? AtTimeCell(adaptive, p) : std::string()) + " |") << "\n";
+             << (p.config.method != "full" ? AtTimeCell(fullByTime, p, fullAt) : "") << " |"
+             << (adaptive.empty() ? "" : " " + (dcm ? AtTimeCell(adaptiveByTime, p, adaptiveAt) : std::string()) + " |")
+             << "\n";
   }
   *summary << "\nSpeed-up: the full render at the same samples (adaptive sampling: at its largest) over this run's "
               "wall time. The full render at this wall time: its PSNR interpolated in log time between the full "
