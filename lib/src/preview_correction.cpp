@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "dcm/downsample.h"
+#include "dcm/preview_filter.h"
 
 namespace dcm {
 
@@ -30,6 +31,12 @@ constexpr double kSignificance = 1.5;
 /// one that stops. An assumed variance does not show a firefly, which would
 /// pass for such a bias. Chosen on the tuning set (docs/TUNING.md).
 constexpr int kChoiceRadius = 3;
+
+/// An interpolated pixel with a filtered preview (FilterPreview) ends as the
+/// mean of its corrected value and that: each misses what the other keeps
+/// (the corrected value the preview's noise, the filter what its weights cut
+/// across). Chosen on the tuning set (docs/TUNING.md).
+constexpr double kFilterShare = 0.5;
 
 /// Sums of `v` (W x H) over the window of radius r around each pixel,
 /// clipped to the grid: a horizontal then a vertical pass, each summed
@@ -108,8 +115,10 @@ double PreviewNoisePsnr(SampleProvider& preview, std::span<const RGB> ownVarianc
 
 Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample, Reconstruction* rec,
                             PreviewCorrectionStats* stats, std::span<const RGB> ownVariance, double exactShare,
-                            std::span<const RGB> textureCovariance) {
+                            std::span<const RGB> textureCovariance, int filterRadius, const GuideImage& guides) {
   if (radius < 0) return Status::Error("preview correction: radius " + std::to_string(radius) + " is negative");
+  if (filterRadius < 0)
+    return Status::Error("preview correction: filter radius " + std::to_string(filterRadius) + " is negative");
   if (downsample < 1)
     return Status::Error("preview correction: downsample " + std::to_string(downsample) + " is below 1");
   PreviewCorrectionStats result;
@@ -139,7 +148,9 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample,
     for (int y = 0; y < H; ++y)
       for (int x = 0; x < W; ++x) all[size_t(y) * size_t(W) + size_t(x)] = {x, y};
     std::vector<ExactSample> p(n);
-    if (Status s = preview.Evaluate(all, SampleRequest{shared, true}, p); !s.ok())
+    // The filter averages L_i and L_c apart where it has the texture guide.
+    const bool split = caps.splitRadiance && (shared || (filterRadius > 0 && !guides.texture.empty()));
+    if (Status s = preview.Evaluate(all, SampleRequest{split, true}, p); !s.ok())
       return Status::Error("preview correction: " + s.message());
 
     std::vector<uint8_t> usable(n);
@@ -203,19 +214,55 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample,
           if (sums[i] < best[i]) best[i] = sums[i], choice[i] = j;
       }
     }
-    // Per pixel, the estimated squared display error of the result (a sum over channels).
-    std::vector<double> error(downsample == 1 ? n : 0, 0.0);
+    // The share of its difference each interpolated pixel and channel takes.
+    std::vector<float> share(3 * n, 0.0f);
     for (size_t i = 0; i < n; ++i) {
       if (rec->sampleMap[i] != SampleReason::kInterpolated || !usable[i]) continue;
       for (int c = 0; c < 3; ++c) {
         const double k = choice[i] == 0 ? double(wiener[3 * i + size_t(c)]) : choice[i] == 1 ? 0.0 : 1.0;
-        if (!error.empty())
-          error[i] += DisplayError(p[i].L[c], own(i, c), rec->workImage[i][c], k,
-                                   shared ? double(p[i].Li[c]) * double(textureCovariance[i][c]) : 0.0);
+        share[3 * i + size_t(c)] = float(k);
         if (k <= 0) continue;
         corrected[i][c] = float(double(rec->workImage[i][c]) + k * (double(p[i].L[c]) - double(rec->workImage[i][c])));
         moved[i] = 1;
         weightSum += k;
+      }
+    }
+    // The filtered preview, its pilot the corrected image (which carries the
+    // edges the correction found); it leaves each pixel's own preview out.
+    // The centre's pilot moves with its own preview by k s (s the preview's
+    // sd): the filtered value made with each half's pilot, for the estimate.
+    FilteredPreview filtered;
+    if (filterRadius > 0) {
+      std::vector<RGB> shift(n);
+      for (size_t i = 0; i < n; ++i)
+        for (int c = 0; c < 3; ++c)
+          shift[i][c] = float(double(share[3 * i + size_t(c)]) * std::sqrt(std::max(own(i, c), 0.0)));
+      DCM_RETURN_IF_ERROR(FilterPreview(p, split, guides, corrected, shift, rec->sampleMap, W, H, filterRadius,
+                                        &filtered));
+    }
+    // Per pixel, the estimated squared display error of the result (a sum over channels).
+    std::vector<double> error(downsample == 1 ? n : 0, 0.0);
+    for (size_t i = 0; i < n; ++i) {
+      if (rec->sampleMap[i] != SampleReason::kInterpolated || !usable[i]) continue;
+      const bool mixed = !filtered.value.empty() && IsFinite(filtered.value[i]);
+      const bool moves = mixed && IsFinite(filtered.plus[i]) && IsFinite(filtered.minus[i]);
+      result.filtered += mixed;
+      for (int c = 0; c < 3; ++c) {
+        // (1 - s) (x + k (p - x)) + s f, with f the filtered value and s its
+        // share, is x' + k' (p - x') with k' = (1 - s) k and x' = ((1 - s)
+        // (1 - k) x + s f) / (1 - k'), the form the estimate takes; f moves
+        // with p's noise through its pilot by (f+ - f-) / 2 per sd of p.
+        const double x = rec->workImage[i][c], k = share[3 * i + size_t(c)], s = mixed ? kFilterShare : 0.0;
+        const double kk = (1 - s) * k;
+        const double xx = mixed ? ((1 - s) * (1 - k) * x + s * double(filtered.value[i][c])) / (1 - kk) : x;
+        const double ofX = mixed ? (1 - s) * (1 - k) / (1 - kk) : 1.0;  // x's share in x'
+        if (mixed) corrected[i][c] = float(xx + kk * (double(p[i].L[c]) - xx)), moved[i] = 1;
+        if (error.empty()) continue;
+        double cov = shared ? ofX * double(p[i].Li[c]) * double(textureCovariance[i][c]) : 0.0;
+        if (moves)
+          cov += std::sqrt(std::max(own(i, c), 0.0)) * s *
+                 (double(filtered.plus[i][c]) - double(filtered.minus[i][c])) / 2 / (1 - kk);
+        error[i] += DisplayError(p[i].L[c], own(i, c), float(xx), kk, cov);
       }
     }
     if (!error.empty()) {

@@ -64,6 +64,7 @@ Status CheckPreviewSchedule(SampleProvider& exact, SampleProvider& preview, cons
                          std::to_string(schedule.maxRounds) + ")");
   if (schedule.correctionRadius < 0)
     return Status::Error("preview schedule: correctionRadius must not be negative");
+  if (schedule.filterRadius < 0) return Status::Error("preview schedule: filterRadius must not be negative");
   if (!(schedule.minRoundShare >= 0 && schedule.minRoundShare <= 1))
     return Status::Error("preview schedule: minRoundShare must be in [0, 1]");
   const ProviderCapabilities exactCaps = exact.Capabilities();
@@ -127,12 +128,21 @@ Status Finish(PlanningProvider& planning, SampleProvider& preview, const Reconst
   // missed at a rendered pixel, it missed around it too.
   if (schedule.correctionRadius > 0 && preview.Capabilities().variance) {
     const auto start = std::chrono::steady_clock::now();
+    GuideImage guides;
+    if (schedule.filterRadius > 0) {
+      // Every guide the renderer has: the filter weighs each one it is given.
+      const ProviderCapabilities caps = planning.Capabilities();
+      DCM_RETURN_IF_ERROR(planning.Guides({{0, 0}, {out->workWidth, out->workHeight}},
+                                          GuideRequest{caps.objectId, caps.shaderId, caps.texture, caps.normal},
+                                          &guides));
+    }
     DCM_RETURN_IF_ERROR(CorrectTowardPreview(preview, schedule.correctionRadius, options.downsample, out,
                                              &stats->correction, schedule.previewOwnVariance,
                                              ExactVarianceShare(schedule),
                                              out->stats.settings.split ? std::span<const RGB>(
                                                                              schedule.previewTextureCovariance)
-                                                                       : std::span<const RGB>()));
+                                                                       : std::span<const RGB>(),
+                                             schedule.filterRadius, guides));
     stats->timeEngineS += Seconds(start);
   }
   if (rendered > 0) {

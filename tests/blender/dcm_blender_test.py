@@ -89,7 +89,8 @@ def variance(dcm, blender, src, tmp):
     runs = {}
     for name, flags in (("auto", []), ("on", ["--variance", "on"]), ("raw", ["--variance", "on", "--no-denoise-samples"]),
                         ("exact preview", ["--variance", "on", "--preview-samples", "16"]),
-                        ("uncorrected", ["--variance", "on", "--preview-correction", "0"])):
+                        ("uncorrected", ["--variance", "on", "--preview-correction", "0"]),
+                        ("unfiltered", ["--variance", "on", "--preview-filter", "0"])):
         out, stats, smap = (os.path.join(tmp, name + e) for e in (".exr", ".json", ".png"))
         code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--sample-map", smap, "--blender", blender,
                                  "--max-rounds", "8", "--min-round-share", "0", "--schedule", "preview"] + flags)
@@ -142,6 +143,14 @@ def variance(dcm, blender, src, tmp):
     assert unc[2]["blender"]["preview_corrected"] == 0, unc[2]["blender"]
     corrected = on[2]["blender"]["preview_corrected"]
     assert 0.9 * corrected <= moved.sum() <= corrected and corrected > 0, (moved.sum(), on[2]["blender"])
+    # The preview filter (on by default) changes interpolated pixels only, those it says it
+    # took halfway to their filtered preview: the correction's shares come before it.
+    unf = runs["unfiltered"]
+    assert (on[1] == unf[1]).all() and (on[0][on[1]] == unf[0][unf[1]]).all(), "the filter changed an exact pixel"
+    filtered = on[2]["blender"]["preview_filtered"]
+    changed = (on[0][:, :, :3] != unf[0][:, :, :3]).any(axis=2)
+    assert unf[2]["blender"]["preview_filtered"] == 0, unf[2]["blender"]
+    assert 0 < changed.sum() <= filtered <= (~on[1]).sum(), (changed.sum(), filtered, on[2]["blender"])
     # The corrected run estimates its PSNR against the converged image from the
     # preview where the preview's own noise costs less than 25 dB; without the
     # correction there is no estimate.

@@ -410,6 +410,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       };
     }
     so.correctionRadius = f.rounds.previewCorrection;
+    so.filterRadius = f.rounds.previewFilter;
     so.minRoundShare = f.rounds.minRoundShare;
     // A target in dB or a budget is judged by the preview's estimate where the preview can tell.
     const double target = f.pipe.engine.targetPsnr.value_or(defaultGoal ? kDefaultTargetPsnr : 0);
@@ -592,6 +593,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     b["extra_pixels"] = timed.extraPixels;
     if (schedule == RoundSchedule::kPreview && (!quality || targetFromPreview)) {  // the search's runs each make their own
       b["preview_corrected"] = sched.correction.pixels;
+      b["preview_filtered"] = sched.correction.filtered;
       b["preview_correction_weight"] = sched.correction.meanWeight;
       if (std::isfinite(sched.correction.previewPsnr)) b["preview_psnr"] = sched.correction.previewPsnr;
     }
@@ -672,8 +674,10 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
               "total %.2f s\n",
               handshakeS - guidesRenderS, guidesRenderS + timed.guidesS, previewS, roundsS, engineS, wallS);
   if (sched.correction.pixels > 0)
-    std::printf("  correction     %lld interpolated pixels moved toward the preview (mean weight %.3f)\n",
-                static_cast<long long>(sched.correction.pixels), sched.correction.meanWeight);
+    std::printf("  correction     %lld interpolated pixels moved toward the preview (mean weight %.3f), %lld "
+                "halfway to its filtered value\n",
+                static_cast<long long>(sched.correction.pixels), sched.correction.meanWeight,
+                static_cast<long long>(sched.correction.filtered));
   if (!quality && !previewEstimate && std::isfinite(sched.correction.previewPsnr) && f.pipe.engine.verbose)
     std::fprintf(stderr, "dcm %s: no estimate of the PSNR: the preview's own is %.2f dB, too noisy to tell\n",
                  cmd.c_str(), sched.correction.previewPsnr);

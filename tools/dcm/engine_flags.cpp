@@ -228,6 +228,12 @@ void AddRoundFlags(CLI::App* app, RoundFlags* f) {
                   "noise does not explain (lib/include/dcm/preview_correction.h); 0: off")
       ->transform(Integer(0, 64))
       ->capture_default_str();
+  app->add_option("--preview-filter", f->previewFilter,
+                  "with the preview correction: interpolated pixels start from their mean with the preview "
+                  "averaged over the neighbours, in a window of this radius, that the guides and the interpolation "
+                  "say show the same surface (lib/include/dcm/preview_filter.h); 0: off")
+      ->transform(Integer(0, 16))
+      ->capture_default_str();
 }
 
 Status ScheduleFor(const RoundFlags& flags, const RoundCost& cost, bool previewAvailable, RoundSchedule* out) {

@@ -62,6 +62,7 @@ struct RoundFlags {
   double minRoundShare = 0.001;
   /// Window radius of the preview correction (PreviewScheduleOptions::correctionRadius); 0: off.
   int previewCorrection = PreviewScheduleOptions{}.correctionRadius;
+  int previewFilter = 3;  // a renderer's preview: noise of one sign in R, G, B (docs/TUNING.md)
 };
 
 /// Adds --schedule, --max-rounds, --min-round-share and --preview-correction (help group "Rounds").

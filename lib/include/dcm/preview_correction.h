@@ -24,7 +24,8 @@ inline constexpr double kMinPreviewPsnrForEstimate = 25;
 
 /// What a preview correction did.
 struct PreviewCorrectionStats {
-  int64_t pixels = 0;       ///< interpolated working pixels that moved (weight > 0 in a channel)
+  int64_t pixels = 0;       ///< interpolated working pixels that moved (weight > 0 in a channel, or filtered)
+  int64_t filtered = 0;     ///< interpolated working pixels that took half their filtered preview
   double meanWeight = 0;    ///< mean weight over the interpolated pixels and channels, in [0, 1]
   /// The corrected image's display-referred PSNR (sRGB, clipped, as the
   /// stats' PSNR) against the converged image, estimated from the preview at
@@ -75,8 +76,15 @@ double PreviewNoisePsnr(SampleProvider& preview, std::span<const RGB> ownVarianc
 /// covariance of the preview's estimates of tau and of L
 /// (PreviewScheduleOptions::previewTextureCovariance); the estimate takes
 /// out what the interpolation shares with the preview's noise through tau.
+/// `filterRadius` > 0: each interpolated pixel that FilterPreview() gives a
+/// value (over that radius, with `guides` of the whole working image or
+/// none, the corrected image as pilot) ends as the mean of its corrected
+/// value and that one. The filter leaves the pixel's own preview out; what it
+/// takes of it through the pilot, the estimate counts (the value made with
+/// the pilot's centre moved by +- the preview's sd per channel).
 Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample, Reconstruction* rec,
                             PreviewCorrectionStats* stats = nullptr, std::span<const RGB> ownVariance = {},
-                            double exactShare = 0, std::span<const RGB> textureCovariance = {});
+                            double exactShare = 0, std::span<const RGB> textureCovariance = {},
+                            int filterRadius = 0, const GuideImage& guides = {});
 
 }  // namespace dcm

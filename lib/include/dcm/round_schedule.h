@@ -69,6 +69,13 @@ struct PreviewScheduleOptions {
   /// interpolated pixels move toward it by CorrectTowardPreview() in windows
   /// of this radius (0: off). 5 chose on the tuning set (docs/TUNING.md).
   int correctionRadius = 5;
+  /// With the correction: the interpolated pixels start from their mean with
+  /// the preview filtered over windows of this radius, weighted by the
+  /// provider's guides and the corrected image (FilterPreview(); 0: off). Its
+  /// estimate takes the preview's noise as a path tracer's, of one sign in
+  /// R, G and B; of independent channels it errs low by up to 2 dB. `dcm
+  /// blender` uses 3 (chosen on the tuning set, docs/TUNING.md).
+  int filterRadius = 0;
   /// The preview's own variance per working pixel (row-major), from two
   /// halves of its samples and not pooled over neighbours: the correction's
   /// estimate of the result's PSNR reads it (PreviewCorrectionStats::estimate).
