@@ -704,7 +704,6 @@ DCM_API double dcmGetStat(DCMReconstructor r, const char* name) {
   if (n == "rounds") return double(r->schedule.rounds);
   if (n == "preview_stand_ins") return double(r->schedule.previewStandIns);
   if (n == "preview_corrected") return double(r->schedule.correction.pixels);
-  if (n == "preview_filtered") return double(r->schedule.correction.filtered);
   if (n == "stopped_at_target") return r->schedule.stoppedAtTarget ? 1.0 : 0.0;
   if (r->quality) {
     const dcm::QualityReport& q = *r->quality;

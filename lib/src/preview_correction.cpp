@@ -152,6 +152,7 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample,
     const bool split = caps.splitRadiance && (shared || (filterRadius > 0 && !guides.texture.empty()));
     if (Status s = preview.Evaluate(all, SampleRequest{split, true}, p); !s.ok())
       return Status::Error("preview correction: " + s.message());
+    const bool apart = split && !guides.texture.empty();  // as FilterPreview averages
 
     std::vector<uint8_t> usable(n);
     for (size_t i = 0; i < n; ++i) usable[i] = Usable(p[i], p[i].variance) && IsFinite(rec->workImage[i]);
@@ -255,10 +256,13 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample,
         const double x = rec->workImage[i][c], k = share[3 * i + size_t(c)], s = mixed ? kFilterShare : 0.0;
         const double kk = (1 - s) * k;
         const double xx = mixed ? ((1 - s) * (1 - k) * x + s * double(filtered.value[i][c])) / (1 - kk) : x;
-        const double ofX = mixed ? (1 - s) * (1 - k) / (1 - kk) : 1.0;  // x's share in x'
+        // What of x' carries this pixel's own tau, and with it the preview's
+        // noise: x, and f where it multiplies back averaged L_i by that tau
+        // (then all of x': (1 - s) (1 - k) + s = 1 - k').
+        const double ofTau = mixed && !apart ? (1 - s) * (1 - k) / (1 - kk) : 1.0;
         if (mixed) corrected[i][c] = float(xx + kk * (double(p[i].L[c]) - xx)), moved[i] = 1;
         if (error.empty()) continue;
-        double cov = shared ? ofX * double(p[i].Li[c]) * double(textureCovariance[i][c]) : 0.0;
+        double cov = shared ? ofTau * double(p[i].Li[c]) * double(textureCovariance[i][c]) : 0.0;
         if (moves)
           cov += std::sqrt(std::max(own(i, c), 0.0)) * s *
                  (double(filtered.plus[i][c]) - double(filtered.minus[i][c])) / 2 / (1 - kk);
