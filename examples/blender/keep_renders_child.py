@@ -4,7 +4,7 @@
 #   DCM_BLENDER_CHILD=examples/blender/keep_renders_child.py KEEP_DIR=DIR \
 #     dcm blender SCENE.blend -o OUT.exr --sample-map MAP.png
 #
-# For analysis (preview_filter_probe.py); the result is the same as without.
+# For analysis (preview_floor.py); the result is the same as without.
 import os
 import sys
 
