@@ -30,6 +30,9 @@ check(t[t.index("--target-psnr") + 1] == "40.0" and "--threshold" not in t, "a t
 check("--preview-correction" not in runner.command_line("d", "s", "o") and
       runner.command_line("d", "s", "o", preview_correction=False)[-2:] == ["--preview-correction", "0"],
       "the preview correction: dcm's default, or off")
+check("--preview-filter" not in runner.command_line("d", "s", "o") and
+      runner.command_line("d", "s", "o", preview_filter=False)[-2:] == ["--preview-filter", "0"],
+      "the preview filter: dcm's default, or off")
 check("--fixed-samples" not in runner.command_line("d", "s", "o") and
       "--fixed-samples" in runner.command_line("d", "s", "o", fixed_samples=True),
       "the exact pixels' samples: dcm's choice, or every sample")

@@ -75,6 +75,11 @@ class DCMSettings(bpy.types.PropertyGroup):
         description="Move interpolated pixels toward the preview where they differ from it by more than its "
                     "noise explains",
         default=True)
+    preview_filter: BoolProperty(
+        name="Preview filter",
+        description="Take interpolated pixels halfway to the preview averaged over their neighbours on the same "
+                    "surface (after the correction)",
+        default=True)
     fixed_samples: BoolProperty(
         name="Every sample",
         description="Render the exact pixels at every sample, also where the goal would leave them fewer",
@@ -119,8 +124,8 @@ def _build(context, workdir):
         threshold=s.threshold if s.threshold > 0 and s.target_psnr <= 0 and not s.full else None,
         target_psnr=s.target_psnr if s.target_psnr > 0 and not s.full else None,
         schedule=s.schedule, max_rounds=s.max_rounds, preview_correction=s.preview_correction,
-        fixed_samples=s.fixed_samples, view_layer=context.view_layer.name, frame=context.scene.frame_current,
-        extra=s.extra)
+        preview_filter=s.preview_filter, fixed_samples=s.fixed_samples, view_layer=context.view_layer.name,
+        frame=context.scene.frame_current, extra=s.extra)
     return cmd, out
 
 
@@ -267,6 +272,9 @@ class RENDER_PT_dcm(bpy.types.Panel):
         col.prop(s, "schedule", text="Schedule")
         col.prop(s, "max_rounds")
         col.prop(s, "preview_correction")
+        sub = col.row()
+        sub.active = s.preview_correction  # the filter acts within the correction
+        sub.prop(s, "preview_filter")
         col.prop(s, "fixed_samples")
         layout.prop(s, "output")
         layout.prop(s, "sample_map")

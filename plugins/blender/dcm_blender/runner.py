@@ -14,7 +14,7 @@ _PROGRESS = re.compile(r"^(?P<stage>.*?)\s+(?P<percent>\d{1,3})% \((?P<seconds>[
 
 def command_line(dcm, scene_file, output, *, blender=None, stats=None, samples=0, preview_samples=0,
                  method="dcm", full=False, threshold=None, target_psnr=None, schedule="auto", max_rounds=3,
-                 preview_correction=True, fixed_samples=False, view_layer=None, frame=None, sample_map=None,
+                 preview_correction=True, preview_filter=True, fixed_samples=False, view_layer=None, frame=None, sample_map=None,
                  extra=""):
     """The `dcm blender` command for one render of `scene_file` into `output`."""
     cmd = [dcm, "blender", scene_file, "-o", output]
@@ -39,6 +39,8 @@ def command_line(dcm, scene_file, output, *, blender=None, stats=None, samples=0
     cmd += ["--schedule", schedule, "--max-rounds", str(int(max_rounds))]
     if not preview_correction:
         cmd += ["--preview-correction", "0"]
+    if not preview_filter:
+        cmd += ["--preview-filter", "0"]
     if fixed_samples:
         cmd += ["--fixed-samples"]
     if view_layer:
