@@ -16,8 +16,8 @@ namespace dcm {
 namespace {
 
 // The widths of the weights, chosen on the tuning set (docs/TUNING.md): a
-// crease of about 12 degrees, an albedo step of 0.05, a display step of 0.05
-// halve a neighbour's weight at most a little more than once.
+// step of one width (a crease of about 12 degrees, an albedo or a display
+// step of 0.05) keeps exp(-1/2) = 0.61 of a neighbour's weight.
 constexpr double kNormalSd = 0.2;
 constexpr double kTextureSd = 0.05;
 constexpr double kPilotSd = 0.05;

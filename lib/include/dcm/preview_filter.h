@@ -1,6 +1,6 @@
 // Preview filter: the noisy preview averaged over the neighbours of each
-// interpolated pixel that the guides and the interpolation say show the same
-// thing (a cross-bilateral filter), so that what the preview correction then
+// interpolated pixel that the guides and the corrected image say show the
+// same thing (a cross-bilateral filter), so that what the preview correction
 // takes of the preview carries less of its noise.
 #pragma once
 
@@ -36,8 +36,8 @@ struct FilteredPreview {
 /// stand-ins too). With `centreShift` (one per pixel; empty: none),
 /// `out->plus` and `out->minus` are the same with P_i moved by + and - its
 /// shift in all three channels at once: how the value moves with the
-/// centre's pilot where the noise has one sign in R, G and B. `guides` covers the
-/// whole image (region 0..W, 0..H) or is empty.
+/// centre's pilot where the noise has one sign in R, G and B. `guides` covers
+/// the whole image (region 0..W, 0..H) or is empty.
 Status FilterPreview(std::span<const ExactSample> preview, bool split, const GuideImage& guides,
                      std::span<const RGB> pilot, std::span<const RGB> centreShift,
                      std::span<const SampleReason> sampleMap, int W, int H, int radius, FilteredPreview* out);
