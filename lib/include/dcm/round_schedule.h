@@ -73,8 +73,9 @@ struct PreviewScheduleOptions {
   /// the preview filtered over windows of this radius, weighted by the
   /// provider's guides and the corrected image (FilterPreview(); 0: off). Its
   /// estimate takes the preview's noise as a path tracer's, of one sign in
-  /// R, G and B; of independent channels it errs low by up to 2 dB. `dcm
-  /// blender` uses 3 (chosen on the tuning set, docs/TUNING.md).
+  /// R, G and B; on the analytic scenes of the tests it errs low by 0.7-2 dB
+  /// (docs/BLENDER.md). `dcm blender` uses 3 (chosen on the tuning set,
+  /// docs/TUNING.md).
   int filterRadius = 0;
   /// The preview's own variance per working pixel (row-major), from two
   /// halves of its samples and not pooled over neighbours: the correction's
