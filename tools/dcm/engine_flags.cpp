@@ -229,9 +229,9 @@ void AddRoundFlags(CLI::App* app, RoundFlags* f) {
       ->transform(Integer(0, 64))
       ->capture_default_str();
   app->add_option("--preview-filter", f->previewFilter,
-                  "with the preview correction: interpolated pixels start from their mean with the preview "
-                  "averaged over the neighbours, in a window of this radius, that the guides and the interpolation "
-                  "say show the same surface (lib/include/dcm/preview_filter.h); 0: off")
+                  "with the preview correction: interpolated pixels end halfway to the preview averaged over the "
+                  "neighbours, in a window of this radius, that the guides and the corrected image say show the "
+                  "same surface (lib/include/dcm/preview_filter.h); 0: off")
       ->transform(Integer(0, 16))
       ->capture_default_str();
 }

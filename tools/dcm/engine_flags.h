@@ -62,7 +62,9 @@ struct RoundFlags {
   double minRoundShare = 0.001;
   /// Window radius of the preview correction (PreviewScheduleOptions::correctionRadius); 0: off.
   int previewCorrection = PreviewScheduleOptions{}.correctionRadius;
-  int previewFilter = 3;  // a renderer's preview: noise of one sign in R, G, B (docs/TUNING.md)
+  /// Window radius of the preview filter (PreviewScheduleOptions::filterRadius, off there: its estimate
+  /// takes a renderer's noise, of one sign in R, G and B); 3 chose on the tuning set (docs/TUNING.md).
+  int previewFilter = 3;
 };
 
 /// Adds --schedule, --max-rounds, --min-round-share and --preview-correction (help group "Rounds").

@@ -81,7 +81,7 @@ double PreviewNoisePsnr(SampleProvider& preview, std::span<const RGB> ownVarianc
 /// none, the corrected image as pilot) ends as the mean of its corrected
 /// value and that one. The filter leaves the pixel's own preview out; what it
 /// takes of it through the pilot, the estimate counts (the value made with
-/// the pilot's centre moved by +- the preview's sd per channel).
+/// the pilot's centre moved by +- the preview's sd, in R, G and B at once).
 Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample, Reconstruction* rec,
                             PreviewCorrectionStats* stats = nullptr, std::span<const RGB> ownVariance = {},
                             double exactShare = 0, std::span<const RGB> textureCovariance = {},

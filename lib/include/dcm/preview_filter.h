@@ -4,7 +4,6 @@
 // takes of the preview carries less of its noise.
 #pragma once
 
-#include <cstdint>
 #include <span>
 #include <vector>
 

@@ -69,9 +69,9 @@ struct PreviewScheduleOptions {
   /// interpolated pixels move toward it by CorrectTowardPreview() in windows
   /// of this radius (0: off). 5 chose on the tuning set (docs/TUNING.md).
   int correctionRadius = 5;
-  /// With the correction: the interpolated pixels start from their mean with
-  /// the preview filtered over windows of this radius, weighted by the
-  /// provider's guides and the corrected image (FilterPreview(); 0: off). Its
+  /// With the correction: the interpolated pixels end halfway to the preview
+  /// filtered over windows of this radius, weighted by the provider's guides
+  /// and the corrected image (FilterPreview(); 0: off). Its
   /// estimate takes the preview's noise as a path tracer's, of one sign in
   /// R, G and B; on the analytic scenes of the tests it errs low by 0.7-2 dB
   /// (docs/BLENDER.md). `dcm blender` uses 3 (chosen on the tuning set,

@@ -14,8 +14,8 @@ _PROGRESS = re.compile(r"^(?P<stage>.*?)\s+(?P<percent>\d{1,3})% \((?P<seconds>[
 
 def command_line(dcm, scene_file, output, *, blender=None, stats=None, samples=0, preview_samples=0,
                  method="dcm", full=False, threshold=None, target_psnr=None, schedule="auto", max_rounds=3,
-                 preview_correction=True, preview_filter=True, fixed_samples=False, view_layer=None, frame=None, sample_map=None,
-                 extra=""):
+                 preview_correction=True, preview_filter=True, fixed_samples=False, view_layer=None, frame=None,
+                 sample_map=None, extra=""):
     """The `dcm blender` command for one render of `scene_file` into `output`."""
     cmd = [dcm, "blender", scene_file, "-o", output]
     if blender:
