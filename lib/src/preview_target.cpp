@@ -223,9 +223,12 @@ Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& pre
       }
       if (flat >= 2) break;
     }
-    // With the exact pixels' noise measured on the rounds, where it was; the
+    // With the exact pixels' noise measured on the rounds, where it was, and
+    // through the display at the kept result's values where it was made; the
     // full render's has all of their samples.
-    s.renderPsnr = RenderPsnr(previewPsnr, schedule) + 10 * std::log10(double(1 << s.exactSampleHalvings));
+    const double keptRender = s.last.correction.renderPsnr;
+    s.renderPsnr = (std::isfinite(keptRender) ? keptRender : RenderPsnr(previewPsnr, schedule)) +
+                   10 * std::log10(double(1 << s.exactSampleHalvings));
     s.renderedPixels = planning.KnownCount();
     // As ReconstructToQuality's: the cost of every run (with noisy samples a
     // pixel an earlier run rendered is interpolated again, and still paid for).

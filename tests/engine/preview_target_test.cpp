@@ -49,6 +49,29 @@ ImagePreviewProvider NoisyPreview(const std::vector<RGB>& truth, float sd, unsig
   return ImagePreviewProvider(M, M, M, M, std::move(L), {}, {}, std::move(var));
 }
 
+/// The full render's own display PSNR against the truth where each pixel
+/// keeps `share` of the preview's variance sd^2: the truth plus noise of that
+/// variance (another draw than the preview's).
+double RenderPsnrTruth(const std::vector<RGB>& truth, float sd, double share) {
+  std::mt19937 rng(101);
+  std::normal_distribution<float> noise(0.f, float(sd * std::sqrt(share)));
+  std::vector<RGB> L = truth;
+  for (RGB& v : L) v = {v.r + noise(rng), v.g + noise(rng), v.b + noise(rng)};
+  return DisplayPsnr(L, truth);
+}
+
+/// The render's own PSNR as reported at the end (the share through the
+/// display at the result's values) lies within 0.2 dB of the truth and
+/// closer than the preview's display noise scaled by the share
+/// (`renderPsnrAtStart`), which the display's curve bends by 0.2-0.4 dB at
+/// these noise levels. 0.2 dB: one draw of noise over 128^2 pixels varies
+/// the truth by about 0.03 dB, the estimate's values by as little.
+void ExpectRenderPsnrNearTheTruth(const PreviewTargetStats& stats, double truth) {
+  EXPECT_NEAR(stats.renderPsnr, truth, 0.2);
+  EXPECT_LT(std::abs(stats.renderPsnr - truth), std::abs(stats.renderPsnrAtStart - truth))
+      << "reported " << stats.renderPsnr << ", from the preview's display noise " << stats.renderPsnrAtStart;
+}
+
 QualityGoal Goal(double targetPsnr, double budget = 0) {
   QualityGoal g;
   g.targetPsnr = targetPsnr;
@@ -200,7 +223,8 @@ TEST(PreviewTarget, ATargetBeyondTheRendersOwnNoiseIsSearchedForUnlessADefaultGo
   PreviewTargetStats stats;
   ASSERT_TRUE(ReconstructToTargetFromPreview(truth, preview, Options(), asDefault, schedule, &one, &oneReport, &stats).ok());
   EXPECT_TRUE(stats.beyondRender);
-  EXPECT_NEAR(stats.renderPsnr, PreviewNoisePsnr(preview) + 10 * std::log10(2.0), 1e-9);
+  EXPECT_NEAR(stats.renderPsnrAtStart, PreviewNoisePsnr(preview) + 10 * std::log10(2.0), 1e-9);
+  ExpectRenderPsnrNearTheTruth(stats, RenderPsnrTruth(ref, 0.01f, 0.5));
   EXPECT_LT(stats.renderPsnr, 45 + 0.5);
   ASSERT_EQ(stats.thresholds.size(), 1u);
   EXPECT_EQ(stats.thresholds[0], defaultThreshold);
@@ -314,7 +338,9 @@ TEST(PreviewTarget, AShareMeasuredOnTheRoundsReplacesTheRatioOfSamples) {
   const double own = PreviewNoisePsnr(preview);
   EXPECT_NEAR(stats.renderPsnrAtStart, own + 10 * std::log10(2.0), 1e-9);
   EXPECT_TRUE(stats.beyondRender) << "decided on the ratio: " << stats.renderPsnrAtStart;
-  EXPECT_NEAR(stats.renderPsnr, own + 10 * std::log10(20.0), 1e-9);
+  PreviewTargetStats measured = stats;
+  measured.renderPsnrAtStart = own + 10 * std::log10(20.0);  // the preview's noise at the measured share
+  ExpectRenderPsnrNearTheTruth(measured, RenderPsnrTruth(truth.FullRender(), 0.01f, 0.05));
   EXPECT_EQ(report.renderEstimate.psnr, stats.renderPsnr);
   // The exact pixels' share of the estimated error shrinks with their noise.
   PreviewScheduleOptions assumed;
@@ -408,7 +434,7 @@ TEST(PreviewTarget, ExactPixelsTakeFewerSamplesWhereAFullRenderAtAsFewWouldStill
       EXPECT_GE(psnr, target - 0.5) << "estimated " << report.estimate.psnr;
     }
     EXPECT_NEAR(report.estimate.psnr, psnr, 1.5);
-    EXPECT_NEAR(stats.renderPsnr, stats.renderPsnrAtStart, 1e-9);
+    ExpectRenderPsnrNearTheTruth(stats, RenderPsnrTruth(ref, 0.01f, 1.0 / 64));
   }
 }
 

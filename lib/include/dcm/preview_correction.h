@@ -37,14 +37,19 @@ struct PreviewCorrectionStats {
   /// value does not depend on p's noise, E[(X - A)(X - B)] is X's squared
   /// error; a corrected pixel x + k (p - x) has (1 - k)^2 times that plus
   /// k^2 the preview's display variance (k taken as fixed). An exact pixel
-  /// counts `exactShare` times the preview's display variance (its own
-  /// noise), a preview stand-in the preview's. The interval is that of
-  /// independent pixels.
+  /// counts its own noise, `exactShare` times the preview's variance through
+  /// the display at its value; a preview stand-in the preview's display
+  /// variance. The interval is that of independent pixels.
   PsnrEstimate estimate{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
                         std::numeric_limits<double>::quiet_NaN()};
   /// The preview's own display-referred PSNR against the converged image,
   /// from its variance (NaN with downsample > 1).
   double previewPsnr = std::numeric_limits<double>::quiet_NaN();
+  /// The full render's own display-referred PSNR against the converged
+  /// image: every pixel at `exactShare` of the preview's variance, through
+  /// the display at its value in the result (NaN where the estimate is not
+  /// made or `exactShare` is 0).
+  double renderPsnr = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// The display-referred PSNR of `preview`'s own noise against the converged

@@ -46,7 +46,8 @@ struct PreviewTargetStats {
   int exactSampleHalvings = 0;
   /// That limit: the full render's own PSNR against the converged image, as
   /// the preview estimates it with the exact share known at the end
-  /// (ExactVarianceShare; +inf with noise-free exact samples).
+  /// (ExactVarianceShare), through the display at the kept result's values
+  /// (PreviewCorrectionStats::renderPsnr; +inf with noise-free exact samples).
   double renderPsnr = 0;
   /// The same before the first round: what decided `beyondRender`.
   double renderPsnrAtStart = 0;
