@@ -674,10 +674,11 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
               "total %.2f s\n",
               handshakeS - guidesRenderS, guidesRenderS + timed.guidesS, previewS, roundsS, engineS, wallS);
   if (sched.correction.pixels > 0)
-    std::printf("  correction     %lld interpolated pixels moved toward the preview (mean weight %.3f), %lld "
-                "halfway to its filtered value\n",
+    std::printf("  correction     %lld interpolated pixels moved toward the preview (mean weight %.3f)%s\n",
                 static_cast<long long>(sched.correction.pixels), sched.correction.meanWeight,
-                static_cast<long long>(sched.correction.filtered));
+                sched.correction.filtered > 0
+                    ? (", " + std::to_string(sched.correction.filtered) + " halfway to its filtered value").c_str()
+                    : "");
   if (!quality && !previewEstimate && std::isfinite(sched.correction.previewPsnr) && f.pipe.engine.verbose)
     std::fprintf(stderr, "dcm %s: no estimate of the PSNR: the preview's own is %.2f dB, too noisy to tell\n",
                  cmd.c_str(), sched.correction.previewPsnr);
