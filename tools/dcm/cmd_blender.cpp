@@ -566,7 +566,10 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   // Without a goal, the preview correction's estimate of the whole image (against the converged image).
   const PsnrEstimate& fromPreview = sched.correction.estimate;
   const bool previewEstimate = !quality && std::isfinite(fromPreview.low);
+  // Beside it the full render's own, where the exact pixels carry noise (else NaN).
+  const double renderFromPreview = previewEstimate ? sched.correction.renderPsnr : NAN;
   if (previewEstimate) toolkit::AddEstimateMetadata(fromPreview, &meta);
+  if (std::isfinite(renderFromPreview)) meta.floats.push_back({"dcm:estimated_render_psnr", float(renderFromPreview)});
   if (frame >= 0) meta.strings.push_back({"Frame", std::to_string(frame)});
   toolkit::AddMetadata(meta, &image.attributes);
   if (Status w = toolkit::WriteOutputExr(output, image, f.pipe.exr); !w.ok()) return Fail(w.message());
@@ -628,6 +631,10 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       toolkit::AddEstimateJson(fromPreview, 0.90, &j);  // EstimatePsnr's interval
       j["estimated_psnr_against"] = "converged";
       j["estimated_psnr_from"] = "preview";
+      if (std::isfinite(renderFromPreview)) {
+        j["estimated_render_psnr"] = renderFromPreview;
+        j["closer_than_render"] = fromPreview.psnr >= renderFromPreview;
+      }
     }
     if (quality) {
       toolkit::AddQualityJson(*quality, engine.targetPsnr.value_or(0), engine.budget.value_or(0), &j);
@@ -682,10 +689,16 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   if (!quality && !previewEstimate && std::isfinite(sched.correction.previewPsnr) && f.pipe.engine.verbose)
     std::fprintf(stderr, "dcm %s: no estimate of the PSNR: the preview's own is %.2f dB, too noisy to tell\n",
                  cmd.c_str(), sched.correction.previewPsnr);
-  if (previewEstimate)
+  if (previewEstimate) {
+    char render[160] = "";
+    if (std::isfinite(renderFromPreview))
+      std::snprintf(render, sizeof render, "; the full render's own %.2f dB: %s is closer, by %.2f dB",
+                    renderFromPreview, fromPreview.psnr >= renderFromPreview ? "this result" : "the full render",
+                    std::fabs(fromPreview.psnr - renderFromPreview));
     std::printf("  estimate       PSNR %.2f dB against the converged image, from the preview (90 %% interval %.2f to "
-                "%.2f; the preview's own %.2f dB)\n",
-                fromPreview.psnr, fromPreview.low, fromPreview.high, sched.correction.previewPsnr);
+                "%.2f; the preview's own %.2f dB%s)\n",
+                fromPreview.psnr, fromPreview.low, fromPreview.high, sched.correction.previewPsnr, render);
+  }
   if (quality) {
     std::printf("  quality        %s%s\n", QualityLine(*quality, engine).c_str(), defaultGoal ? " (the default goal)" : "");
     if (f.pipe.engine.verbose) std::cerr << QualityLine(*quality, engine) << "\n";
