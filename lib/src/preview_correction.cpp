@@ -276,7 +276,7 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample,
       // result (the interpolated one where the round's value is filled in
       // later: as good for the slope). A share of the preview's display
       // variance would understate it where the preview's far larger noise
-      // meets the curve's bend and clip (1.9 dB on a glossy scene's edges).
+      // meets the curve's bend and clip.
       std::vector<double> d;
       d.reserve(n);
       double noiseSum = 0, renderSum = 0;
