@@ -283,7 +283,8 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample,
       for (size_t i = 0; i < n; ++i) {
         const RGB& pv = ownVariance.empty() ? p[i].variance : ownVariance[i];
         const double noise = usable[i] ? DisplayNoise(p[i].L, pv) : 0.0;
-        const double ownNoise = usable[i] && IsFinite(corrected[i]) ? DisplayNoise(corrected[i], pv * float(exactShare)) : 0.0;
+        const double ownNoise =
+            usable[i] && IsFinite(corrected[i]) ? DisplayNoise(corrected[i], pv * float(exactShare)) : 0.0;
         noiseSum += noise;
         renderSum += ownNoise;
         const SampleReason r = rec->sampleMap[i];

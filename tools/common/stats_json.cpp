@@ -189,8 +189,13 @@ void AddQualityJson(const QualityReport& r, double targetPsnr, double budget, nl
 }
 
 std::optional<bool> CloserThanRender(const QualityReport& r) {
-  if (!r.againstConverged || !std::isfinite(r.renderEstimate.psnr) || std::isnan(r.estimate.psnr)) return {};
-  return r.estimate.psnr >= r.renderEstimate.psnr;
+  if (!r.againstConverged) return {};
+  return CloserThanRender(r.estimate.psnr, r.renderEstimate.psnr);
+}
+
+std::optional<bool> CloserThanRender(double resultPsnr, double renderPsnr) {
+  if (!std::isfinite(renderPsnr) || std::isnan(resultPsnr)) return {};
+  return resultPsnr >= renderPsnr;
 }
 
 void AddQualityMetadata(const QualityReport& r, Metadata* m) {

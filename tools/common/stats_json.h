@@ -63,6 +63,10 @@ void AddQualityJson(const QualityReport& report, double targetPsnr, double budge
 /// full render, by the two estimates; empty where either is not known.
 std::optional<bool> CloserThanRender(const QualityReport& report);
 
+/// The same from the two PSNRs against the converged image: empty where the
+/// render's is not finite or the result's is NaN.
+std::optional<bool> CloserThanRender(double resultPsnr, double renderPsnr);
+
 /// Adds AddEstimateMetadata() of the report's estimate and, with samples of
 /// known variance, dcm:estimated_render_psnr (finite values only) to EXR
 /// metadata.

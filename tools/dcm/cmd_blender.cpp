@@ -631,9 +631,9 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       toolkit::AddEstimateJson(fromPreview, 0.90, &j);  // EstimatePsnr's interval
       j["estimated_psnr_against"] = "converged";
       j["estimated_psnr_from"] = "preview";
-      if (std::isfinite(renderFromPreview)) {
+      if (const std::optional<bool> closer = toolkit::CloserThanRender(fromPreview.psnr, renderFromPreview)) {
         j["estimated_render_psnr"] = renderFromPreview;
-        j["closer_than_render"] = fromPreview.psnr >= renderFromPreview;
+        j["closer_than_render"] = *closer;
       }
     }
     if (quality) {
@@ -690,14 +690,13 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     std::fprintf(stderr, "dcm %s: no estimate of the PSNR: the preview's own is %.2f dB, too noisy to tell\n",
                  cmd.c_str(), sched.correction.previewPsnr);
   if (previewEstimate) {
-    char render[160] = "";
+    char render[64] = "";
     if (std::isfinite(renderFromPreview))
-      std::snprintf(render, sizeof render, "; the full render's own %.2f dB: %s is closer, by %.2f dB",
-                    renderFromPreview, fromPreview.psnr >= renderFromPreview ? "this result" : "the full render",
-                    std::fabs(fromPreview.psnr - renderFromPreview));
+      std::snprintf(render, sizeof render, "; the full render's own %.2f dB: ", renderFromPreview);
     std::printf("  estimate       PSNR %.2f dB against the converged image, from the preview (90 %% interval %.2f to "
-                "%.2f; the preview's own %.2f dB%s)\n",
-                fromPreview.psnr, fromPreview.low, fromPreview.high, sched.correction.previewPsnr, render);
+                "%.2f; the preview's own %.2f dB%s%s)\n",
+                fromPreview.psnr, fromPreview.low, fromPreview.high, sched.correction.previewPsnr, render,
+                *render ? WhichIsCloser(fromPreview.psnr, renderFromPreview).c_str() : "");
   }
   if (quality) {
     std::printf("  quality        %s%s\n", QualityLine(*quality, engine).c_str(), defaultGoal ? " (the default goal)" : "");

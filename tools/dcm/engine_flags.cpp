@@ -325,17 +325,20 @@ std::string QualityLine(const QualityReport& r, const EngineFlags& f) {
     std::snprintf(noise, sizeof noise, " (%.2f to %.2f)", n.low, n.high);
     line += noise;
   }
-  if (const std::optional<bool> closer = toolkit::CloserThanRender(r)) {
+  if (toolkit::CloserThanRender(r)) {
     // Issue 26's question: which is closer to the converged image.
     if (std::isinf(e.psnr)) line += ": this result is closer (its validation pixels show no error beyond the noise)";
-    else {
-      std::snprintf(noise, sizeof noise, *closer ? ": this result is closer, by %.2f dB"
-                                                 : ": the full render is closer, by %.2f dB",
-                    std::fabs(e.psnr - n.psnr));
-      line += noise;
-    }
+    else line += ": " + WhichIsCloser(e.psnr, n.psnr);
   }
   return line;
+}
+
+std::string WhichIsCloser(double resultPsnr, double renderPsnr) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%s is closer, by %.2f dB",
+                toolkit::CloserThanRender(resultPsnr, renderPsnr).value_or(false) ? "this result" : "the full render",
+                std::fabs(resultPsnr - renderPsnr));
+  return buf;
 }
 
 std::string QualityWarning(const QualityReport& r, const EngineFlags& f) {

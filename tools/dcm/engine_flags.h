@@ -98,6 +98,10 @@ Status ReconstructFor(SampleProvider& provider, const ReconstructionOptions& opt
 /// 0.061", for -v and the summaries.
 std::string QualityLine(const QualityReport& report, const EngineFlags& flags);
 
+/// "this result is closer, by X dB" or "the full render is closer, by X dB"
+/// from the two finite PSNRs against the converged image.
+std::string WhichIsCloser(double resultPsnr, double renderPsnr);
+
 /// The warning of a --target-psnr that was not reached, empty when it was.
 std::string QualityWarning(const QualityReport& report, const EngineFlags& flags);
 
