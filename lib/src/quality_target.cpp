@@ -57,8 +57,17 @@ int64_t ShareOfWhatIsLeft(int64_t used, int64_t limit) {
 constexpr double kLastBudgetStep = 0.97;
 /// Bisections between the last run within the budget and the one beyond.
 constexpr int kBudgetBisections = 3;
-/// At most this many confirming draws (and runs after the first).
+/// Without a budget, at most this many confirming draws (and runs after the
+/// first); with one, the budget bounds them.
 constexpr int kMaxConfirmations = 3;
+
+/// The step of the threshold from `t` that brings the lower bound `low` to
+/// `target`, by the secant through the run before (`lastT`, `lastLow`) in log
+/// threshold; `fallback` where there is no rising secant. Not clamped.
+double SecantStep(double t, double low, double lastT, double lastLow, double target, double fallback) {
+  if (!(lastT > 0) || !std::isfinite(low) || !std::isfinite(lastLow) || !(low > lastLow)) return fallback;
+  return std::exp((target - low) * (std::log(t) - std::log(lastT)) / (low - lastLow));
+}
 
 /// Status message of an evaluation the budget refused (never shown: the
 /// caller recognises CachingProvider::BudgetHit()).
@@ -785,13 +794,9 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
     // Secants in log threshold: of the lower bound, the step that reaches the
     // target; of the log exact pixels, the step that spends the share of the
     // budget a run may. The smaller step of the two.
-    double toTarget = target > 0 ? kDefaultStep : 0, toBudget = 0;
+    const double toTarget = target > 0 ? SecantStep(t, low, lastT, lastLow, target, kDefaultStep) : 0;
+    double toBudget = 0;
     const double used = double(cache.Distinct());
-    if (lastT > 0) {
-      const double dlogT = std::log(t) - std::log(lastT);
-      if (toTarget > 0 && std::isfinite(low) && std::isfinite(lastLow) && low > lastLow)
-        toTarget = std::exp((target - low) * dlogT / (low - lastLow));
-    }
     if (limit > 0) {
       // The pixels as a power of the threshold, t^-alpha: alpha from the last
       // two runs, 1 before a second (cautious: a run refused costs pixels).
@@ -852,9 +857,12 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   // room). A fresh draw, which chose nothing, estimates the result, drawn by
   // importance where the result's error is likely (ErrorProxy). Where it
   // finds the target missed although the search's pixels met it, the descent
-  // goes on, one step at a time, each result confirmed by a draw of its own
-  // (the draws before join the search's pixels).
+  // goes on, each result confirmed by a draw of its own (the draws before
+  // join the search's pixels), by secants of the confirming draws' lower
+  // bounds. Without a budget a few steps; with one, until it binds: a target
+  // asked for within a budget spends the budget before it says "not reached".
   const bool searchMet = meets(*best);
+  double confirmedT = 0, confirmedLow = kNaN;
   for (int confirmation = 0; target > 0 && best->threshold >= 0; ++confirmation) {
     Validation fresh;
     cache.ClearBudgetHit();
@@ -865,10 +873,20 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
     best->estimate = EstimateAt(fresh, goal, best->rec.image, best->rec.width, sampledBy(best->rec), workW, s);
     report->confirmed = true;
     v.AppendAll(fresh);
-    if (meets(*best) || !searchMet || confirmation + 1 >= kMaxConfirmations) break;
-    const double next = best->threshold <= kMinThreshold ? -1 : std::max(kMinThreshold, best->threshold * kDefaultStep);
+    if (meets(*best) || !searchMet || (limit <= 0 && confirmation + 1 >= kMaxConfirmations)) break;
+    const double low = best->estimate.low;
+    const double step =
+        std::clamp(SecantStep(best->threshold, low, confirmedT, confirmedLow, target, kDefaultStep), kMinStep, kMaxStep);
+    confirmedT = best->threshold;
+    confirmedLow = low;
+    const double next = best->threshold <= kMinThreshold ? -1 : std::max(kMinThreshold, best->threshold * step);
     if (limit > 0) cache.SetLimit(ShareOfWhatIsLeft(cache.Distinct(), limit));
     DCM_RETURN_IF_ERROR(runAt(next, &tried));
+    if (!tried && limit > 0) {
+      // Refused by the share, not by the budget: the same run with all that is left.
+      cache.SetLimit(limit);
+      DCM_RETURN_IF_ERROR(runAt(next, &tried));
+    }
     cache.SetLimit(limit);
     if (!tried) {
       report->budgetBound = true;

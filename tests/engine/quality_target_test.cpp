@@ -216,6 +216,50 @@ TEST(QualityTarget, UnreachableTargetReportsWhatTheBudgetReached) {
   EXPECT_LE(provider.TotalEvaluations(), int64_t(0.05 * N * N));
 }
 
+TEST(QualityTarget, ConfirmingDrawsThatFindTheTargetMissedSpendTheBudget) {
+  // A ramp, which every run reconstructs exactly, with an error that hides
+  // from the search: every run above the
+  // threshold tHidden is off by 0.05 at each pixel nobody had evaluated before
+  // it ran, so the search's own validation pixels see no error and each
+  // confirming draw, made after the run, sees it. Without a budget the
+  // descent stops after kMaxConfirmations (3) runs and says the target was
+  // missed; with one, it goes on until the budget binds, here until a run
+  // below tHidden meets the target.
+  const int N = 256;
+  const double tHidden = 0.14 * std::pow(0.7, 4);  // below what three runs from the default reach
+  for (double budget : {0.0, 0.5}) {
+    AnalyticProvider provider(N, N, SpottedRamp(N, 0));
+    QualityGoal goal;
+    goal.targetPsnr = 40;
+    goal.budget = budget;
+    double lowestThreshold = 1;
+    goal.reconstruct = [&](SampleProvider& p, const ReconstructionOptions& o, Reconstruction* out,
+                           std::vector<Point2i>* pending) {
+      std::vector<uint8_t> seen(size_t(N) * N);
+      for (int y = 0; y < N; ++y)
+        for (int x = 0; x < N; ++x) seen[size_t(y) * N + size_t(x)] = provider.EvaluationsOf(x, y) > 0;
+      DCM_RETURN_IF_ERROR(Reconstruct(p, o, out, pending));
+      const double t = double(*o.contrastThreshold);
+      lowestThreshold = std::min(lowestThreshold, t);
+      if (t > tHidden)
+        for (size_t i = 0; i < seen.size(); ++i)
+          if (!seen[i] && provider.EvaluationsOf(int(i % N), int(i / N)) == 0) out->image[i] += RGB::Gray(0.05f);
+      return Status::Ok();
+    };
+    const Outcome r = RunGoal(provider, ReconstructionOptions{}, goal);
+    if (budget == 0) {
+      EXPECT_FALSE(r.report.targetReached);
+      EXPECT_EQ(r.report.runs, 3);  // the first run and one after each of the first two confirming draws
+      EXPECT_GT(lowestThreshold, tHidden);
+    } else {
+      EXPECT_TRUE(r.report.targetReached);
+      EXPECT_LT(lowestThreshold, tHidden);
+      EXPECT_GE(r.truePsnr, goal.targetPsnr - 0.5);
+      EXPECT_LE(provider.TotalEvaluations(), int64_t(budget * N * N));
+    }
+  }
+}
+
 TEST(QualityTarget, SupersampledTargetIsMetAtOutputResolution) {
   const int N = 256;
   AnalyticProvider provider(N, N, FurnishedScene(N, N));

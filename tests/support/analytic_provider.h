@@ -54,6 +54,8 @@ class AnalyticProvider : public SampleProvider {
   /// Largest number of evaluations of any one pixel.
   int MaxEvaluationsOfOnePixel() const;
   int64_t TotalEvaluations() const;
+  /// How many times pixel (x, y) was evaluated.
+  int EvaluationsOf(int x, int y) const { return count_[size_t(y) * size_t(width_) + size_t(x)].load(); }
 
  private:
   int width_, height_;
