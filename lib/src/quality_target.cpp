@@ -736,6 +736,17 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
     return Status::Ok();
   };
 
+  // A run that may spend the share of the budget left; one refused by the
+  // share, not by the budget, runs again with all that is left: it asks for
+  // the same pixels first, so nothing spent is lost.
+  auto runShared = [&](double t, std::optional<Run>* into) -> Status {
+    cache.SetLimit(ShareOfWhatIsLeft(cache.Distinct(), limit));
+    DCM_RETURN_IF_ERROR(runAt(t, into));
+    if (*into) return Status::Ok();
+    cache.SetLimit(limit);
+    return runAt(t, into);
+  };
+
   const double threshold = double(ResolveSettings(options, caps).contrastThreshold);
   // Contrasts are at most 1 but for the display-weighted metric's brightest sets.
   const double t0 = limit > 0 ? std::min(kStartFactorBudget * threshold, 1.0) : kStartFactor * threshold;
@@ -749,15 +760,7 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   for (;;) {
     // A run of the descent after the first may spend only part of what is
     // left: one the budget refuses leaves the rest to the bisection below.
-    const bool shared = limit > 0 && best;
-    if (shared) cache.SetLimit(ShareOfWhatIsLeft(cache.Distinct(), limit));
-    DCM_RETURN_IF_ERROR(runAt(t, &tried));
-    if (!tried && shared) {
-      // Refused by the share, not by the budget: the same run with all that is
-      // left asks for the same pixels first, so nothing spent is lost.
-      cache.SetLimit(limit);
-      DCM_RETURN_IF_ERROR(runAt(t, &tried));
-    }
+    DCM_RETURN_IF_ERROR(limit > 0 && best ? runShared(t, &tried) : runAt(t, &tried));
     if (!tried) {
       refused = t;
       break;
@@ -880,13 +883,7 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
     confirmedT = best->threshold;
     confirmedLow = low;
     const double next = best->threshold <= kMinThreshold ? -1 : std::max(kMinThreshold, best->threshold * step);
-    if (limit > 0) cache.SetLimit(ShareOfWhatIsLeft(cache.Distinct(), limit));
-    DCM_RETURN_IF_ERROR(runAt(next, &tried));
-    if (!tried && limit > 0) {
-      // Refused by the share, not by the budget: the same run with all that is left.
-      cache.SetLimit(limit);
-      DCM_RETURN_IF_ERROR(runAt(next, &tried));
-    }
+    DCM_RETURN_IF_ERROR(limit > 0 ? runShared(next, &tried) : runAt(next, &tried));
     cache.SetLimit(limit);
     if (!tried) {
       report->budgetBound = true;
