@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "dcm/reconstructor.h"
@@ -80,6 +81,20 @@ class PlanningProvider : public SampleProvider {
     int64_t kept = 0;
     for (size_t k = 0; k < known_.size(); ++k) {
       // A non-finite sample stays out, as the engine keeps it out of its neighbours.
+      if (!known_[k] || rec->sampleMap[k] != SampleReason::kInterpolated || !IsFinite(samples_[k].L)) continue;
+      rec->sampleMap[k] = SampleReason::kRendered;
+      ++kept;
+    }
+    rec->stats.byReason[size_t(SampleReason::kRendered)] += kept;
+    rec->stats.exactPixels += kept;
+    return kept;
+  }
+
+  /// MarkRendered() for `only` of the pixels.
+  int64_t MarkRendered(Reconstruction* rec, std::span<const Point2i> only) const {
+    int64_t kept = 0;
+    for (const Point2i& p : only) {
+      const size_t k = Index(p);
       if (!known_[k] || rec->sampleMap[k] != SampleReason::kInterpolated || !IsFinite(samples_[k].L)) continue;
       rec->sampleMap[k] = SampleReason::kRendered;
       ++kept;

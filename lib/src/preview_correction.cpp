@@ -115,7 +115,8 @@ double PreviewNoisePsnr(SampleProvider& preview, std::span<const RGB> ownVarianc
 
 Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample, Reconstruction* rec,
                             PreviewCorrectionStats* stats, std::span<const RGB> ownVariance, double exactShare,
-                            std::span<const RGB> textureCovariance, int filterRadius, const GuideImage& guides) {
+                            std::span<const RGB> textureCovariance, int filterRadius, const GuideImage& guides,
+                            std::vector<float>* excess) {
   if (radius < 0) return Status::Error("preview correction: radius " + std::to_string(radius) + " is negative");
   if (filterRadius < 0)
     return Status::Error("preview correction: filter radius " + std::to_string(filterRadius) + " is negative");
@@ -279,6 +280,7 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample,
       // meets the curve's bend and clip.
       std::vector<double> d;
       d.reserve(n);
+      std::vector<double> over(excess ? n : 0), noises(excess ? n : 0);
       double noiseSum = 0, renderSum = 0;
       for (size_t i = 0; i < n; ++i) {
         const RGB& pv = ownVariance.empty() ? p[i].variance : ownVariance[i];
@@ -291,6 +293,24 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample,
         if (r == SampleReason::kPreviewStandIn) d.push_back(noise);
         else if (r != SampleReason::kInterpolated) d.push_back(ownNoise);
         else if (usable[i]) d.push_back(error[i] / 3);
+        if (excess) {
+          noises[i] = noise;
+          over[i] = r == SampleReason::kInterpolated && usable[i] ? error[i] / 3 - ownNoise : std::numeric_limits<double>::quiet_NaN();
+        }
+      }
+      if (excess) {
+        // One pixel's variance from its two halves has one degree of freedom:
+        // the noise is pooled over the pixel's 5 x 5 neighbours, and never
+        // below the image's mean (where the preview has no noise, a clear
+        // sky, any error would stand out of none).
+        const std::vector<double> pooled = WindowSums(noises, W, H, 2),
+                                  ones = WindowSums(std::vector<double>(n, 1.0), W, H, 2);
+        const double floor = noiseSum / double(n);
+        excess->assign(n, std::numeric_limits<float>::quiet_NaN());
+        for (size_t i = 0; i < n; ++i) {
+          const double scale = std::max(pooled[i] / ones[i], floor);
+          if (std::isfinite(over[i]) && scale > 0) (*excess)[i] = float(over[i] / scale);
+        }
       }
       result.previewPsnr = 10 * std::log10(double(n) / std::max(noiseSum, 1e-30));
       if (exactShare > 0) result.renderPsnr = 10 * std::log10(double(n) / std::max(renderSum, 1e-30));

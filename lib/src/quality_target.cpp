@@ -133,7 +133,7 @@ class CachingProvider : public SampleProvider {
       for (size_t k : misses) fresh += index_[Index(pixels[k])] < 0 ? 1 : 0;
       if (limit_ > 0 && distinct_ + fresh > limit_) {
         budgetHit_ = true;
-        return Status::Error(kBudgetMessage);
+        return Status::OverBudget(kBudgetMessage);
       }
       // Reserved before the (unlocked) evaluation: concurrent batches are
       // disjoint, so no pixel is counted twice.

@@ -116,14 +116,17 @@ void MarkStandIns(const std::vector<Point2i>& wanted, Reconstruction* out) {
   }
 }
 
-/// The rendered pixels kept (not with noisy samples), the interpolated ones
-/// corrected toward the preview, the rendered values filled in.
+/// The rendered pixels kept (not with noisy samples, but `keep`), the
+/// interpolated ones corrected toward the preview, the rendered values filled
+/// in; `excess` as CorrectTowardPreview's.
 Status Finish(PlanningProvider& planning, SampleProvider& preview, const ReconstructionOptions& options,
-              const PreviewScheduleOptions& schedule, Reconstruction* out, PreviewScheduleStats* stats) {
+              const PreviewScheduleOptions& schedule, Reconstruction* out, PreviewScheduleStats* stats,
+              std::vector<float>* excess = nullptr, std::span<const Point2i> keep = {}) {
   // Rendered pixels keep their exact values, but not with noisy samples: the
   // final run denoised its exact samples against their neighbours, and a raw
-  // one among them is noise (docs/TUNING.md).
-  const int64_t rendered = out->stats.settings.noisy ? 0 : planning.MarkRendered(out);
+  // one among them is noise (docs/TUNING.md). The error round's are kept:
+  // their interpolation missed by far more than that noise.
+  const int64_t rendered = out->stats.settings.noisy ? planning.MarkRendered(out, keep) : planning.MarkRendered(out);
   // The correction sees their interpolated values: where the interpolation
   // missed at a rendered pixel, it missed around it too.
   if (schedule.correctionRadius > 0 && preview.Capabilities().variance) {
@@ -142,7 +145,7 @@ Status Finish(PlanningProvider& planning, SampleProvider& preview, const Reconst
                                              out->stats.settings.split ? std::span<const RGB>(
                                                                              schedule.previewTextureCovariance)
                                                                        : std::span<const RGB>(),
-                                             schedule.filterRadius, guides));
+                                             schedule.filterRadius, guides, excess));
     stats->timeEngineS += Seconds(start);
   }
   if (rendered > 0) {
@@ -245,7 +248,42 @@ Status PlanRenderAndFinish(PlanningProvider& planning, SampleProvider& preview, 
   // The final run's engine time excludes the rounds; the provider time is the rounds'.
   out->stats.timeProviderS = stats->timeExactS;
   out->stats.providerCalls = stats->rounds;
-  return finished ? Status::Ok() : Finish(planning, preview, options, schedule, out, stats);
+  if (finished) return Status::Ok();
+  if (!(schedule.errorRound > 0)) return Finish(planning, preview, options, schedule, out, stats);
+  // The error round: the result finished once says, per pixel, where the
+  // interpolation misses by more than a rendered pixel would.
+  const Reconstruction unfinished = *out;
+  std::vector<float> excess;
+  DCM_RETURN_IF_ERROR(Finish(planning, preview, options, schedule, out, stats, &excess));
+  std::vector<size_t> worst;
+  for (size_t i = 0; i < excess.size(); ++i)
+    if (excess[i] > schedule.errorRound) worst.push_back(i);
+  const int64_t left = schedule.maxExactPixels > 0 ? schedule.maxExactPixels - planning.KnownCount() : INT64_MAX;
+  if (worst.empty() || left <= 0) return Status::Ok();
+  std::sort(worst.begin(), worst.end(), [&](size_t a, size_t b) { return excess[a] > excess[b]; });
+  if (int64_t(worst.size()) > left) {
+    worst.resize(size_t(left));
+    stats->budgetBound = true;
+  }
+  std::vector<Point2i> pick(worst.size());
+  for (size_t k = 0; k < worst.size(); ++k)
+    pick[k] = {int(worst[k] % size_t(caps.width)), int(worst[k] / size_t(caps.width))};
+  const auto exactStart = std::chrono::steady_clock::now();
+  const Status s = planning.EvaluateExactly(pick, schedule.maxExactPixels);
+  stats->timeExactS += Seconds(exactStart);
+  // A quality search's budget refused the round: the result stays as finished.
+  if (s.overBudget()) {
+    stats->budgetBound = true;
+    return Status::Ok();
+  }
+  DCM_RETURN_IF_ERROR(s);
+  ++stats->rounds;
+  stats->pixelsPerRound.push_back(int64_t(pick.size()));
+  stats->errorRoundPixels = int64_t(pick.size());
+  *out = unfinished;
+  out->stats.timeProviderS = stats->timeExactS;
+  out->stats.providerCalls = stats->rounds;
+  return Finish(planning, preview, options, schedule, out, stats, nullptr, pick);
 }
 
 ImagePreviewProvider::ImagePreviewProvider(int workWidth, int workHeight, int previewWidth,

@@ -87,10 +87,15 @@ def variance(dcm, blender, src, tmp):
     half_b = bs.render_full(blender, src, blend, tmp, 8, 1)
     h, w = half_a.shape[:2]
     runs = {}
-    for name, flags in (("auto", []), ("on", ["--variance", "on"]), ("raw", ["--variance", "on", "--no-denoise-samples"]),
-                        ("exact preview", ["--variance", "on", "--preview-samples", "16"]),
+    # "on" and the runs compared with it have no error round (it depends on the correction's estimate);
+    # "error round" has it, as by default.
+    no_error_round = ["--error-round", "0"]
+    for name, flags in (("auto", []), ("on", ["--variance", "on"] + no_error_round),
+                        ("raw", ["--variance", "on", "--no-denoise-samples"] + no_error_round),
+                        ("exact preview", ["--variance", "on", "--preview-samples", "16"] + no_error_round),
                         ("uncorrected", ["--variance", "on", "--preview-correction", "0"]),
-                        ("unfiltered", ["--variance", "on", "--preview-filter", "0"])):
+                        ("unfiltered", ["--variance", "on", "--preview-filter", "0"] + no_error_round),
+                        ("error round", ["--variance", "on"])):
         out, stats, smap = (os.path.join(tmp, name + e) for e in (".exr", ".json", ".png"))
         code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--sample-map", smap, "--blender", blender,
                                  "--max-rounds", "8", "--min-round-share", "0", "--schedule", "preview"] + flags)
@@ -151,6 +156,16 @@ def variance(dcm, blender, src, tmp):
     changed = (on[0][:, :, :3] != unf[0][:, :, :3]).any(axis=2)
     assert unf[2]["blender"]["preview_filtered"] == 0, unf[2]["blender"]
     assert 0 < changed.sum() <= filtered <= (~on[1]).sum(), (changed.sum(), filtered, on[2]["blender"])
+    # The error round renders, after the same rounds, the interpolated pixels the preview says the
+    # interpolation missed most, and keeps them exact as the mean of the two seeds' renders
+    # (not denoised, though the samples are noisy).
+    er = runs["error round"]
+    n_error = er[2]["blender"]["error_round_pixels"]
+    added = er[1] & ~on[1]
+    assert (er[1] | ~on[1]).all() and added.sum() == n_error > 0, (added.sum(), er[2]["blender"])
+    assert len(er[2]["blender"]["rounds"]) == len(on[2]["blender"]["rounds"]) + 1, (er[2]["blender"], on[2]["blender"])
+    err = np.abs(er[0] - mean)[added][:, :3]
+    assert (err <= 1e-5 * np.maximum(np.abs(mean[added][:, :3]), 1) + 1e-7).all(), err.max()
     # The corrected run estimates its PSNR against the converged image from the
     # preview where the preview's own noise costs less than 25 dB; without the
     # correction there is no estimate.

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <utility>
 
 #include "dcm/round_schedule.h"
@@ -130,9 +131,10 @@ TEST(RoundSchedule, TheLastRoundLeavesStandInsAndSaysSo) {
 }
 
 /// A few-samples preview of a Monte Carlo render: the scene with the noise of
-/// `model` (every pixel), with its variance or without.
-ImagePreviewProvider NoisyPreview(int w, int h, NoiseModel model, bool withVariance) {
-  AnalyticProvider scene(w, h, FurnishedScene(w, h));
+/// `model` (every pixel), with its variance or without; of the furnished
+/// scene unless another is given.
+ImagePreviewProvider NoisyPreview(int w, int h, NoiseModel model, bool withVariance, SceneFunction of = {}) {
+  AnalyticProvider scene(w, h, of ? of : FurnishedScene(w, h));
   NoisyProvider noisy(scene, model);
   std::vector<Point2i> all;
   for (int y = 0; y < h; ++y)
@@ -194,6 +196,69 @@ TEST(RoundSchedule, ANoisyPreviewWithItsVarianceIsNotTakenForEdges) {
     ASSERT_TRUE(rec->stats.settings.noisy);
     EXPECT_EQ(rec->stats.byReason[size_t(SampleReason::kRendered)], 0);
   }
+}
+
+TEST(RoundSchedule, TheErrorRoundRendersWhatTheInterpolationMissedAndKeepsIt) {
+  // A ramp with 64 one-pixel highlights off the lattice, which no block test
+  // sees, noisy exact samples with their variance and a preview of four times
+  // their noise, which shows the highlights (0.4 against its sd of about
+  // 0.04). The correction, which weighs a window, moves a lone pixel toward
+  // the noisy preview only in part; the error round renders the highlights
+  // and keeps them exact though the samples are noisy, and nearly nothing else.
+  const int N = 128;
+  auto spots = [](int x, int y) { return x % 16 == 5 && y % 16 == 11; };
+  const SceneFunction scene = [&](int x, int y) {
+    PixelTruth t;
+    t.Li = RGB{0.2f + 0.3f * float(x) / N, 0.25f, 0.2f + 0.2f * float(y) / N} + RGB::Gray(spots(x, y) ? 0.4f : 0.f);
+    return t;
+  };
+  AnalyticProvider truth(N, N, scene);
+  const std::vector<RGB> ref = truth.FullRender();
+  const NoiseModel exactNoise{0.02f, 0.002f, 1}, previewNoise{0.08f, 0.008f, 2};
+  auto spotMse = [&](const Reconstruction& rec) {
+    double sum = 0;
+    int n = 0;
+    for (int y = 0; y < N; ++y)
+      for (int x = 0; x < N; ++x)
+        if (spots(x, y)) {
+          const RGB d = rec.workImage[size_t(y) * N + x] - ref[size_t(y) * N + x];
+          sum += double(d.r) * d.r + double(d.g) * d.g + double(d.b) * d.b;
+          n += 3;
+        }
+    return sum / n;
+  };
+  Reconstruction rec[2];
+  PreviewScheduleStats stats[2];
+  for (int on : {0, 1}) {
+    NoisyProvider exact(truth, exactNoise);
+    ImagePreviewProvider preview = NoisyPreview(N, N, previewNoise, true, scene);
+    PreviewScheduleOptions schedule;
+    schedule.errorRound = on ? 8 : 0;
+    ASSERT_TRUE(ReconstructWithPreview(exact, preview, {}, schedule, &rec[on], &stats[on]).ok());
+    ASSERT_TRUE(rec[on].stats.settings.noisy);
+  }
+  int spotsRendered = 0, spotPixels = 0;
+  for (int y = 0; y < N; ++y)
+    for (int x = 0; x < N; ++x)
+      if (spots(x, y)) {
+        ++spotPixels;
+        spotsRendered += rec[1].sampleMap[size_t(y) * N + x] == SampleReason::kRendered;
+      }
+  std::printf("error round: %lld pixels, %d of the %d highlight pixels; their MSE %.3g without, %.3g with; "
+              "%.2f / %.2f dB\n",
+              (long long)stats[1].errorRoundPixels, spotsRendered, spotPixels, spotMse(rec[0]), spotMse(rec[1]),
+              DisplayPsnr(rec[0].workImage, ref), DisplayPsnr(rec[1].workImage, ref));
+  EXPECT_EQ(stats[0].errorRoundPixels, 0);
+  EXPECT_EQ(stats[0].rounds + 1, stats[1].rounds);  // one render call more
+  // Every highlight rendered, and few others: chance excesses of the
+  // preview's noise past 8 times its variance, under 1 % of the image.
+  EXPECT_EQ(spotsRendered, spotPixels);
+  EXPECT_LE(stats[1].errorRoundPixels - spotsRendered, N * N / 100);
+  EXPECT_EQ(rec[1].stats.byReason[size_t(SampleReason::kRendered)], stats[1].errorRoundPixels);
+  // Kept exact, the highlights carry the exact samples' noise only: their
+  // error falls by far more than half.
+  EXPECT_LT(spotMse(rec[1]), 0.25 * spotMse(rec[0]));
+  EXPECT_GT(DisplayPsnr(rec[1].workImage, ref), DisplayPsnr(rec[0].workImage, ref));
 }
 
 TEST(RoundSchedule, ThePreviewCorrectionCostsLittleWhereThePreviewIsMuchNoisier) {

@@ -411,6 +411,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     }
     so.correctionRadius = f.rounds.previewCorrection;
     so.filterRadius = f.rounds.previewFilter;
+    so.errorRound = f.rounds.errorRound;
     so.minRoundShare = f.rounds.minRoundShare;
     // A target in dB or a budget is judged by the preview's estimate where the preview can tell.
     const double target = f.pipe.engine.targetPsnr.value_or(defaultGoal ? kDefaultTargetPsnr : 0);
@@ -597,6 +598,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     if (schedule == RoundSchedule::kPreview && (!quality || targetFromPreview)) {  // the search's runs each make their own
       b["preview_corrected"] = sched.correction.pixels;
       b["preview_filtered"] = sched.correction.filtered;
+      b["error_round_pixels"] = sched.errorRoundPixels;
       b["preview_correction_weight"] = sched.correction.meanWeight;
       if (std::isfinite(sched.correction.previewPsnr)) b["preview_psnr"] = sched.correction.previewPsnr;
     }
@@ -686,6 +688,10 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
                 sched.correction.filtered > 0
                     ? (", " + std::to_string(sched.correction.filtered) + " halfway to its filtered value").c_str()
                     : "");
+  if (sched.errorRoundPixels > 0)
+    std::printf("  error round    %lld interpolated pixels rendered where the preview said the interpolation "
+                "missed (--error-round)\n",
+                static_cast<long long>(sched.errorRoundPixels));
   if (!quality && !previewEstimate && std::isfinite(sched.correction.previewPsnr) && f.pipe.engine.verbose)
     std::fprintf(stderr, "dcm %s: no estimate of the PSNR: the preview's own is %.2f dB, too noisy to tell\n",
                  cmd.c_str(), sched.correction.previewPsnr);

@@ -234,6 +234,12 @@ void AddRoundFlags(CLI::App* app, RoundFlags* f) {
                   "same surface (lib/include/dcm/preview_filter.h); 0: off")
       ->transform(Integer(0, 16))
       ->capture_default_str();
+  app->add_option("--error-round", f->errorRound,
+                  "with the preview correction: one more round renders the interpolated pixels whose estimated "
+                  "error exceeds what they would carry rendered by more than Z times the preview's display "
+                  "variance there, most first (lib/include/dcm/round_schedule.h); 0: off")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
 }
 
 Status ScheduleFor(const RoundFlags& flags, const RoundCost& cost, bool previewAvailable, RoundSchedule* out) {

@@ -65,6 +65,8 @@ struct RoundFlags {
   /// Window radius of the preview filter (PreviewScheduleOptions::filterRadius, off there: its estimate
   /// takes a renderer's noise, of one sign in R, G and B); 3 chose on the tuning set (docs/TUNING.md).
   int previewFilter = 3;
+  /// PreviewScheduleOptions::errorRound (off there); 8 chose on the tuning set (docs/TUNING.md).
+  double errorRound = 8;
 };
 
 /// Adds --schedule, --max-rounds, --min-round-share and --preview-correction (help group "Rounds").

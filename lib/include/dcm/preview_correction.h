@@ -87,9 +87,15 @@ double PreviewNoisePsnr(SampleProvider& preview, std::span<const RGB> ownVarianc
 /// value and that one. The filter leaves the pixel's own preview out; what it
 /// takes of it through the pilot, the estimate counts (the value made with
 /// the pilot's centre moved by +- the preview's sd, in R, G and B at once).
+/// `excess` (where the estimate is made): per working pixel, how far the
+/// interpolated pixel's estimated squared display error exceeds what it
+/// would carry rendered (`exactShare` of the preview's variance), in units of
+/// the preview's display variance there, the noise of that estimate; NaN
+/// where the pixel is not interpolated or has no estimate.
 Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample, Reconstruction* rec,
                             PreviewCorrectionStats* stats = nullptr, std::span<const RGB> ownVariance = {},
                             double exactShare = 0, std::span<const RGB> textureCovariance = {},
-                            int filterRadius = 0, const GuideImage& guides = {});
+                            int filterRadius = 0, const GuideImage& guides = {},
+                            std::vector<float>* excess = nullptr);
 
 }  // namespace dcm

@@ -77,6 +77,14 @@ struct PreviewScheduleOptions {
   /// (docs/BLENDER.md). `dcm blender` uses 3 (chosen on the tuning set,
   /// docs/TUNING.md).
   int filterRadius = 0;
+  /// After the last round, where the correction estimates each pixel's
+  /// error: one more round renders the interpolated pixels whose estimated
+  /// squared error exceeds what they would carry rendered by more than this
+  /// many times the preview's display variance there (the noise of that
+  /// estimate), most first, within the budget; they keep their exact values
+  /// (also with noisy samples, which the final run would otherwise denoise
+  /// away). 0: off.
+  double errorRound = 0;
   /// The preview's own variance per working pixel (row-major), from two
   /// halves of its samples and not pooled over neighbours: the correction's
   /// estimate of the result's PSNR reads it (PreviewCorrectionStats::estimate).
@@ -133,6 +141,7 @@ struct PreviewScheduleStats {
   int rounds = 0;                       ///< calls to the exact provider
   std::vector<int64_t> pixelsPerRound;  ///< exact pixels evaluated in each call
   int64_t previewStandIns = 0;          ///< wanted pixels left at their preview value
+  int64_t errorRoundPixels = 0;         ///< rendered by PreviewScheduleOptions::errorRound
   int engineRuns = 0;                   ///< reconstructions run (one more than the rounds, at most)
   double timeEngineS = 0;               ///< in the engine runs (preview evaluation included)
   double timeExactS = 0;                ///< in the exact provider's Evaluate()
