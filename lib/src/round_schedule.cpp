@@ -251,10 +251,12 @@ Status PlanRenderAndFinish(PlanningProvider& planning, SampleProvider& preview, 
   if (finished) return Status::Ok();
   if (!(schedule.errorRound > 0)) return Finish(planning, preview, options, schedule, out, stats);
   // The error round: the result finished once says, per pixel, where the
-  // interpolation misses by more than a rendered pixel would.
+  // interpolation misses by more than a rendered pixel would. Where it
+  // reaches the goal already, the render call buys nothing asked for.
   const Reconstruction unfinished = *out;
   std::vector<float> excess;
   DCM_RETURN_IF_ERROR(Finish(planning, preview, options, schedule, out, stats, &excess));
+  if (canStop && Mse(stats->correction.estimate.low) <= allowed) return Status::Ok();
   std::vector<size_t> worst;
   for (size_t i = 0; i < excess.size(); ++i)
     if (excess[i] > schedule.errorRound) worst.push_back(i);

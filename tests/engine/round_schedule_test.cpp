@@ -259,6 +259,19 @@ TEST(RoundSchedule, TheErrorRoundRendersWhatTheInterpolationMissedAndKeepsIt) {
   // error falls by far more than half.
   EXPECT_LT(spotMse(rec[1]), 0.25 * spotMse(rec[0]));
   EXPECT_GT(DisplayPsnr(rec[1].workImage, ref), DisplayPsnr(rec[0].workImage, ref));
+  // A goal the result without the round reaches (20 dB; it lies near 35) skips
+  // the round; one it misses (45 dB) does not.
+  for (double goal : {20.0, 45.0}) {
+    NoisyProvider exact(truth, exactNoise);
+    ImagePreviewProvider preview = NoisyPreview(N, N, previewNoise, true, scene);
+    PreviewScheduleOptions schedule;
+    schedule.errorRound = 8;
+    schedule.stopAtPsnr = goal;
+    Reconstruction r;
+    PreviewScheduleStats st;
+    ASSERT_TRUE(ReconstructWithPreview(exact, preview, {}, schedule, &r, &st).ok());
+    EXPECT_EQ(st.errorRoundPixels > 0, goal > 30) << goal << " dB, estimated " << st.correction.estimate.low;
+  }
 }
 
 TEST(RoundSchedule, ThePreviewCorrectionCostsLittleWhereThePreviewIsMuchNoisier) {

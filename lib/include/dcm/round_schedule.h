@@ -83,7 +83,8 @@ struct PreviewScheduleOptions {
   /// many times the preview's display variance there (the noise of that
   /// estimate), most first, within the budget; they keep their exact values
   /// (also with noisy samples, which the final run would otherwise denoise
-  /// away). 0: off.
+  /// away). Not where the result's estimate reaches `stopAtPsnr` already.
+  /// 0: off.
   double errorRound = 0;
   /// The preview's own variance per working pixel (row-major), from two
   /// halves of its samples and not pooled over neighbours: the correction's
