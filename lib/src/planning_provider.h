@@ -79,29 +79,15 @@ class PlanningProvider : public SampleProvider {
   /// FillRendered(). Returns how many.
   int64_t MarkRendered(Reconstruction* rec) const {
     int64_t kept = 0;
-    for (size_t k = 0; k < known_.size(); ++k) {
-      // A non-finite sample stays out, as the engine keeps it out of its neighbours.
-      if (!known_[k] || rec->sampleMap[k] != SampleReason::kInterpolated || !IsFinite(samples_[k].L)) continue;
-      rec->sampleMap[k] = SampleReason::kRendered;
-      ++kept;
-    }
-    rec->stats.byReason[size_t(SampleReason::kRendered)] += kept;
-    rec->stats.exactPixels += kept;
-    return kept;
+    for (size_t k = 0; k < known_.size(); ++k) kept += MarkOne(rec, k);
+    return Counted(rec, kept);
   }
 
   /// MarkRendered() for `only` of the pixels.
   int64_t MarkRendered(Reconstruction* rec, std::span<const Point2i> only) const {
     int64_t kept = 0;
-    for (const Point2i& p : only) {
-      const size_t k = Index(p);
-      if (!known_[k] || rec->sampleMap[k] != SampleReason::kInterpolated || !IsFinite(samples_[k].L)) continue;
-      rec->sampleMap[k] = SampleReason::kRendered;
-      ++kept;
-    }
-    rec->stats.byReason[size_t(SampleReason::kRendered)] += kept;
-    rec->stats.exactPixels += kept;
-    return kept;
+    for (const Point2i& p : only) kept += MarkOne(rec, Index(p));
+    return Counted(rec, kept);
   }
 
   /// Gives the pixels MarkRendered() marked their exact values.
@@ -143,6 +129,19 @@ class PlanningProvider : public SampleProvider {
   }
 
  private:
+  /// Marks pixel k rendered where a round evaluated it and `rec` interpolated
+  /// it. A non-finite sample stays out, as the engine keeps it out of its neighbours.
+  bool MarkOne(Reconstruction* rec, size_t k) const {
+    if (!known_[k] || rec->sampleMap[k] != SampleReason::kInterpolated || !IsFinite(samples_[k].L)) return false;
+    rec->sampleMap[k] = SampleReason::kRendered;
+    return true;
+  }
+  static int64_t Counted(Reconstruction* rec, int64_t kept) {
+    rec->stats.byReason[size_t(SampleReason::kRendered)] += kept;
+    rec->stats.exactPixels += kept;
+    return kept;
+  }
+
   size_t Index(const Point2i& p) const { return size_t(p.y) * size_t(caps_.width) + size_t(p.x); }
 
   SampleProvider& exact_;

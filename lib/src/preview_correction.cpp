@@ -295,7 +295,8 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample,
         else if (usable[i]) d.push_back(error[i] / 3);
         if (excess) {
           noises[i] = noise;
-          over[i] = r == SampleReason::kInterpolated && usable[i] ? error[i] / 3 - ownNoise : std::numeric_limits<double>::quiet_NaN();
+          over[i] = r == SampleReason::kInterpolated && usable[i] ? error[i] / 3 - ownNoise
+                                                                   : std::numeric_limits<double>::quiet_NaN();
         }
       }
       if (excess) {
