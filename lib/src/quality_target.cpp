@@ -91,11 +91,13 @@ double PsnrOf(double mse) { return mse > 0 ? 10.0 * std::log10(1.0 / mse) : kInf
 /// A provider that evaluates each pixel of `inner` at most once over its
 /// lifetime (several runs of the engine, the validation pixels), keeps the
 /// guides of the whole image, and refuses an evaluation that would take the
-/// distinct pixels beyond `limit` (0: none).
+/// distinct pixels beyond `limit` (0: none). Each pixel is asked for at
+/// least `widest`, the channels any run of the search asks for: a full
+/// evaluation asks for L alone, and a later run would pay for the pixel again.
 class CachingProvider : public SampleProvider {
  public:
-  CachingProvider(SampleProvider& inner, int64_t limit)
-      : inner_(inner), caps_(inner.Capabilities()), limit_(limit),
+  CachingProvider(SampleProvider& inner, int64_t limit, SampleRequest widest)
+      : inner_(inner), caps_(inner.Capabilities()), limit_(limit), widest_(widest),
         index_(size_t(std::max(0, caps_.width)) * size_t(std::max(0, caps_.height)), -1) {}
 
   ProviderCapabilities Capabilities() const override { return caps_; }
@@ -115,7 +117,8 @@ class CachingProvider : public SampleProvider {
     return Status::Ok();
   }
 
-  Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what, std::span<ExactSample> out) override {
+  Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& asked, std::span<ExactSample> out) override {
+    const SampleRequest what{asked.split || widest_.split, asked.variance || widest_.variance};
     const uint8_t need = Mask(what);
     std::vector<size_t> misses;
     int64_t fresh = 0;  // pixels never evaluated before, reserved in the budget
@@ -229,6 +232,7 @@ class CachingProvider : public SampleProvider {
   SampleProvider& inner_;
   ProviderCapabilities caps_;
   int64_t limit_;
+  SampleRequest widest_;
   mutable std::mutex mutex_;
   std::vector<int32_t> index_;  ///< per working pixel: its sample, -1 none
   std::vector<ExactSample> samples_;
@@ -629,7 +633,8 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   const int s = std::max(1, options.downsample);
   const int outW = (caps.width + s - 1) / s, outH = (caps.height + s - 1) / s;
   const int64_t limit = goal.budget > 0 ? std::max<int64_t>(1, int64_t(std::floor(goal.budget * double(total)))) : 0;
-  CachingProvider cache(provider, limit);
+  const SampleRequest what{caps.splitRadiance && options.textureSplit, caps.variance};  // the validation's too
+  CachingProvider cache(provider, limit, what);
   if (goal.targetRender && !caps.variance)
     return Status::Error("--target-psnr render: the samples carry no variance (" + caps.name +
                          "), so the full render's own error is not known; give a target in dB");
@@ -642,8 +647,6 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   if (limit > 0)
     count = std::min(count, std::max<int64_t>(2, limit / (hasTarget ? 4 : 20) / (int64_t(s) * s)));
   count = std::min(count, outPixels);
-  const bool split = caps.splitRadiance && options.textureSplit;
-  const SampleRequest what{split, caps.variance};
   Validation v;
   std::vector<uint8_t> drawn(size_t(outPixels), 0);  // output pixels validated, for the cost
   int draws = 0;
@@ -783,10 +786,12 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
     // samples grew. What the validation sees is then error that a lower
     // threshold does not remove (a feature the lattice misses at any
     // threshold, hit by a validation pixel); the last draw judges the result.
+    // With a budget, the budget ends the descent instead: a target asked for
+    // within one spends it before it says "not reached".
     lows.push_back(low);
     spends.push_back(double(cache.Distinct()));
     const size_t n = lows.size();
-    if (target > 0 && n >= 3 && std::isfinite(lows[n - 3]) && lows[n - 1] - lows[n - 3] < kPlateauDb &&
+    if (target > 0 && limit <= 0 && n >= 3 && std::isfinite(lows[n - 3]) && lows[n - 1] - lows[n - 3] < kPlateauDb &&
         spends[n - 1] > kPlateauGrowth * spends[n - 3])
       break;
     if (t <= kMinThreshold) {

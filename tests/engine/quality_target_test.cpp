@@ -260,6 +260,34 @@ TEST(QualityTarget, ConfirmingDrawsThatFindTheTargetMissedSpendTheBudget) {
   }
 }
 
+TEST(QualityTarget, APlateauEndsTheDescentOnlyWithoutABudget) {
+  // Twelve highlights no threshold finds: the validation's lower bound stops
+  // rising while the pixels grow. Without a budget the descent stops there
+  // (a few per cent of the pixels); with one, the budget ends it: spent
+  // within the last run's share (60 % of what was left, then the bisection).
+  const int n = 256;
+  const double budget = 0.15;
+  for (double b : {0.0, budget}) {
+    AnalyticProvider provider(n, n, SpottedRamp(n, 12));
+    QualityGoal goal;
+    goal.targetPsnr = 40;
+    goal.budget = b;
+    goal.seed = 8 * 7919;  // a seed whose search sees a highlight: "not reached" either way
+    const Outcome r = RunGoal(provider, ReconstructionOptions{}, goal);
+    EXPECT_FALSE(r.report.targetReached);
+    if (b == 0) {
+      EXPECT_LT(r.report.exactFraction(), 0.1);
+    } else {
+      EXPECT_TRUE(r.report.budgetBound);
+      EXPECT_GT(r.report.exactFraction(), 0.6 * budget);
+      // Each pixel once, also where the descent reached the full evaluation,
+      // which asks for L alone, and the runs after it asked for L_i and L_c.
+      EXPECT_EQ(provider.MaxEvaluationsOfOnePixel(), 1);
+      EXPECT_LE(provider.TotalEvaluations(), int64_t(budget * n * n));
+    }
+  }
+}
+
 TEST(QualityTarget, SupersampledTargetIsMetAtOutputResolution) {
   const int N = 256;
   AnalyticProvider provider(N, N, FurnishedScene(N, N));
