@@ -218,10 +218,10 @@ TEST(QualityTarget, UnreachableTargetReportsWhatTheBudgetReached) {
 
 TEST(QualityTarget, ConfirmingDrawsThatFindTheTargetMissedSpendTheBudget) {
   // A ramp, which every run reconstructs exactly, with an error that hides
-  // from the search: every run above the
-  // threshold tHidden is off by 0.05 at each pixel nobody had evaluated before
-  // it ran, so the search's own validation pixels see no error and each
-  // confirming draw, made after the run, sees it. Without a budget the
+  // from the search: every run above the threshold tHidden is off by 0.05 at
+  // each pixel nobody had evaluated before it ran, so the search's own
+  // validation pixels see no error and each confirming draw, made after the
+  // run, sees it. Without a budget the
   // descent stops after kMaxConfirmations (3) runs and says the target was
   // missed; with one, it goes on until the budget binds, here until a run
   // below tHidden meets the target.
