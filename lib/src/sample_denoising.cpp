@@ -27,6 +27,19 @@ bool SolveFirstColumn(const double M[3][3], double g[3]) {
   return true;
 }
 
+/// Every channel within k times kColourGate luminance standard deviations:
+/// the luminance test alone averages colours of equal luminance (a red and a
+/// blue texel). 2 lies above the 1.33 sd of a channel whose noise is
+/// independent of the others' (grey noise does not trip it).
+constexpr float kColourGate = 2.f;
+
+bool SameColour(const Value& p, const Value& q, float k) {
+  const float sa = k * kColourGate * std::sqrt(p.varA + q.varA), sb = k * kColourGate * std::sqrt(p.varB + q.varB);
+  for (int c = 0; c < 3; ++c)
+    if (std::fabs(p.a[c] - q.a[c]) > sa || std::fabs(p.b[c] - q.b[c]) > sb) return false;
+  return true;
+}
+
 }  // namespace
 
 int64_t DenoiseExactSamples(SampleStore& store, int radius, const ContrastTest& noise, float gate) {
@@ -50,7 +63,8 @@ int64_t DenoiseExactSamples(SampleStore& store, int radius, const ContrastTest& 
         for (int nx = std::max(0, x - radius); nx <= std::min(W - 1, x + radius); ++nx) {
           const int64_t j = store.Index(nx, ny);
           if (!store.IsExact(j) || !store.IsFinite(j) || !surfaces.Same(i, j)) continue;
-          if (j != i && !noise.WithinNoise(vi, store.ValueAt(j), gate)) continue;
+          if (j != i && !(noise.WithinNoise(vi, store.ValueAt(j), gate) && SameColour(vi, store.ValueAt(j), gate)))
+            continue;
           const double dx = double(nx - x), dy = double(ny - y);
           const Neighbour n{j, dx / radius, dy / radius, std::exp(-(dx * dx + dy * dy) / (2 * sd * sd))};
           const double v[3] = {1, n.x, n.y};
