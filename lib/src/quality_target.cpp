@@ -560,6 +560,7 @@ Status EvaluateValidation(CachingProvider& cache, const ReconstructionOptions& o
 struct Run {
   Reconstruction rec;
   PsnrEstimate estimate;
+  PsnrEstimate second{kNaN, kNaN, kNaN};  ///< QualityGoal::secondEstimate of the run, NaN: none
   std::vector<LevelEstimate> levels;
   double threshold = 0;
 };
@@ -735,6 +736,7 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
       return st;
     }
     r.estimate = EstimateAt(v, goal, r.rec.image, r.rec.width, sampledBy(r.rec), workW, s);
+    if (goal.secondEstimate && caps.variance) r.second = goal.secondEstimate();
     *result = std::move(r);
     return Status::Ok();
   };
@@ -753,7 +755,9 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   const double threshold = double(ResolveSettings(options, caps).contrastThreshold);
   // Contrasts are at most 1 but for the display-weighted metric's brightest sets.
   const double t0 = limit > 0 ? std::min(kStartFactorBudget * threshold, 1.0) : kStartFactor * threshold;
-  auto meets = [&](const Run& r) { return target > 0 && r.estimate.low >= target; };
+  auto meets = [&](const Run& r) {
+    return target > 0 && r.estimate.low >= target && !(r.second.low < target);
+  };
 
   std::optional<Run> best, tried;
   std::vector<double> lows, spends;  // per run of the descent: the lower bound, the pixels spent
@@ -900,6 +904,7 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   // The render's own error does not depend on the search: every draw counts.
   report->renderEstimate = RenderEstimate(v, goal);
   report->estimate = best->estimate;
+  report->secondEstimate = best->second;
   report->levels = std::move(best->levels);
   report->threshold = best->threshold;
   report->targetReached = target <= 0 || meets(*best);

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
+#include <limits>
 #include <span>
 #include <utility>
 #include <vector>
@@ -369,6 +371,50 @@ TEST(QualityTarget, NoisyEstimateIsAgainstTheConvergedImage) {
     }
     EXPECT_GE(estimateCovered, 7) << "downsample " << downsample;
     EXPECT_GE(renderCovered, 7) << "downsample " << downsample;
+  }
+}
+
+TEST(QualityTarget, ASecondJudgeBelowTheTargetKeepsTheSearchGoing) {
+  // Noisy samples with their variance, a target the validation meets at the
+  // first run: a second estimate whose lower bound falls short of it for the
+  // first two runs holds the search to a third; one with no opinion (NaN), or
+  // any second estimate where the samples carry no variance (the validation
+  // is then against the full render, the second against the converged
+  // image), changes nothing.
+  const int n = 128;
+  const double target = 30;
+  for (bool variance : {true, false}) {
+    int calls = 0;
+    auto run = [&](std::function<PsnrEstimate()> second) {
+      AnalyticProvider exact(n, n, FurnishedScene(n, n));
+      NoisyProvider noisy(exact, {0.05f, 0.002f, 1, variance});
+      QualityGoal goal;
+      goal.targetPsnr = target;
+      goal.secondEstimate = std::move(second);
+      Reconstruction rec;
+      QualityReport report;
+      EXPECT_TRUE(ReconstructToQuality(noisy, ReconstructionOptions{}, goal, &rec, &report).ok());
+      return report;
+    };
+    const QualityReport alone = run({});
+    ASSERT_TRUE(alone.targetReached);
+    ASSERT_EQ(alone.runs, 1) << "the validation alone meets the target at once";
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const QualityReport noOpinion = run([&] { return PsnrEstimate{nan, nan, nan}; });
+    EXPECT_EQ(noOpinion.runs, 1);
+    EXPECT_TRUE(noOpinion.targetReached);
+    const QualityReport judged = run([&] {
+      const double low = ++calls <= 2 ? target - 5 : target + 5;
+      return PsnrEstimate{low + 1, low, low + 2};
+    });
+    EXPECT_TRUE(judged.targetReached);
+    if (variance) {
+      EXPECT_EQ(judged.runs, 3);
+      EXPECT_EQ(judged.secondEstimate.low, target + 5);
+    } else {
+      EXPECT_EQ(judged.runs, 1);
+      EXPECT_TRUE(std::isnan(judged.secondEstimate.low));
+    }
   }
 }
 

@@ -186,6 +186,9 @@ void AddQualityJson(const QualityReport& r, double targetPsnr, double budget, nl
                      {"threshold", r.threshold < 0 ? nlohmann::json(nullptr) : nlohmann::json(r.threshold)},
                      {"levels", levels}};
   if (targetPsnr < 0) (*j)["quality"]["target_render"] = true;
+  if (std::isfinite(r.secondEstimate.psnr))
+    (*j)["quality"]["second_estimate"] = {
+        {"psnr", r.secondEstimate.psnr}, {"low", r.secondEstimate.low}, {"high", r.secondEstimate.high}};
 }
 
 std::optional<bool> CloserThanRender(const QualityReport& r) {

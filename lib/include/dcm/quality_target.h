@@ -14,6 +14,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -24,6 +25,14 @@
 #include "dcm/status.h"
 
 namespace dcm {
+
+/// The estimate of the PSNR of an image against the full render.
+struct PsnrEstimate {
+  double psnr = 0;  ///< from the mean squared error at the validation pixels; +inf with none
+  /// Bounds of the two-sided 90 % interval (CLT on the weighted mean of the
+  /// squared errors): `low` is also the one-sided 95 % lower bound.
+  double low = 0, high = 0;
+};
 
 /// What to deliver: a target, a budget, or both (whichever binds first).
 struct QualityGoal {
@@ -75,17 +84,18 @@ struct QualityGoal {
   /// is highest, it is biased there; the pixel's own is not, and the
   /// estimate averages it over the validation pixels. Empty: the provider's.
   std::function<void(std::span<const Point2i> pixels, std::span<RGB> variance)> ownVariance;
+  /// A second estimate, against the converged image, of the run that
+  /// `reconstruct` made last (ReconstructToQualityWithPreview: the preview
+  /// correction's, from every pixel). Where the samples carry their variance
+  /// (the validation's estimate is then against the converged image too) a
+  /// run meets the target only where this lower bound does as well: a draw
+  /// of validation pixels can miss the few pixels that carry the error, and
+  /// the two judges rarely miss them together. NaN low: no opinion. Empty:
+  /// the validation alone.
+  std::function<PsnrEstimate()> secondEstimate;
 
   /// Checks the ranges ("--target-psnr: ..."); the message names the flag.
   Status Validate() const;
-};
-
-/// The estimate of the PSNR of an image against the full render.
-struct PsnrEstimate {
-  double psnr = 0;  ///< from the mean squared error at the validation pixels; +inf with none
-  /// Bounds of the two-sided 90 % interval (CLT on the weighted mean of the
-  /// squared errors): `low` is also the one-sided 95 % lower bound.
-  double low = 0, high = 0;
 };
 
 /// One refinement level of the final run (progressive output).
@@ -115,6 +125,9 @@ struct QualityReport {
   /// The full render's own PSNR against the converged image, from the
   /// variance of the samples at every validation pixel; NaN without variance.
   PsnrEstimate renderEstimate;
+  /// QualityGoal::secondEstimate of the result's run; NaN where none was asked.
+  PsnrEstimate secondEstimate{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
+                              std::numeric_limits<double>::quiet_NaN()};
   /// The target the search aimed at: goal.targetPsnr, or with
   /// goal.targetRender the render's estimate it was set to (0: none).
   double targetPsnr = 0;
