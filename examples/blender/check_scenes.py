@@ -5,7 +5,7 @@
 # that `dcm reconstruct --preset blender` reads them as it reads the room.
 #
 #   blender -b --factory-startup --python check_scenes.py -- \
-#       --scene glossy|spines|mirror|outdoor --out X.exr [--res 256] \
+#       --scene glossy|spines|mirror|outdoor|stage|shelf|street --out X.exr [--res 256] \
 #       [--samples 64] [--seed 1] [--threads 2] [--save-blend X.blend]
 #
 #  - glossy:  a large floor of procedural tiles under a clear coat, a monkey,
@@ -18,6 +18,18 @@
 #             brick and striped walls; a spot light and a faint environment.
 #  - outdoor: a sun and a gradient sky over a textured lawn with a paved
 #             path, three buildings and five trees casting long shadows.
+#
+# Three more, held out from 2026-12-06 (key CC2 of docs/TUNING.md):
+#  - stage:   white and grey objects on a satin floor before a wall, lit by a
+#             red, a green and a blue area light: coloured shadows whose
+#             colours change where their luminance barely does.
+#  - shelf:   a bookshelf of thin books of many colours (each its own
+#             object and material), a vase and a lamp shade in a corner of
+#             two walls, lit by a low sun from the open side, a blue sky and
+#             a small warm lamp.
+#  - street:  a sunlit street: a striped road, a picket fence of thin
+#             slats, lamp posts, coloured boxes and a glass-fronted
+#             building under a clear sky (direct light: clean at 64 spp).
 #
 # Every texture is a shader node (no image files), so the saved .blend is
 # self-contained. These scenes are the check set of docs/TUNING.md (key CC):
@@ -32,7 +44,7 @@ import bpy
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from cycles_common import box, cyl, hash01, join, look_at_camera, principled, setup_render  # noqa: E402
 
-SCENES = ("glossy", "spines", "mirror", "outdoor")
+SCENES = ("glossy", "spines", "mirror", "outdoor", "stage", "shelf", "street")
 
 
 def parse_args():
@@ -435,12 +447,143 @@ def build_outdoor():
     look_at_camera((-4.0, -9.0, 1.7), (1.0, 6.0, 2.0), 30.0)
 
 
+def build_stage():
+    m_floor = principled("SatinFloor", 1, color=(0.60, 0.60, 0.58), rough=0.25, spec=0.5)
+    m_wall = textured("Wall", 2, noise_ramp(3.0, [(0.4, (0.70, 0.70, 0.68)), (0.6, (0.80, 0.80, 0.78))]),
+                      rough=0.9, spec=0.3)
+    m_white = principled("WhitePlaster", 3, color=(0.85, 0.85, 0.85), rough=0.6, spec=0.4)
+    m_grey = textured("GreyStripes", 4, stripes(4.0, [(0.45, (0.25, 0.25, 0.25)), (0.55, (0.65, 0.65, 0.65))]),
+                      rough=0.5, spec=0.5)
+    m_steel = principled("Steel", 5, color=(0.7, 0.7, 0.72), rough=0.15, metal=1.0)
+
+    plane("Floor", (0, 1.0, 0), (10.0, 10.0), m_floor, 1)
+    plane("Wall", (0, 3.0, 2.0), (10.0, 4.0), m_wall, 2, rot=(math.pi / 2, 0, 0))
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=64, ring_count=32, radius=0.45, location=(-0.7, 1.2, 0.45))
+    smooth_object(bpy.context.active_object, m_white, 3, "Sphere")
+    c = cyl("StripedColumn", (0.6, 1.6, 0.6), 0.25, 1.2, m_grey, verts=48)
+    c.pass_index = 4
+    bpy.ops.object.shade_smooth()
+    bpy.ops.mesh.primitive_cone_add(vertices=48, radius1=0.35, depth=0.7, location=(0.1, 0.4, 0.35))
+    smooth_object(bpy.context.active_object, m_white, 6, "Cone")
+    pole = cyl("Pole", (-1.6, 2.0, 0.9), 0.025, 1.8, m_steel, verts=16)
+    pole.pass_index = 5
+    for name, loc, col in (("RedLight", (-2.5, -0.5, 2.2), (1.0, 0.08, 0.05)),
+                           ("GreenLight", (0.2, -1.8, 2.6), (0.08, 1.0, 0.10)),
+                           ("BlueLight", (2.6, -0.3, 2.0), (0.08, 0.15, 1.0))):
+        a = light("AREA", name, loc, 60.0, shape="SQUARE", size=0.5, color=col)
+        aim(a, (0.0, 1.2, 0.4))
+    world((0.02, 0.02, 0.02), 1.0)
+    look_at_camera((0.2, -3.2, 1.5), (0.0, 1.2, 0.55), 32.0)
+
+
+def build_shelf():
+    m_wood = textured("Wood", 1, stripes((1.0, 12.0, 1.0), [(0.4, (0.30, 0.17, 0.08)), (0.6, (0.42, 0.25, 0.12))]),
+                      rough=0.6, spec=0.4)
+    m_wall = principled("WallPaint", 2, color=(0.75, 0.72, 0.66), rough=0.9, spec=0.3)
+    m_floor = textured("FloorBoards", 3, brick(4.0, (0.45, 0.30, 0.18), (0.38, 0.25, 0.15), (0.10, 0.07, 0.05),
+                                                mortar_size=0.01, row_height=0.125, brick_width=1.0), rough=0.5, spec=0.4)
+    m_vase = principled("Ceramic", 4, color=(0.10, 0.30, 0.60), rough=0.1, spec=0.6)
+    m_shade = principled("LampShade", 5, color=(0.90, 0.85, 0.70), rough=0.9, spec=0.2)
+
+    plane("Floor", (0, 0, 0), (8.0, 8.0), m_floor, 3)
+    plane("BackWall", (0, 1.0, 1.5), (8.0, 3.0), m_wall, 2, rot=(math.pi / 2, 0, 0))
+    plane("SideWall", (-2.2, -1.0, 1.5), (4.0, 3.0), m_wall, 2, rot=(math.pi / 2, 0, math.pi / 2))
+    # the shelf: two sides and four boards
+    parts = [box("side_l", (-1.0, 0.8, 1.0), (0.04, 0.35, 2.0), m_wood),
+             box("side_r", (1.0, 0.8, 1.0), (0.04, 0.35, 2.0), m_wood)]
+    for k, z in enumerate((0.05, 0.6, 1.15, 1.7)):
+        parts.append(box("board%d" % k, (0.0, 0.8, z), (2.0, 0.35, 0.03), m_wood))
+    join("Shelf", parts, 1)
+    # books of many colours on three boards, each its own object and material
+    idx = 10
+    for row, z in enumerate((0.065, 0.615, 1.165)):
+        x = -0.96
+        k = 0
+        while x < 0.9:
+            w = 0.02 + 0.03 * hash01(row * 101 + k)
+            h = 0.32 + 0.18 * hash01(row * 211 + k + 7)
+            hue = hash01(row * 307 + k + 13)
+            col = (0.15 + 0.7 * abs(math.sin(6.28 * hue)), 0.15 + 0.6 * abs(math.sin(6.28 * hue + 2.1)),
+                   0.15 + 0.6 * abs(math.sin(6.28 * hue + 4.2)))
+            m = principled("Book%d" % idx, idx, color=col, rough=0.5, spec=0.4)
+            b = box("Book%d" % idx, (x + w / 2, 0.78, z + h / 2), (w, 0.25, h), m)
+            b.rotation_euler[1] = math.radians(6.0 * (hash01(idx) - 0.5)) if hash01(idx + 5) > 0.7 else 0.0
+            b.pass_index = idx
+            x += w + 0.004
+            k += 1
+            idx += 1
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=48, ring_count=24, radius=0.12, location=(0.6, 0.8, 1.85))
+    vase = bpy.context.active_object
+    vase.scale = (1.0, 1.0, 1.5)
+    smooth_object(vase, m_vase, 4, "Vase")
+    bpy.ops.mesh.primitive_cone_add(vertices=48, radius1=0.28, radius2=0.16, depth=0.3, location=(1.5, 0.2, 1.3))
+    smooth_object(bpy.context.active_object, m_shade, 5, "LampShade")
+    cyl("LampStand", (1.5, 0.2, 0.6), 0.02, 1.2, m_wood, verts=12).pass_index = 6
+    light("POINT", "Lamp", (1.5, 0.2, 1.28), 25.0, shadow_soft_size=0.05, color=(1.0, 0.8, 0.55))
+    sun = light("SUN", "Sun", (0, 0, 5), 3.0, angle=math.radians(1.0), color=(1.0, 0.92, 0.80))
+    sun.rotation_euler = (math.radians(70), 0.0, math.radians(-60))
+    world((0.35, 0.45, 0.65), 0.6)
+    look_at_camera((0.3, -1.3, 1.2), (-0.05, 0.8, 0.95), 30.0)
+
+
+def build_street():
+    m_road = textured("Asphalt", 1, noise_ramp(30.0, [(0.4, (0.10, 0.10, 0.11)), (0.6, (0.16, 0.16, 0.17))]),
+                      rough=0.85, spec=0.3)
+    m_line = principled("RoadLine", 2, color=(0.85, 0.80, 0.30), rough=0.7, spec=0.3)
+    m_walk = textured("Sidewalk", 3, checker(12.0, (0.55, 0.53, 0.50), (0.45, 0.44, 0.42)), rough=0.8, spec=0.3)
+    m_fence = principled("WhitePaint", 4, color=(0.85, 0.85, 0.82), rough=0.6, spec=0.4)
+    m_post = principled("DarkMetal", 5, color=(0.08, 0.08, 0.09), rough=0.35, metal=1.0)
+    m_wall = textured("Stucco", 6, noise_ramp(15.0, [(0.4, (0.70, 0.55, 0.40)), (0.6, (0.78, 0.62, 0.46))]),
+                      rough=0.9, spec=0.3)
+    m_glass = principled("Window", 7, color=(0.10, 0.14, 0.18), rough=0.05, spec=0.9)
+
+    plane("Road", (0, 10.0, 0), (8.0, 60.0), m_road, 1)
+    for k in range(12):
+        plane("Line%d" % k, (0, 1.0 + 3.0 * k, 0.005), (0.15, 1.5), m_line, 2)
+    plane("Sidewalk", (6.0, 10.0, 0.05), (4.0, 60.0), m_walk, 3, uv_scale=15.0)
+    plane("Verge", (-10.0, 10.0, 0.0), (12.0, 60.0), m_walk, 3, uv_scale=15.0)
+    # a picket fence of thin slats along the far side of the sidewalk
+    slats = []
+    for k in range(70):
+        slats.append(box("slat", (7.8, -2.0 + 0.28 * k, 0.55), (0.04, 0.09, 1.0), m_fence))
+    slats.append(box("rail", (7.78, 7.7, 0.8), (0.03, 19.6, 0.06), m_fence))
+    join("Fence", slats, 4)
+    for k in range(4):
+        post = cyl("Post%d" % k, (4.4, 1.0 + 6.0 * k, 2.0), 0.05, 4.0, m_post, verts=12)
+        arm = box("Arm%d" % k, (4.0, 1.0 + 6.0 * k, 3.95), (0.8, 0.06, 0.06), m_post)
+        join("LampPost%d" % k, [post, arm], 5 + k)
+    for k, (x, y, col) in enumerate([(-2.0, 3.0, (0.70, 0.08, 0.06)), (2.0, 7.0, (0.05, 0.25, 0.65)),
+                                     (-2.0, 12.0, (0.85, 0.75, 0.10)), (2.0, 16.0, (0.10, 0.45, 0.15))]):
+        m = principled("CarPaint%d" % k, 20 + k, color=col, rough=0.25, spec=0.6)
+        body = box("CarBody%d" % k, (x, y, 0.55), (1.7, 4.0, 0.8), m)
+        top = box("CarTop%d" % k, (x, y - 0.2, 1.2), (1.5, 2.0, 0.5), m_glass)
+        join("Car%d" % k, [body, top], 20 + k)
+    bldg = box("Building", (-8.0, 14.0, 5.0), (6.0, 16.0, 10.0), m_wall)
+    wins = [bldg]
+    for fl in range(4):
+        for k in range(7):
+            wins.append(box("win", (-4.98, 7.5 + 2.0 * k, 1.5 + 2.3 * fl), (0.05, 1.0, 1.4), m_glass))
+    join("Building", wins, 30)
+    sun = light("SUN", "Sun", (0, 0, 10), 5.0, angle=math.radians(0.6), color=(1.0, 0.96, 0.90))
+    sun.rotation_euler = (math.radians(55), 0.0, math.radians(40))
+    w = world((0.0, 0.0, 0.0), 1.0)
+    nt = w.node_tree
+    tc = nt.nodes.new("ShaderNodeTexCoord")
+    sep = nt.nodes.new("ShaderNodeSeparateXYZ")
+    nt.links.new(tc.outputs["Generated"], sep.inputs["Vector"])
+    col = ramp(nt, sep.outputs["Z"], [(0.0, (0.75, 0.82, 0.92)), (0.4, (0.30, 0.50, 0.90)), (1.0, (0.15, 0.30, 0.75))])
+    nt.links.new(col, nt.nodes["Background"].inputs["Color"])
+    nt.nodes["Background"].inputs["Strength"].default_value = 0.9
+    look_at_camera((1.5, -6.0, 1.6), (0.5, 10.0, 1.5), 32.0)
+
+
 def main():
     args = parse_args()
     outdir = os.path.dirname(os.path.abspath(args.out))
     os.makedirs(outdir, exist_ok=True)
     clear_scene()
-    {"glossy": build_glossy, "spines": build_spines, "mirror": build_mirror, "outdoor": build_outdoor}[args.scene]()
+    {"glossy": build_glossy, "spines": build_spines, "mirror": build_mirror, "outdoor": build_outdoor,
+     "stage": build_stage, "shelf": build_shelf, "street": build_street}[args.scene]()
     setup_render(args)
     if args.save_blend:
         bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(args.save_blend))

@@ -4,7 +4,8 @@
 #
 #   examples/blender/check_set.sh OUT_DIR
 #
-# Per scene NAME (glossy, spines, mirror, outdoor), 256x256:
+# Per scene NAME (glossy, spines, mirror, outdoor; with SCENES="stage shelf
+# street" the held-out set CC2 of docs/TUNING.md), 256x256:
 #   NAME_64_s1.exr, NAME_64_s2.exr   64 spp, seeds 1 and 2
 #   NAME_512_s1.exr                  512 spp, seed 1
 #   NAME_ref.exr                     the converged reference: 2048 spp, seed 1000

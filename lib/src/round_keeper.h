@@ -113,7 +113,9 @@ class RoundKeeper : public SampleProvider {
   bool Owes() const { return !owed_.empty(); }
 
   /// The exact sample of `p` when it was rendered before run `run` (the
-  /// samples a run planned with when it first ran), else false.
+  /// samples a run planned with when it first ran) and a run asked for it,
+  /// else false: a pixel only validation draws asked for stays unseen, or
+  /// the runs it judges would be pulled toward its value.
   bool Visible(const Point2i& p, int run, const SampleRequest& what, ExactSample* out) const {
     const size_t k = Index(p);
     if (epoch_[k] < 0 || epoch_[k] >= run || validationOnly_[k] || (mask_[k] & Mask(what)) != Mask(what)) return false;
@@ -213,8 +215,8 @@ class RoundKeeper : public SampleProvider {
   bool roundDue_ = false;
 };
 
-/// The preview a run plans on: the exact samples rendered before the run
-/// first ran, the preview elsewhere. What a run sees does not depend on how
+/// The preview a run plans on: the exact samples earlier runs asked for
+/// (RoundKeeper::Visible), the preview elsewhere. What a run sees does not depend on how
 /// often the search was run again.
 class RunPreview : public SampleProvider {
  public:
