@@ -230,6 +230,17 @@ def world(color, strength):
     return w
 
 
+def gradient_sky(stops, strength):
+    """A sky graded on the view direction's z (the world's Generated coordinate) through stops."""
+    w = world((0.0, 0.0, 0.0), 1.0)
+    nt = w.node_tree
+    tc = nt.nodes.new("ShaderNodeTexCoord")
+    sep = nt.nodes.new("ShaderNodeSeparateXYZ")
+    nt.links.new(tc.outputs["Generated"], sep.inputs["Vector"])
+    nt.links.new(ramp(nt, sep.outputs["Z"], stops), nt.nodes["Background"].inputs["Color"])
+    nt.nodes["Background"].inputs["Strength"].default_value = strength
+
+
 def light(kind, name, loc, energy, rot=(0, 0, 0), **data):
     bpy.ops.object.light_add(type=kind, location=loc, rotation=rot)
     o = bpy.context.active_object
@@ -435,15 +446,7 @@ def build_outdoor():
     sun = light("SUN", "Sun", (0, 0, 10), 4.0, angle=math.radians(0.8), color=(1.0, 0.95, 0.86))
     sun.rotation_euler = (math.radians(65), 0.0, math.radians(-100))   # 25 degrees high, from the left
 
-    # a gradient sky on the view direction's z (the world's Generated coordinate): pale at the horizon, blue above
-    w = world((0.0, 0.0, 0.0), 1.0)
-    nt = w.node_tree
-    tc = nt.nodes.new("ShaderNodeTexCoord")
-    sep = nt.nodes.new("ShaderNodeSeparateXYZ")
-    nt.links.new(tc.outputs["Generated"], sep.inputs["Vector"])
-    col = ramp(nt, sep.outputs["Z"], [(0.0, (0.80, 0.86, 0.95)), (0.35, (0.35, 0.52, 0.88)), (1.0, (0.18, 0.36, 0.80))])
-    nt.links.new(col, nt.nodes["Background"].inputs["Color"])
-    nt.nodes["Background"].inputs["Strength"].default_value = 0.8
+    gradient_sky([(0.0, (0.80, 0.86, 0.95)), (0.35, (0.35, 0.52, 0.88)), (1.0, (0.18, 0.36, 0.80))], 0.8)
     look_at_camera((-4.0, -9.0, 1.7), (1.0, 6.0, 2.0), 30.0)
 
 
@@ -566,14 +569,7 @@ def build_street():
     join("Building", wins, 30)
     sun = light("SUN", "Sun", (0, 0, 10), 5.0, angle=math.radians(0.6), color=(1.0, 0.96, 0.90))
     sun.rotation_euler = (math.radians(55), 0.0, math.radians(40))
-    w = world((0.0, 0.0, 0.0), 1.0)
-    nt = w.node_tree
-    tc = nt.nodes.new("ShaderNodeTexCoord")
-    sep = nt.nodes.new("ShaderNodeSeparateXYZ")
-    nt.links.new(tc.outputs["Generated"], sep.inputs["Vector"])
-    col = ramp(nt, sep.outputs["Z"], [(0.0, (0.75, 0.82, 0.92)), (0.4, (0.30, 0.50, 0.90)), (1.0, (0.15, 0.30, 0.75))])
-    nt.links.new(col, nt.nodes["Background"].inputs["Color"])
-    nt.nodes["Background"].inputs["Strength"].default_value = 0.9
+    gradient_sky([(0.0, (0.75, 0.82, 0.92)), (0.4, (0.30, 0.50, 0.90)), (1.0, (0.15, 0.30, 0.75))], 0.9)
     look_at_camera((1.5, -6.0, 1.6), (0.5, 10.0, 1.5), 32.0)
 
 
