@@ -13,6 +13,7 @@
 
 #include "dcm/downsample.h"
 #include "number_text.h"
+#include "sample_mask.h"
 
 namespace dcm {
 
@@ -119,7 +120,7 @@ class CachingProvider : public SampleProvider {
 
   Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& asked, std::span<ExactSample> out) override {
     const SampleRequest what{asked.split || widest_.split, asked.variance || widest_.variance};
-    const uint8_t need = Mask(what);
+    const uint8_t need = detail::RequestMask(what);
     std::vector<size_t> misses;
     int64_t fresh = 0;  // pixels never evaluated before, reserved in the budget
     {
@@ -226,7 +227,6 @@ class CachingProvider : public SampleProvider {
   }
 
  private:
-  static uint8_t Mask(const SampleRequest& w) { return uint8_t(1 | (w.split ? 2 : 0) | (w.variance ? 4 : 0)); }
   size_t Index(Point2i p) const { return size_t(p.y) * size_t(caps_.width) + size_t(p.x); }
 
   SampleProvider& inner_;
@@ -236,7 +236,7 @@ class CachingProvider : public SampleProvider {
   mutable std::mutex mutex_;
   std::vector<int32_t> index_;  ///< per working pixel: its sample, -1 none
   std::vector<ExactSample> samples_;
-  std::vector<uint8_t> masks_;  ///< what each sample holds (Mask)
+  std::vector<uint8_t> masks_;  ///< what each sample holds (detail::RequestMask)
   int64_t distinct_ = 0;
   bool budgetHit_ = false;
   bool marking_ = false;

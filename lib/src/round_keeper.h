@@ -14,14 +14,13 @@
 #include "dcm/quality_preview.h"
 #include "dcm/sample_provider.h"
 #include "guide_cache.h"
+#include "sample_mask.h"
 
 namespace dcm::detail {
 
 inline double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
-
-inline uint8_t Mask(const SampleRequest& w) { return uint8_t(1 | (w.split ? 2 : 0) | (w.variance ? 4 : 0)); }
 
 /// Between the search and the exact provider: keeps every sample rendered
 /// (with the run of the search it was rendered in) and renders what a run or
@@ -50,13 +49,13 @@ class RoundKeeper : public SampleProvider {
   }
 
   Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what, std::span<ExactSample> out) override {
-    const uint8_t need = Mask(what);
+    const uint8_t need = RequestMask(what);
     std::vector<Point2i> unknown;
     for (const Point2i& p : pixels) {
       if (!Has(p, need)) unknown.push_back(p);
       // A run's pixels are the engine's; a validation draw's stay unseen by the runs' previews.
-      uint8_t& v = validationOnly_[Index(p)];
-      v = run_ > 0 ? 0 : (epoch_[Index(p)] < 0 || v ? 1 : 0);
+      const size_t k = Index(p);
+      validationOnly_[k] = run_ > 0 ? 0 : (epoch_[k] < 0 || validationOnly_[k] ? 1 : 0);
     }
     if (!unknown.empty()) {
       if (run_ == 0 && runs_ > 0) {
@@ -118,7 +117,8 @@ class RoundKeeper : public SampleProvider {
   /// the runs it judges would be pulled toward its value.
   bool Visible(const Point2i& p, int run, const SampleRequest& what, ExactSample* out) const {
     const size_t k = Index(p);
-    if (epoch_[k] < 0 || epoch_[k] >= run || validationOnly_[k] || (mask_[k] & Mask(what)) != Mask(what)) return false;
+    const uint8_t need = RequestMask(what);
+    if (epoch_[k] < 0 || epoch_[k] >= run || validationOnly_[k] || (mask_[k] & need) != need) return false;
     *out = samples_[k];
     return true;
   }
@@ -174,7 +174,7 @@ class RoundKeeper : public SampleProvider {
         epoch_[k] = epoch;
       }
       samples_[k] = got[i];
-      mask_[k] = Mask(what);
+      mask_[k] = RequestMask(what);
     }
     // The pixels the call computed besides are kept as rendered (never
     // rendered again) and passed on once, to the cache above.
@@ -189,7 +189,7 @@ class RoundKeeper : public SampleProvider {
       const size_t k = Index(p);
       epoch_[k] = epoch;
       samples_[k] = extraSamples[i];
-      mask_[k] = Mask(what);
+      mask_[k] = RequestMask(what);
       pendingExtra_.push_back(p);
       pendingExtraSamples_.push_back(extraSamples[i]);
     }
@@ -202,7 +202,7 @@ class RoundKeeper : public SampleProvider {
   QualityRoundStats* stats_;
   GuideCache guides_;
   std::vector<int32_t> epoch_;  ///< per pixel: the run it was rendered in, -1 not rendered
-  std::vector<uint8_t> mask_;   ///< what its sample holds (Mask)
+  std::vector<uint8_t> mask_;   ///< what its sample holds (RequestMask)
   std::vector<ExactSample> samples_;
   std::vector<Point2i> owed_;
   std::vector<uint8_t> owedMark_;

@@ -63,8 +63,10 @@ int64_t DenoiseExactSamples(SampleStore& store, int radius, const ContrastTest& 
         for (int nx = std::max(0, x - radius); nx <= std::min(W - 1, x + radius); ++nx) {
           const int64_t j = store.Index(nx, ny);
           if (!store.IsExact(j) || !store.IsFinite(j) || !surfaces.Same(i, j)) continue;
-          if (j != i && !(noise.WithinNoise(vi, store.ValueAt(j), gate) && SameColour(vi, store.ValueAt(j), gate)))
-            continue;
+          if (j != i) {
+            const Value vj = store.ValueAt(j);
+            if (!noise.WithinNoise(vi, vj, gate) || !SameColour(vi, vj, gate)) continue;
+          }
           const double dx = double(nx - x), dy = double(ny - y);
           const Neighbour n{j, dx / radius, dy / radius, std::exp(-(dx * dx + dy * dy) / (2 * sd * sd))};
           const double v[3] = {1, n.x, n.y};
