@@ -96,6 +96,9 @@ class PlanningProvider : public SampleProvider {
       if (rec->sampleMap[k] == SampleReason::kRendered) rec->workImage[k] = samples_[k].L;
   }
 
+  /// Whether working pixel p has been evaluated exactly.
+  bool Known(const Point2i& p) const { return known_[Index(p)] != 0; }
+
   /// Working pixels evaluated exactly so far.
   int64_t KnownCount() const { return known_.size() - std::count(known_.begin(), known_.end(), uint8_t(0)); }
 

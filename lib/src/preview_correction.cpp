@@ -178,7 +178,13 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample,
       for (size_t i = 0; i < n; ++i) {
         const double d = usable[i] ? double(p[i].L[c]) - double(rec->workImage[i][c]) : 0.0;
         v[i] = usable[i] ? double(p[i].variance[c]) : 0.0;
-        e[i] = d * d - v[i];
+        // Where the run's own exact sample stands, d carries its noise too (the
+        // preview renders with seeds of its own); a pixel rendered but
+        // interpolated by the run holds its interpolated value until Finish.
+        const SampleReason r = rec->sampleMap[i];
+        const bool exact = r != SampleReason::kInterpolated && r != SampleReason::kRendered &&
+                           r != SampleReason::kPreviewStandIn;
+        e[i] = d * d - v[i] * (exact ? 1 + exactShare : 1.0);
         e2[i] = e[i] * e[i];
       }
       const std::vector<double> se = WindowSums(e, W, H, radius), se2 = WindowSums(e2, W, H, radius),

@@ -267,11 +267,16 @@ Status PlanRenderAndFinish(PlanningProvider& planning, SampleProvider& preview, 
     worst.resize(size_t(left));
     stats->budgetBound = true;
   }
-  std::vector<Point2i> pick(worst.size());
-  for (size_t k = 0; k < worst.size(); ++k)
-    pick[k] = {int(worst[k] % size_t(caps.width)), int(worst[k] / size_t(caps.width))};
+  // A pixel rendered before and interpolated by the run (noisy samples are
+  // not kept unasked) takes its sample again without a render.
+  std::vector<Point2i> pick, render;
+  for (size_t i : worst) {
+    const Point2i p{int(i % size_t(caps.width)), int(i / size_t(caps.width))};
+    pick.push_back(p);
+    if (!planning.Known(p)) render.push_back(p);
+  }
   const auto exactStart = std::chrono::steady_clock::now();
-  const Status s = planning.EvaluateExactly(pick, schedule.maxExactPixels);
+  const Status s = render.empty() ? Status::Ok() : planning.EvaluateExactly(render, schedule.maxExactPixels);
   stats->timeExactS += Seconds(exactStart);
   // A quality search's budget refused the round: the result stays as finished.
   if (s.overBudget()) {
@@ -279,8 +284,10 @@ Status PlanRenderAndFinish(PlanningProvider& planning, SampleProvider& preview, 
     return Status::Ok();
   }
   DCM_RETURN_IF_ERROR(s);
-  ++stats->rounds;
-  stats->pixelsPerRound.push_back(int64_t(pick.size()));
+  if (!render.empty()) {
+    ++stats->rounds;
+    stats->pixelsPerRound.push_back(int64_t(render.size()));
+  }
   stats->errorRoundPixels = int64_t(pick.size());
   *out = unfinished;
   out->stats.timeProviderS = stats->timeExactS;

@@ -30,7 +30,7 @@ row = lambda k: np.array([[c[k] for c in cases]], np.float32)
 took, L, A, B = row(1) / n, row(2), row(3), row(4)
 rgb = lambda x: np.repeat(x[..., None], 3, axis=-1)
 planes = {"Debug Sample Count.X": took, **{"Combined." + c: L for c in "RGB"}}
-guides = {"L": rgb((A + B) / 2), "L_of_seed": [rgb(A), rgb(B)]}
+guides = {"L": rgb((A + B) / 2), "L_of_half": [rgb(A), rgb(B)]}
 fake = types.SimpleNamespace(SAME=S.SAME, guides=lambda: guides, _rgb=lambda pl, name, comps="RGB": S._rgb(None, pl, name, comps))
 xs, ys = np.arange(w), np.zeros(w, int)
 again = S._stopped_early(fake, planes, n, xs, ys, np.ones(w, bool))

@@ -69,6 +69,29 @@ TEST(PreviewCorrection, WhereTheInterpolationIsRightThePreviewsNoiseStaysOut) {
   EXPECT_LT(MseAgainstTruth(r), 0.05 * kSd * kSd);
 }
 
+TEST(PreviewCorrection, AnExactPixelsOwnNoiseIsNoBiasOfItsWindow) {
+  // Half the pixels exact (a checkerboard), each with noise of the preview's
+  // variance (an exact share of 1) and seeds of its own; the interpolated
+  // ones right. At an exact pixel the difference to the preview carries both
+  // noises, 2 v: counted as v, each window would show a bias of v / 2, four
+  // times its sd over 121 pixels, and pull every interpolated pixel a third
+  // of the way to the preview's noise.
+  std::mt19937 rng(11);
+  std::normal_distribution<float> noise(0.f, kSd);
+  Reconstruction r = Interpolated(Truth);
+  for (int y = 0; y < N; ++y)
+    for (int x = (y & 1); x < N; x += 2) {
+      const size_t i = size_t(y) * N + size_t(x);
+      r.sampleMap[i] = SampleReason::kBorder;
+      r.workImage[i] = r.workImage[i] + RGB{noise(rng), noise(rng), noise(rng)};
+    }
+  ImagePreviewProvider preview = NoisyPreview(3);
+  PreviewCorrectionStats stats;
+  ASSERT_TRUE(CorrectTowardPreview(preview, 5, 1, &r, &stats, {}, 1.0).ok());
+  // As with no exact pixel (WhereTheInterpolationIsRight...): chance excesses only.
+  EXPECT_LT(stats.meanWeight, 0.1);
+}
+
 TEST(PreviewCorrection, WhatTheInterpolationMissedComesBackAtThePreviewsNoise) {
   // The interpolation lost a bright stripe (x in [24, 40)) of height 0.3 = 6 sd.
   Reconstruction r = Interpolated(+[](int x, int y) {

@@ -77,22 +77,24 @@ def _write_png(path, grey):
                 + chunk(b"IDAT", zlib.compress(rows.tobytes(), 1)) + chunk(b"IEND", b""))
 
 
+def _srgb(x):
+    """The sRGB encoding of linear x, clipped to [0, 1] (dcm::SrgbEncode)."""
+    x = np.clip(x, 0.0, 1.0)
+    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
+
+
 def _noise_psnr(var, L):
-    """The display-referred PSNR that noise of variance `var` [h, w, 3] (one pixel's
-    halves each, one degree of freedom) costs on the image L, as dcm's AOV noise
-    detection measures it (NoisePsnrFromData): the median over the pixels that are
-    not black of the variance relative to the squared value, over 0.455 (the median
-    of a chi-square of one degree of freedom), as a relative sd through
-    dcm::SrgbRelativeSlope (the slope of the sRGB encoding times L, at 1 above 1).
-    The median: a noisy value near 0 would make the slope, and a mean, explode."""
-    lit = L.sum(axis=-1) > 3e-3
-    if not lit.any():
-        return 99.0
-    rho2 = float(np.median(var.sum(axis=-1)[lit] / (L ** 2).sum(axis=-1)[lit])) / 0.455
-    x = np.clip(L, 0.0031308, 1.0)
-    rel = np.where(L <= 0.0031308, 12.92 * np.maximum(L, 0), 1.055 / 2.4 * np.power(x, 1 / 2.4))
-    mse = rho2 * float(np.mean(rel ** 2))
-    return 99.0 if not mse > 0 else -10 * np.log10(mse)
+    """The display-referred PSNR that noise of variance `var` [h, w, 3] (from one
+    pixel's halves) costs on the image L: the mean over pixels and channels of
+    ((enc(L + s) - enc(L - s)) / 2)^2, s = sqrt(var), as dcm's estimate counts an
+    exact pixel's noise (DisplayNoise in lib/src/preview_correction.cpp). A mean,
+    not a typical pixel: a path tracer's noise sits in few pixels (the
+    highlights, the indirect corners), and the PSNR is their mean; the display's
+    clip bounds what one firefly adds."""
+    s = np.sqrt(np.maximum(var.astype(np.float64), 0.0))
+    L = L.astype(np.float64)
+    mse = float(np.mean(((_srgb(L + s) - _srgb(L - s)) / 2) ** 2))
+    return 99.0 if not mse > 0 else min(99.0, -10 * np.log10(mse))
 
 
 def _clock_seconds(text):
@@ -200,6 +202,11 @@ class Session:
         # Two halves of the samples with two seeds: the second seed is the next one.
         self.halves = a.variance_halves and self.samples >= 2
         self.seeds = (cy.seed, (cy.seed + 1) % 2 ** 31) if self.halves else (cy.seed,)
+        # The preview's halves take the two seeds after those: with the exact
+        # pixels' own seeds its samples would be the first of theirs (Cycles'
+        # sequences are progressive), and a result drawn toward the preview
+        # would share their noise, which the validation's estimate then misses.
+        self.preview_seeds = tuple((cy.seed + 2 + k) % 2 ** 31 for k in range(2 if self.halves else 1))
         c.restore_later(cy, ("seed",))
         if a.threads > 0:
             c.set(r, "threads_mode", "FIXED")
@@ -427,7 +434,7 @@ class Session:
                                       self.width * self.args.mask_scale), np.float32))
             ps = self.preview_samples
             counts = [ps - ps // 2, ps // 2] if self.halves and ps >= 2 else [ps]
-            pls = [self._render(n, "guides", seed) for n, seed in zip(counts, self.seeds)]
+            pls = [self._render(n, "guides", seed) for n, seed in zip(counts, self.preview_seeds)]
             if len(pls) == 2:  # one entry: round_cost() reads the guides render's time
                 self.render_seconds[-2:] = [("guides", *(a + b for a, b in zip(self.render_seconds[-2][1:],
                                                                                  self.render_seconds[-1][1:])))]
@@ -442,8 +449,8 @@ class Session:
             g["texture"] = mean("DiffCol")
             g["normal"] = self._rgb(pl, "Normal", "XYZ")
             g["L"] = mean("Combined")
-            # Each seed's render alone: where it is 0, that seed's first samples of the pixel are.
-            g["L_of_seed"] = [self._rgb(p, "Combined") for p in pls]
+            # Each half's render alone (_careful, _stopped_early).
+            g["L_of_half"] = [self._rgb(p, "Combined") for p in pls]
             g["Li"] = mean("DiffDir") + mean("DiffInd")
             g["Lc"] = g["L"] - g["Li"] * g["texture"]
             if len(pls) == 2:
@@ -513,17 +520,19 @@ class Session:
         minimum), an eighth of them where an exact pixel might stop (careful)."""
         return max(4, min(n, self.args.masked_min_samples or (n // 8 if careful else 8)))
 
-    def _careful(self, xs, ys, h, n):
-        """Whether a render of exact pixels (xs, ys) at n samples with the h-th
-        seed should keep its masked pixels for an eighth of the samples: where
-        exact pixels might stop early and rendering them again (one call per
-        run of 16-px tiles) would cost more than the masked samples. A pixel
-        might stop where its preview with that seed is 0 (the same seed's
-        first samples were all 0) and the preview of the other seed is not
-        (it is not black); without halves a black preview counts too."""
+    def _careful(self, xs, ys, n):
+        """Whether a render of exact pixels (xs, ys) at n samples should keep
+        its masked pixels for an eighth of the samples: where exact pixels
+        might stop early and rendering them again (one call per run of 16-px
+        tiles) would cost more than the masked samples. A pixel
+        might stop where a few samples can all be 0: where one half of the
+        preview is 0 and the other is not (a dark pixel that rare paths
+        light); without halves a black preview counts too. (The preview has
+        seeds of its own: it tells the odds, not a seed's first samples.)"""
         g = self.guides()
-        zero = (g["L_of_seed"][min(h, len(g["L_of_seed"]) - 1)][ys, xs] == 0).all(axis=1)
-        if len(g["L_of_seed"]) > 1:
+        halves = [(p[ys, xs] == 0).all(axis=1) for p in g["L_of_half"]]
+        zero = np.logical_or.reduce(halves)
+        if len(halves) > 1:
             zero &= ~(g["L"][ys, xs] == 0).all(axis=1)
         if not zero.any():
             return False
@@ -567,9 +576,9 @@ class Session:
         def same(a, b):
             return (np.abs(a - b) <= self.SAME * np.maximum(np.abs(a), np.abs(b))).all(axis=1)
         constant = same(L, g["L"][ys, xs])
-        seeds = g["L_of_seed"]
-        for other in seeds[1:]:
-            constant &= same(seeds[0][ys, xs], other[ys, xs])
+        halves = g["L_of_half"]
+        for other in halves[1:]:
+            constant &= same(halves[0][ys, xs], other[ys, xs])
         return short & ~constant
 
     @staticmethod
@@ -641,7 +650,7 @@ class Session:
             inside = self._inside(rect, xs, ys)
             finside = self._inside(rect, fx, fy)
             for h, (n, seed) in enumerate(zip(counts, self.seeds)):
-                careful = self._careful(xs[inside], ys[inside], h, n)
+                careful = self._careful(xs[inside], ys[inside], n)
                 self.careful_renders += careful
                 self._masked_pixels_stop(n, careful)
                 pl = self._render(n, "eval%d" % self._evals, seed)
