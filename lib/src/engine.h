@@ -25,6 +25,7 @@
 #include "oriented_interpolation.h"
 #include "sample_store.h"
 #include "settings.h"
+#include "elapsed.h"
 
 namespace dcm::detail {
 
@@ -93,7 +94,7 @@ class Engine {
       double provider0;
       const ReconstructionStats& stats;
       ~Add() {
-        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        const double wall = SecondsSince(t0);
         *slot += std::max(0.0, wall - (stats.timeProviderS + stats.timeGuidesS - provider0));
       }
     } add{slot, t0, provider0, stats_};

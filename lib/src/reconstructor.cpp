@@ -13,6 +13,7 @@
 
 #include "dcm/downsample.h"
 #include "engine.h"
+#include "elapsed.h"
 
 namespace dcm {
 
@@ -139,7 +140,7 @@ Status Engine::Run(Reconstruction* out, std::vector<Point2i>* pending) {
   for (size_t r = 0; r < stats_.byReason.size(); ++r)
     if (r != size_t(SampleReason::kInterpolated)) stats_.exactPixels += stats_.byReason[r];
   stats_.byReason[size_t(SampleReason::kInterpolated)] = stats_.totalPixels - stats_.exactPixels;
-  const double total = std::chrono::duration<double>(Clock::now() - tStart).count();
+  const double total = SecondsSince(tStart);
   stats_.timeEngineS = std::max(0.0, total - stats_.timeProviderS - stats_.timeGuidesS);
   out->stats = stats_;
   Progress(1.f, "done");

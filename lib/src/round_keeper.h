@@ -15,12 +15,9 @@
 #include "dcm/sample_provider.h"
 #include "guide_cache.h"
 #include "sample_mask.h"
+#include "elapsed.h"
 
 namespace dcm::detail {
-
-inline double Seconds(std::chrono::steady_clock::time_point since) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
 
 /// Between the search and the exact provider: keeps every sample rendered
 /// (with the run of the search it was rendered in) and renders what a run or
@@ -163,7 +160,7 @@ class RoundKeeper : public SampleProvider {
     std::vector<ExactSample> got(pixels.size());
     const auto start = std::chrono::steady_clock::now();
     DCM_RETURN_IF_ERROR(exact_.Evaluate(pixels, what, got));
-    stats_->timeExactS += Seconds(start);
+    stats_->timeExactS += SecondsSince(start);
     ++stats_->rounds;
     stats_->pixelsPerRound.push_back(int64_t(pixels.size()));
     const int epoch = run_ > 0 ? run_ : runs_;

@@ -13,6 +13,7 @@
 
 #include "dcm/downsample.h"
 #include "planning_provider.h"
+#include "elapsed.h"
 
 namespace dcm {
 
@@ -20,10 +21,6 @@ namespace {
 
 constexpr std::array<std::pair<std::string_view, RoundSchedule>, 2> kSchedules{{
     {"levels", RoundSchedule::kLevels}, {"preview", RoundSchedule::kPreview}}};
-
-double Seconds(std::chrono::steady_clock::time_point since) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
 
 }  // namespace
 
@@ -146,7 +143,7 @@ Status Finish(PlanningProvider& planning, SampleProvider& preview, const Reconst
                                                                              schedule.previewTextureCovariance)
                                                                        : std::span<const RGB>(),
                                              schedule.filterRadius, guides, excess));
-    stats->timeEngineS += Seconds(start);
+    stats->timeEngineS += detail::SecondsSince(start);
   }
   if (rendered > 0) {
     planning.FillRendered(out);
@@ -164,7 +161,7 @@ Status Plan(PlanningProvider& planning, ReconstructionOptions options, Reconstru
   options.onLevel = nullptr;
   const auto start = std::chrono::steady_clock::now();
   Status s = Reconstruct(planning, options, out);
-  *engineS += Seconds(start) - out->stats.timeGuidesS;
+  *engineS += detail::SecondsSince(start) - out->stats.timeGuidesS;
   *pixels = int64_t(planning.TakeWanted().size());
   return s;
 }
@@ -196,7 +193,7 @@ Status PlanRenderAndFinish(PlanningProvider& planning, SampleProvider& preview, 
   for (int rounds = 0;;) {
     const auto engineStart = std::chrono::steady_clock::now();
     Status s = Reconstruct(planning, options, out);
-    stats->timeEngineS += Seconds(engineStart) - out->stats.timeGuidesS;
+    stats->timeEngineS += detail::SecondsSince(engineStart) - out->stats.timeGuidesS;
     ++stats->engineRuns;
     if (!s.ok()) return s;
     std::vector<Point2i> wanted = planning.TakeWanted();
@@ -239,7 +236,7 @@ Status PlanRenderAndFinish(PlanningProvider& planning, SampleProvider& preview, 
     }
     const auto exactStart = std::chrono::steady_clock::now();
     s = planning.EvaluateExactly(wanted, schedule.maxExactPixels);
-    stats->timeExactS += Seconds(exactStart);
+    stats->timeExactS += detail::SecondsSince(exactStart);
     if (!s.ok()) return s;
     ++rounds;
     ++stats->rounds;
@@ -277,7 +274,7 @@ Status PlanRenderAndFinish(PlanningProvider& planning, SampleProvider& preview, 
   }
   const auto exactStart = std::chrono::steady_clock::now();
   const Status s = render.empty() ? Status::Ok() : planning.EvaluateExactly(render, schedule.maxExactPixels);
-  stats->timeExactS += Seconds(exactStart);
+  stats->timeExactS += detail::SecondsSince(exactStart);
   // A quality search's budget refused the round: the result stays as finished.
   if (s.overBudget()) {
     stats->budgetBound = true;

@@ -10,6 +10,7 @@
 #include <limits>
 
 #include "texture_split.h"
+#include "elapsed.h"
 
 namespace dcm::detail {
 
@@ -126,7 +127,7 @@ Status SampleStore::Flush(SampleProvider& provider, const SampleRequest& what, i
   } else {
     for (size_t bi = 0; bi < nbatches; ++bi) run(bi);
   }
-  stats->timeProviderS += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  stats->timeProviderS += SecondsSince(t0);
   stats->providerCalls += int64_t(nbatches);
   for (const Status& s : results) {
     if (s.pending()) {

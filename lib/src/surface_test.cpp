@@ -12,6 +12,7 @@
 
 #include "engine.h"
 #include "texture_split.h"
+#include "elapsed.h"
 
 namespace dcm::detail {
 
@@ -241,7 +242,7 @@ Status Engine::LoadGuides() {
   GuideImage g;
   const auto t0 = std::chrono::steady_clock::now();
   DCM_RETURN_IF_ERROR(provider_.Guides(all, want, &g));
-  stats_.timeGuidesS += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  stats_.timeGuidesS += SecondsSince(t0);
   const size_t n = size_t(all.area());
   auto check = [&](bool wanted, size_t size, const char* name) {
     if (wanted && size != n)

@@ -191,6 +191,9 @@ def variance(dcm, blender, src, tmp):
     j = json.load(open(stats))
     assert j["blender"]["variance"] == "halves" and j["settings"]["noisy"], (j["blender"], j["settings"])
     assert j["quality"]["target_render"] and j["estimated_render_psnr"] > 0, j
+    # The preview's estimate, the validation's second judge, in the summary where the stats have it.
+    second = j["quality"].get("second_estimate")
+    assert second and "the second judge, %.2f dB" % second["psnr"] in so, (second, so)
     print("%.1f %% exact; %.0f %% of them differ between the seeds; %d denoised; auto: noise %.1f dB, %s; first "
           "round %d pixels (%d with an exact preview); with it, the preview's own PSNR %.1f dB, estimate %s"
           % (100 * is_exact.mean(), 100 * differ, runs["on"][2]["denoised_samples"],

@@ -321,12 +321,19 @@ std::string QualityLine(const QualityReport& r, const EngineFlags& f) {
                 "(%s), threshold %s",
                 e.psnr, 100 * r.confidence, e.low, e.high, target.c_str(), 100 * r.exactFraction(), r.runs, from,
                 r.threshold < 0 ? "none (full evaluation)" : G(r.threshold).c_str());
-  if (!r.againstConverged) return buf;
+  std::string line = buf;
+  if (std::isfinite(r.secondEstimate.psnr)) {
+    char second[128];
+    std::snprintf(second, sizeof second, "; the preview's estimate, the second judge, %.2f dB (%.2f to %.2f)",
+                  r.secondEstimate.psnr, r.secondEstimate.low, r.secondEstimate.high);
+    line += second;
+  }
+  if (!r.againstConverged) return line;
   const PsnrEstimate& n = r.renderEstimate;
   char noise[160];
   std::snprintf(noise, sizeof noise, "; against the converged image, the full render's own estimated PSNR %.2f dB",
                 n.psnr);
-  std::string line = buf + std::string(noise);
+  line += noise;
   if (std::isfinite(n.low) && std::isfinite(n.high)) {
     std::snprintf(noise, sizeof noise, " (%.2f to %.2f)", n.low, n.high);
     line += noise;
