@@ -20,12 +20,12 @@
 #include "block.h"
 #include "contrast_test.h"
 #include "dcm/reconstructor.h"
+#include "elapsed.h"
 #include "interpolation_recorder.h"
 #include "least_discrepancy_direction.h"
 #include "oriented_interpolation.h"
 #include "sample_store.h"
 #include "settings.h"
-#include "elapsed.h"
 
 namespace dcm::detail {
 

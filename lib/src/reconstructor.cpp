@@ -12,8 +12,8 @@
 #include <string>
 
 #include "dcm/downsample.h"
-#include "engine.h"
 #include "elapsed.h"
+#include "engine.h"
 
 namespace dcm {
 

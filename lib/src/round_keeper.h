@@ -13,9 +13,9 @@
 
 #include "dcm/quality_preview.h"
 #include "dcm/sample_provider.h"
+#include "elapsed.h"
 #include "guide_cache.h"
 #include "sample_mask.h"
-#include "elapsed.h"
 
 namespace dcm::detail {
 

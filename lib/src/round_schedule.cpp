@@ -12,8 +12,8 @@
 #include <utility>
 
 #include "dcm/downsample.h"
-#include "planning_provider.h"
 #include "elapsed.h"
+#include "planning_provider.h"
 
 namespace dcm {
 

@@ -9,8 +9,8 @@
 #include <cmath>
 #include <limits>
 
-#include "texture_split.h"
 #include "elapsed.h"
+#include "texture_split.h"
 
 namespace dcm::detail {
 

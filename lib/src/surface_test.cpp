@@ -10,9 +10,9 @@
 #include <string>
 #include <unordered_map>
 
+#include "elapsed.h"
 #include "engine.h"
 #include "texture_split.h"
-#include "elapsed.h"
 
 namespace dcm::detail {
 
