@@ -11,6 +11,7 @@
 
 #include "dcm/downsample.h"
 #include "dcm/preview_filter.h"
+#include "dcm/preview_pooling.h"
 
 namespace dcm {
 
@@ -116,7 +117,7 @@ double PreviewNoisePsnr(SampleProvider& preview, std::span<const RGB> ownVarianc
 Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample, Reconstruction* rec,
                             PreviewCorrectionStats* stats, std::span<const RGB> ownVariance, double exactShare,
                             std::span<const RGB> textureCovariance, int filterRadius, const GuideImage& guides,
-                            std::vector<float>* excess) {
+                            std::vector<float>* excess, bool exactPooled) {
   if (radius < 0) return Status::Error("preview correction: radius " + std::to_string(radius) + " is negative");
   if (filterRadius < 0)
     return Status::Error("preview correction: filter radius " + std::to_string(filterRadius) + " is negative");
@@ -279,22 +280,24 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample,
     if (!error.empty()) {
       // A stand-in keeps the preview's value, so its error is the preview's
       // noise; an exact pixel's is its own: the exact share of the preview's
-      // variance, taken through the display at the pixel's value in the
-      // result (the interpolated one where the round's value is filled in
-      // later: as good for the slope). A share of the preview's display
+      // variance (pooled: the pooled share), taken through the display at the
+      // pixel's value in the result (the interpolated one where the round's
+      // value is filled in later: as good for the slope). A share of the preview's display
       // variance would understate it where the preview's far larger noise
       // meets the curve's bend and clip.
       std::vector<double> d;
       d.reserve(n);
       std::vector<double> over(excess ? n : 0), noises(excess ? n : 0);
       double noiseSum = 0, renderSum = 0;
+      const float pooledShare = float(PreviewPoolWeight(exactShare));
       for (size_t i = 0; i < n; ++i) {
         const RGB& pv = ownVariance.empty() ? p[i].variance : ownVariance[i];
         const double noise = usable[i] ? DisplayNoise(p[i].L, pv) : 0.0;
-        const double ownNoise =
-            usable[i] && IsFinite(corrected[i]) ? DisplayNoise(corrected[i], pv * float(exactShare)) : 0.0;
+        const bool finite = usable[i] && IsFinite(corrected[i]);
+        const double renderNoise = finite ? DisplayNoise(corrected[i], pv * float(exactShare)) : 0.0;
+        const double ownNoise = exactPooled && finite ? DisplayNoise(corrected[i], pv * pooledShare) : renderNoise;
         noiseSum += noise;
-        renderSum += ownNoise;
+        renderSum += renderNoise;
         const SampleReason r = rec->sampleMap[i];
         if (r == SampleReason::kPreviewStandIn) d.push_back(noise);
         else if (r != SampleReason::kInterpolated) d.push_back(ownNoise);

@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "dcm/downsample.h"
+#include "dcm/preview_pooling.h"
 #include "elapsed.h"
 #include "planning_provider.h"
 
@@ -142,13 +143,20 @@ Status Finish(PlanningProvider& planning, SampleProvider& preview, const Reconst
                                              out->stats.settings.split ? std::span<const RGB>(
                                                                              schedule.previewTextureCovariance)
                                                                        : std::span<const RGB>(),
-                                             schedule.filterRadius, guides, excess));
+                                             schedule.filterRadius, guides, excess, schedule.poolPreview));
     stats->timeEngineS += detail::SecondsSince(start);
   }
   if (rendered > 0) {
     planning.FillRendered(out);
     out->image = BoxDownsample(out->workImage, out->workWidth, out->workHeight, options.downsample, &out->width,
                                &out->height);
+  }
+  // Last: the correction's windows compared the exact values as rendered.
+  if (schedule.poolPreview) {
+    const auto start = std::chrono::steady_clock::now();
+    DCM_RETURN_IF_ERROR(PoolExactWithPreview(preview, ExactVarianceShare(schedule), options.downsample, out,
+                                             &stats->pooledPixels));
+    stats->timeEngineS += detail::SecondsSince(start);
   }
   return Status::Ok();
 }

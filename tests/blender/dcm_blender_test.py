@@ -37,7 +37,8 @@ def exact(dcm, blender, src, tmp):
     for schedule in ("preview", "levels"):
         out, stats, smap = (os.path.join(tmp, schedule + e) for e in (".exr", ".json", ".png"))
         code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--sample-map", smap, "--schedule", schedule,
-                                 "--blender", blender, "--max-rounds", "8", "--min-round-share", "0", "--variance", "off"])
+                                 "--blender", blender, "--max-rounds", "8", "--min-round-share", "0", "--variance", "off",
+                                 "--pool-preview", "off"])
         assert code == 0, se
         img, spec = bs.read_exr(out)
         assert spec.channelnames == ("ViewLayer.Combined.R", "ViewLayer.Combined.G", "ViewLayer.Combined.B",
@@ -65,8 +66,37 @@ def exact(dcm, blender, src, tmp):
             assert 1 <= rounds <= 8, b
         print("%s: %.1f %% exact in %d render calls, %.1f %% bit-identical to the full render; %.2f s" % (
             schedule, 100 * j["exact_fraction"], rounds, 100 * (err == 0).all(axis=1).mean(), b["wall_s"]))
+        if schedule == "preview":
+            pooled(dcm, blender, src, tmp, blend, img, is_exact, b)
     assert hashlib.sha256(open(blend, "rb").read()).hexdigest() == digest, "the .blend changed"
     assert bs.no_blender_left(blend)
+
+
+def pooled(dcm, blender, src, tmp, blend, alone, is_exact, b):
+    """By default (--pool-preview on) each exact pixel ends as the inverse-variance mean of its
+    samples and its preview's, rendered on seeds of their own: the same run otherwise (the same
+    pixels exact, the interpolated ones unchanged), and the exact pixels closer to the converged
+    image by 1 / (1 + s), s the preview's samples over theirs."""
+    out, stats = os.path.join(tmp, "pooled.exr"), os.path.join(tmp, "pooled.json")
+    code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--schedule", "preview", "--blender", blender,
+                             "--max-rounds", "8", "--min-round-share", "0", "--variance", "off"])
+    assert code == 0, se
+    img = bs.read_exr(out)[0]
+    j = json.load(open(stats))
+    assert j["blender"]["pooled_pixels"] == j["exact_pixels"] == is_exact.sum(), (j["blender"], is_exact.sum())
+    assert "pooled         %d exact pixels" % is_exact.sum() in so, so
+    assert (img[~is_exact] == alone[~is_exact]).all(), "pooling changed an interpolated pixel"
+    s = b["exact_noise_share"]["assumed"]  # 8 preview samples of the file's 16: 0.5
+    # The converged image: 1024 samples, whose own noise is 1/64 of the exact pixels'.
+    conv = bs.render_full(blender, src, blend, tmp, samples=1024, seed=101)[..., :3]
+    mse = [float(np.mean((x[is_exact][:, :3] - conv[is_exact]) ** 2)) for x in (alone, img)]
+    # Expected 1 / (1 + s) = 0.67 (0.68 with the reference's noise). About 1000 pixels whose noise
+    # is one path per channel: the ratio's sd is a few per cent, so 0.82 is far above chance and
+    # far below the 1.0 of no pooling.
+    assert mse[1] < 0.82 * mse[0], (mse, s)
+    assert mse[1] > 0.5 * mse[0], ("pooled past its weight", mse, s)
+    print("pooled: the exact pixels' squared error against 1024 spp %.3g -> %.3g (%.2f; 1/(1+s) = %.2f)" % (
+        mse[0], mse[1], mse[1] / mse[0], 1 / (1 + s)))
 
 
 def exact_mask(smap, h, w):
@@ -88,14 +118,15 @@ def variance(dcm, blender, src, tmp):
     h, w = half_a.shape[:2]
     runs = {}
     # "on" and the runs compared with it have no error round (it depends on the correction's estimate);
-    # "error round" has it, as by default.
+    # "error round" has it, as by default. "raw" and "error round" keep the exact samples as
+    # rendered (not pooled with the preview, `pooled` above) to compare them with the renders.
     no_error_round = ["--error-round", "0"]
     for name, flags in (("auto", []), ("on", ["--variance", "on"] + no_error_round),
-                        ("raw", ["--variance", "on", "--no-denoise-samples"] + no_error_round),
+                        ("raw", ["--variance", "on", "--no-denoise-samples", "--pool-preview", "off"] + no_error_round),
                         ("exact preview", ["--variance", "on", "--preview-samples", "16"] + no_error_round),
                         ("uncorrected", ["--variance", "on", "--preview-correction", "0"]),
                         ("unfiltered", ["--variance", "on", "--preview-filter", "0"] + no_error_round),
-                        ("error round", ["--variance", "on"])):
+                        ("error round", ["--variance", "on", "--pool-preview", "off"])):
         out, stats, smap = (os.path.join(tmp, name + e) for e in (".exr", ".json", ".png"))
         code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--sample-map", smap, "--blender", blender,
                                  "--max-rounds", "8", "--min-round-share", "0", "--schedule", "preview"] + flags)

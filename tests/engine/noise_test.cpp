@@ -178,7 +178,7 @@ TEST(Noise, DenoisingKeepsColoursOfEqualLuminanceApart) {
       ++n;
     }
   ASSERT_GT(n, 0);
-  for (int c = 0; c < 3; ++c) EXPECT_LT(std::sqrt(err[c] / n), std::sqrt(sd[c] / n)) << "channel " << c;
+  for (int c = 0; c < 3; ++c) EXPECT_LT(std::sqrt(err[c] / double(n)), std::sqrt(sd[c] / double(n))) << "channel " << c;
 }
 
 TEST(Noise, EveryPixelIsInterpolatedAfterDenoising) {

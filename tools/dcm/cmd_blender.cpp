@@ -83,6 +83,8 @@ struct BlenderFlags {
   std::string viewLayer;   ///< empty: the first that renders
   int samples = 0;         ///< 0: the file's
   int previewSamples = 0;  ///< 0: samples / 16, at least 8
+  /// on: the exact pixels pooled with their preview (its own seeds: PreviewScheduleOptions::poolPreview)
+  std::string poolPreview = "on";
   /// Every exact pixel at `samples`, also where a goal in dB needs fewer.
   bool fixedSamples = false;
   RoundFlags rounds;       ///< --schedule, --max-rounds
@@ -444,6 +446,12 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
         std::cerr << "blender: " << (target > 0 ? "--target-psnr" : "--budget") << " judged by "
                   << (targetFromPreview ? std::string("the preview's estimate") : "validation pixels: " + why) << "\n";
     }
+    // The preview renders on seeds of its own (the child's `seeds`): its
+    // samples are more samples of the exact pixels, where the result is judged
+    // against the converged image; not where validation pixels judge it against
+    // the full render, nor in the baseline.
+    const bool againstRender = haveGoal && !targetFromPreview && !useVariance;
+    so.poolPreview = f.poolPreview == "on" && !options.fullEvaluation && !againstRender;
     // The exact pixels' noise is measured (the first round in two halves: one
     // render call more, unless the engine weighs the variance) but for a
     // target judged by the preview that the render's own noise, from the
@@ -599,6 +607,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       b["preview_corrected"] = sched.correction.pixels;
       b["preview_filtered"] = sched.correction.filtered;
       b["error_round_pixels"] = sched.errorRoundPixels;
+      b["pooled_pixels"] = sched.pooledPixels;
       b["preview_correction_weight"] = sched.correction.meanWeight;
       if (std::isfinite(sched.correction.previewPsnr)) b["preview_psnr"] = sched.correction.previewPsnr;
     }
@@ -692,6 +701,9 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     std::printf("  error round    %lld interpolated pixels rendered where the preview said the interpolation "
                 "missed (--error-round)\n",
                 static_cast<long long>(sched.errorRoundPixels));
+  if (sched.pooledPixels > 0)
+    std::printf("  pooled         %lld exact pixels took their preview's samples in (--pool-preview)\n",
+                static_cast<long long>(sched.pooledPixels));
   if (!quality && !previewEstimate && std::isfinite(sched.correction.previewPsnr) && f.pipe.engine.verbose)
     std::fprintf(stderr, "dcm %s: no estimate of the PSNR: the preview's own is %.2f dB, too noisy to tell\n",
                  cmd.c_str(), sched.correction.previewPsnr);
@@ -768,6 +780,12 @@ Registration reg("blender", "Render a .blend with Cycles at the pixels DCM asks 
                    app->add_option("--preview-samples", f->previewSamples,
                                    "samples of the guides and preview render (0: a sixteenth of --samples, at least 8)")
                        ->transform(Integer(0, 1 << 24));
+                   app->add_option("--pool-preview", f->poolPreview,
+                                   "on: each exact pixel ends as the inverse-variance mean of its samples and its "
+                                   "preview's (rendered on seeds of their own), the preview's weight its samples' "
+                                   "share; off: the exact samples alone")
+                       ->check(CLI::IsMember({"on", "off"}))
+                       ->capture_default_str();
                    app->add_option("--variance", f->variance,
                                    "exact pixels as two renders of half the samples with two seeds, whose difference "
                                    "gives the engine their variance: auto (where the preview's halves say their "

@@ -92,10 +92,13 @@ double PreviewNoisePsnr(SampleProvider& preview, std::span<const RGB> ownVarianc
 /// would carry rendered (`exactShare` of the preview's variance), in units of
 /// the preview's display variance there, the noise of that estimate; NaN
 /// where the pixel is not interpolated or has no estimate.
+/// `exactPooled`: the exact pixels will be pooled with their preview afterwards
+/// (PoolExactWithPreview): the estimate and `excess` count an exact pixel's
+/// noise at PreviewPoolWeight(exactShare) of the preview's variance.
 Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample, Reconstruction* rec,
                             PreviewCorrectionStats* stats = nullptr, std::span<const RGB> ownVariance = {},
                             double exactShare = 0, std::span<const RGB> textureCovariance = {},
                             int filterRadius = 0, const GuideImage& guides = {},
-                            std::vector<float>* excess = nullptr);
+                            std::vector<float>* excess = nullptr, bool exactPooled = false);
 
 }  // namespace dcm

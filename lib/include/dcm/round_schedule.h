@@ -95,6 +95,13 @@ struct PreviewScheduleOptions {
   /// samples over the exact ones'), for the estimate: an exact pixel's error
   /// against the converged image. 0: exact samples count as noise-free.
   double exactVarianceShare = 0;
+  /// The preview renders on random numbers of its own, independent of the
+  /// exact samples': each exact pixel of the result ends pooled with its
+  /// preview at the inverse-variance weight (PoolExactWithPreview, with the
+  /// share ExactVarianceShare()), and the estimate counts it at the pooled
+  /// variance. Off: a preview that is the first of the exact samples (a
+  /// progressive renderer on one seed) would count them twice.
+  bool poolPreview = false;
   /// Where set and it returns a positive number: that share as measured on
   /// the exact pixels rendered so far (two halves of their samples against
   /// the preview's at the same pixels). It replaces exactVarianceShare, whose
@@ -143,6 +150,7 @@ struct PreviewScheduleStats {
   std::vector<int64_t> pixelsPerRound;  ///< exact pixels evaluated in each call
   int64_t previewStandIns = 0;          ///< wanted pixels left at their preview value
   int64_t errorRoundPixels = 0;         ///< rendered by PreviewScheduleOptions::errorRound
+  int64_t pooledPixels = 0;             ///< exact pixels pooled with their preview (poolPreview)
   int engineRuns = 0;                   ///< reconstructions run (one more than the rounds, at most)
   double timeEngineS = 0;               ///< in the engine runs (preview evaluation included)
   double timeExactS = 0;                ///< in the exact provider's Evaluate()
