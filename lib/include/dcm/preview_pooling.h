@@ -23,9 +23,9 @@ double PreviewPoolWeight(double exactShare);
 /// Moves every exact pixel of `rec` (any reason but kInterpolated and
 /// kPreviewStandIn) toward `preview`'s value there by PreviewPoolWeight(
 /// exactShare), and makes `rec->image` again, downsampled by `downsample`.
-/// A denoised exact value (noisy samples) takes the weight of its raw sample:
-/// the weight of its reduced variance alone moved it less and lost on the
-/// check scenes (docs/NOISE.md): its error is more than that variance.
+/// A denoised exact value (noisy samples) takes its raw sample's weight: its
+/// error is more than its reduced variance, and the weight of that variance
+/// alone did worse (docs/TUNING.md).
 /// The preview must give every working pixel's L from samples independent of
 /// the exact ones (pooling a preview that is the first of the exact samples
 /// would count those twice). A pixel whose preview or exact value is not
