@@ -28,6 +28,7 @@ bool IsBlendInput(const std::string& input) {
 #ifdef DCM_HAVE_PIPE
 
 #include "blender_files.h"
+#include "common/elapsed.h"
 #include "common/image_io.h"
 #include "common/output_transaction.h"
 #include "dcm/pipe/pipe_provider.h"
@@ -154,7 +155,7 @@ Status MeasureCycles(const BenchFlags& f, const std::string& input, const std::s
       if (talk) std::cerr << "dcm bench: " << name << ": " << step << " ...\n";
       const auto t0 = Clock::now();
       Status st = pipe::RunCommand(command, log, kRunTimeout);
-      t.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
+      t.push_back(toolkit::SecondsSince(t0));
       if (!st.ok()) return Status::Error(input + ": " + step + ": " + st.message());
       if (talk) std::cerr << "dcm bench: " << name << ": " << step << ": " << Fixed(t.back(), 2) << " s\n";
     }

@@ -21,6 +21,7 @@
 #include <string_view>
 #include <vector>
 
+#include "common/elapsed.h"
 #include "dcm/color.h"
 #include "dcm/geometry.h"
 #include "dcm/sample_provider.h"
@@ -138,7 +139,7 @@ inline Status RunRival(SampleProvider& provider, Upsampler kind, int64_t budget,
   } else {
     for (size_t bi = 0; bi < nbatches; ++bi) run(bi);
   }
-  out->timeIllumS = std::chrono::duration<double>(Clock::now() - t0).count();
+  out->timeIllumS = toolkit::SecondsSince(t0);
   for (const Status& s : results) {
     if (s.pending()) return Status::Error("provider '" + caps.name + "' cannot evaluate pixels now (sparse input)");
     if (!s.ok()) return s;
@@ -157,7 +158,7 @@ inline Status RunRival(SampleProvider& provider, Upsampler kind, int64_t budget,
     if (want.objectId || want.shaderId || want.texture) {
       t0 = Clock::now();
       DCM_RETURN_IF_ERROR(provider.Guides(Bounds2i{{0, 0}, {W, H}}, want, &guides));
-      out->timeGuidesS = std::chrono::duration<double>(Clock::now() - t0).count();
+      out->timeGuidesS = toolkit::SecondsSince(t0);
       const size_t n = size_t(W) * size_t(H);
       if ((want.objectId && guides.objectId.size() != n) || (want.shaderId && guides.shaderId.size() != n) ||
           (want.texture && guides.texture.size() != n)) {
@@ -234,9 +235,9 @@ inline Status RunRival(SampleProvider& provider, Upsampler kind, int64_t budget,
   for (int j = 0; j < ny; ++j)
     for (int i = 0; i < nx; ++i)
       out->workImage[size_t(grid.ys[size_t(j)]) * size_t(W) + size_t(grid.xs[size_t(i)])] = S(i, j);
-  out->timeEngineS = std::chrono::duration<double>(Clock::now() - t0).count();
+  out->timeEngineS = toolkit::SecondsSince(t0);
   out->exactPixels = grid.count();
-  out->wallS = std::chrono::duration<double>(Clock::now() - tStart).count();
+  out->wallS = toolkit::SecondsSince(tStart);
   return Status::Ok();
 }
 

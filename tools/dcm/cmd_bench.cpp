@@ -41,6 +41,7 @@
 #include "common/output_guard.h"
 #include "common/output_transaction.h"
 #include "common/stats_json.h"
+#include "common/elapsed.h"
 #include "dcm/pipe/run_command.h"
 #include "dcm/pipe/scratch_folder.h"
 #include "dcm/reconstructor.h"
@@ -81,10 +82,6 @@ std::string Join(const std::vector<std::string>& v, const char* sep = ",") {
   std::string s;
   for (const auto& e : v) s += (s.empty() ? "" : sep) + e;
   return s;
-}
-
-double Seconds(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 bool EndsWith(const std::string& s, const std::string& suffix) {
@@ -633,7 +630,7 @@ int RunBench(const BenchFlags& f) {
       Reconstruction rec;
       const auto t0 = std::chrono::steady_clock::now();
       if (Status st = Reconstruct(*provider, full.config.options, &rec); !st.ok()) return Fail(st);
-      full.timeTotalS = Seconds(t0);
+      full.timeTotalS = toolkit::SecondsSince(t0);
       full.exactPixels = rec.stats.exactPixels;
       full.totalPixels = rec.stats.totalPixels;
       full.exactFraction = rec.stats.exactFraction();
@@ -667,7 +664,7 @@ int RunBench(const BenchFlags& f) {
             f.threads, &r, f.jbu));
         const auto t0 = std::chrono::steady_clock::now();
         *image = ToOutput(r.workImage, r.width, r.height, c.supersampling, &ow, &oh);
-        const double tDown = Seconds(t0);
+        const double tDown = toolkit::SecondsSince(t0);
         p->exactPixels = r.exactPixels;
         p->totalPixels = int64_t(r.width) * r.height;
         p->timeIllumS = r.timeIllumS;
@@ -680,7 +677,7 @@ int RunBench(const BenchFlags& f) {
         Reconstruction rec;
         const auto t0 = std::chrono::steady_clock::now();
         DCM_RETURN_IF_ERROR(Reconstruct(*prov, o, &rec));
-        p->timeTotalS = Seconds(t0);
+        p->timeTotalS = toolkit::SecondsSince(t0);
         p->exactPixels = rec.stats.exactPixels;
         p->totalPixels = rec.stats.totalPixels;
         p->timeIllumS = rec.stats.timeProviderS;
@@ -957,13 +954,13 @@ int RunBench(const BenchFlags& f) {
                       {"points", points},
                       {"plots", plots},
                       {"plot_note", plotNote},
-                      {"time_s", Seconds(tBench)}};
+                      {"time_s", toolkit::SecondsSince(tBench)}};
   if (Status st = toolkit::WriteJson((fs::path(f.out) / "bench.json").string(), j); !st.ok()) return Fail(st);
   if (Status st = WriteText((fs::path(f.out) / "summary.md").string(), summary.str()); !st.ok()) return Fail(st);
   if (Status st = transaction.Commit(); !st.ok()) return Fail(st);
   if (!f.quiet) std::cout << summary.str();
   if (talk) {
-    std::cout << "dcm bench: " << all.size() << " points in " << Fmt("%.1f", Seconds(tBench)) << " s; wrote "
+    std::cout << "dcm bench: " << all.size() << " points in " << Fmt("%.1f", toolkit::SecondsSince(tBench)) << " s; wrote "
               << f.out << "/{bench.csv,bench.json,summary.md}\n";
   }
   return kExitOk;

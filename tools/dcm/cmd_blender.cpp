@@ -35,6 +35,7 @@
 
 #include "blender_files.h"
 #include "commands.h"
+#include "common/elapsed.h"
 #include "common/output_exr.h"
 #include "common/output_guard.h"
 #include "common/output_transaction.h"
@@ -115,7 +116,6 @@ std::string PercentDecoded(const std::string& s) {
   return out;
 }
 
-double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 /// Times every call of the exact provider: a round each with the preview schedule.
 class TimedProvider final : public SampleProvider {
@@ -126,7 +126,7 @@ class TimedProvider final : public SampleProvider {
     step = "reading the guides";
     const auto t = Clock::now();
     Status st = p_.Guides(region, what, out);
-    guidesS += Since(t);
+    guidesS += toolkit::SecondsSince(t);
     return st;
   }
   Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what, std::span<ExactSample> out) override {
@@ -134,7 +134,7 @@ class TimedProvider final : public SampleProvider {
            std::to_string(pixels.size()) + " pixels)";
     const auto t = Clock::now();
     Status st = p_.Evaluate(pixels, what, out);
-    rounds.push_back({int64_t(pixels.size()), Since(t)});
+    rounds.push_back({int64_t(pixels.size()), toolkit::SecondsSince(t)});
     return st;
   }
   void TakeExtraSamples(std::vector<Point2i>* pixels, std::vector<ExactSample>* samples) override {
@@ -297,7 +297,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   if (Status st = pipe::PipeProvider::Start(po, &provider); !st.ok())
     return Fail("'" + f.scene + "': starting Blender: " + st.message());
   // The child renders its guides and preview before it answers the handshake.
-  const double handshakeS = Since(t0);
+  const double handshakeS = toolkit::SecondsSince(t0);
   const auto& keys = provider->handshakeKeys();
   const double guidesRenderS = keys.count("guides_seconds") ? std::atof(keys.at("guides_seconds").c_str()) : 0.0;
   const std::string layer = keys.count("view_layer") ? PercentDecoded(keys.at("view_layer")) : "ViewLayer";
@@ -387,7 +387,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     PreviewScheduleOptions so;
     st = provider->FetchPreview({options.textureSplit && caps.splitRadiance, previewVariance}, &preview, poolRadius,
                                 &so.previewOwnVariance, &so.previewTextureCovariance);
-    previewS = Since(tp);
+    previewS = toolkit::SecondsSince(tp);
     // An exact pixel's noise, against the converged image: the preview's at its samples.
     const double samples = keys.count("samples") ? std::atof(keys.at("samples").c_str()) : 0.0;
     const double previewSamples = keys.count("preview_samples") ? std::atof(keys.at("preview_samples").c_str()) : 0.0;
@@ -466,7 +466,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       previewGoal.targetPsnr = std::max(0.0, target);
       previewGoal.searchBeyondRender = !defaultGoal;
       st = ReconstructToTargetFromPreview(timed, *preview, options, previewGoal, so, &rec, &report, &ptarget);
-      goalS = Since(tq);
+      goalS = toolkit::SecondsSince(tq);
       if (st.ok()) quality = std::move(report);
       sched = ptarget.last;
       // Halved samples: the exact pixels' variance is a larger share of the preview's.
@@ -510,7 +510,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       QualityReport report;
       const auto tq = Clock::now();
       st = ReconstructToQualityWithPreview(timed, *preview, options, goal, so, &rec, &report, &qrounds);
-      goalS = Since(tq);
+      goalS = toolkit::SecondsSince(tq);
       if (st.ok()) quality = std::move(report);
       sched.previewStandIns = qrounds.previewStandIns;
     } else if (st.ok()) {
@@ -536,7 +536,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   }
   // Blender must end cleanly before anything is written.
   if (Status fin = provider->Finish(); !fin.ok()) return Fail("'" + f.scene + "': " + fin.message());
-  const double wallS = Since(t0);
+  const double wallS = toolkit::SecondsSince(t0);
   const ReconstructionStats& stats_ = rec.stats;
   double roundsS = 0;
   for (const auto& r : timed.rounds) roundsS += r.seconds;

@@ -14,6 +14,7 @@
 #include <string>
 
 #include "commands.h"
+#include "common/elapsed.h"
 #include "common/image_io.h"
 #include "common/output_guard.h"
 #include "common/output_transaction.h"
@@ -109,7 +110,7 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
   if (!st.ok()) return Fail(st.message());
   // The child must end cleanly before anything is written.
   if (Status fin = provider->Finish(); !fin.ok()) return Fail(fin.message());
-  const double wallS = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double wallS = toolkit::SecondsSince(t0);
   const ReconstructionStats& stats = rec.stats;
   if (f.engine.verbose) std::cerr << toolkit::StageTimesLine(stats) << "\n";
   if (f.engine.verbose && quality) std::cerr << QualityLine(*quality, f.engine) << "\n";

@@ -30,6 +30,7 @@
 #include <string>
 
 #include "commands.h"
+#include "common/elapsed.h"
 #include "common/image_io.h"
 #include "common/metrics.h"
 #include "common/output_guard.h"
@@ -62,7 +63,6 @@ struct PovrayFlags {
   toolkit::ExrFormat exr;
 };
 
-double Since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 int Fail(const std::string& message, int code = kExitFailure) {
   std::cerr << "dcm povray: error: " << message << "\n";
@@ -173,7 +173,7 @@ int RunPovray(const PovrayFlags& f) {
     std::vector<std::vector<RGB>> beauty;
     const povray::Pass pass[] = {povray::Pass::kBeauty};
     if (Status st = provider->RenderDense(pass, W, H, &beauty); !st.ok()) return Fail(st.message());
-    denseS = Since(td);
+    denseS = toolkit::SecondsSince(td);
     rec.image = BoxDownsample(beauty[0], W, H, options.downsample, &rec.width, &rec.height);
     rec.workWidth = W;
     rec.workHeight = H;
@@ -189,7 +189,7 @@ int RunPovray(const PovrayFlags& f) {
     }
     Status st = provider->RenderGuides(lit, pw, ph, &preview);
     if (!st.ok()) return Fail(st.message());
-    denseS = Since(td);
+    denseS = toolkit::SecondsSince(td);
     if (f.engine.verbose)
       std::cerr << "dcm povray: engine settings: " << SettingsSummary(options, provider->Capabilities()) << "\n"
                 << "dcm povray: highlight mask (pass 6): "
@@ -232,7 +232,7 @@ int RunPovray(const PovrayFlags& f) {
       st = ReconstructFor(*provider, options, f.engine, &rec, &quality);
     }
     if (!st.ok()) return Fail(st.message());
-    engineS = Since(te);
+    engineS = toolkit::SecondsSince(te);
     for (double s : provider->runStats().roundS) engineS -= s;
   }
   const povray::PovrayRunStats runs = provider->runStats();
@@ -295,7 +295,7 @@ int RunPovray(const PovrayFlags& f) {
   if (!f.sampleMap.empty())
     if (Status w = toolkit::WriteSampleMap(f.sampleMap, rec); !w.ok()) return Fail(w.message());
   // The wall clock up to the outputs' commit, the process's own start-up not included.
-  j["time_wall_s"] = Since(t0);
+  j["time_wall_s"] = toolkit::SecondsSince(t0);
   if (!f.stats.empty())
     if (Status w = toolkit::WriteJson(f.stats, j); !w.ok()) return Fail(w.message());
   if (Status w = outputs.Commit(); !w.ok()) return Fail(w.message());
@@ -303,7 +303,7 @@ int RunPovray(const PovrayFlags& f) {
 
   if (!f.engine.quiet) {
     std::printf("%s: %dx%d, %s, %d POV-Ray processes (%d lit), %.2f s\n", f.output.c_str(), rec.width, rec.height,
-                full ? "full render" : "dcm", runs.invocations, runs.litInvocations, Since(t0));
+                full ? "full render" : "dcm", runs.invocations, runs.litInvocations, toolkit::SecondsSince(t0));
     if (!full) {
       std::printf("  exact pixels   %.2f %% (%lld of %lld) in %zu rounds", 100.0 * rec.stats.exactFraction(),
                   static_cast<long long>(rec.stats.exactPixels), static_cast<long long>(rec.stats.totalPixels),

@@ -21,6 +21,7 @@
 #include "dcm/downsample.h"
 #include "aov_common.h"
 #include "reconstruct_exr.h"
+#include "common/elapsed.h"
 #include "common/image_io.h"
 #include "common/metrics.h"
 #include "common/preview.h"
@@ -123,7 +124,7 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
   std::vector<Point2i> pending;
   const auto t0 = std::chrono::steady_clock::now();
   st = aov_common::Run(provider, options, f.engine, &r, &pending, &region, &info);
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double wall = toolkit::SecondsSince(t0);
   if (st.pending()) {
     return aov_common::Fail(cmd, MissingSamplesMessage(provider, pending, " for this part"));
   }

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "commands.h"
+#include "common/elapsed.h"
 #include "common/image_io.h"
 #include "common/metrics.h"
 #include "common/output_guard.h"
@@ -96,7 +97,7 @@ Status RunOnce(embree::EmbreeProvider& provider, const ReconstructionOptions& op
   provider.ResetRayCounts();
   auto t0 = std::chrono::steady_clock::now();
   Status st = ReconstructFor(provider, options, engine, &run->rec, &run->quality);
-  run->wallS = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  run->wallS = toolkit::SecondsSince(t0);
   run->rays = provider.rayCounts();
   return st;
 }
@@ -151,7 +152,7 @@ int RunRenderPart(const RenderFlags& f, const embree::Scene& scene, Reconstructi
   Reconstruction rec;
   RegionInfo info;
   if (Status st = ReconstructRegion(provider, options, region, &rec, &info); !st.ok()) return Fail(st);
-  const double wallS = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double wallS = toolkit::SecondsSince(t0);
   const embree::RayCounts rays = provider.rayCounts();
   progress.Done();
 

@@ -8,6 +8,7 @@
 #include <map>
 #include <tuple>
 
+#include "common/elapsed.h"
 #include "common/image_io.h"
 #include "common/stats_json.h"
 #include "common/tiles.h"
@@ -91,7 +92,7 @@ Status ReconstructWholeExr(const std::string& cmd, aov::AovProvider& provider, c
   std::vector<Point2i> pending;
   const auto t0 = std::chrono::steady_clock::now();
   const Status st = aov_common::Run(provider, options, engine, &r, &pending, nullptr, nullptr, &out->quality);
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double wall = toolkit::SecondsSince(t0);
   if (st.pending()) return Status::Error(MissingSamplesMessage(provider, pending, ""));
   DCM_RETURN_IF_ERROR(st);
 
