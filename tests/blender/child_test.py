@@ -40,9 +40,9 @@ def main():
         assert child.round_latency > 0 and child.sample_cost > 0, child.hello
         # The preview comes with the guides render: it costs no schedule anything more.
         assert " preview_cost=0 " in child.hello, child.hello
-        # 16 samples: a sixteenth would be 1; the preview takes 8, the floor below which
-        # its error estimate is biased by the sRGB curve (docs/BLENDER.md).
-        assert child.preview_samples == 8, child.hello
+        # 16 samples: a sixteenth would be 1; the preview takes the floor of 16 (at most
+        # the file's samples; docs/BLENDER.md, *Guides, preview and rounds*).
+        assert child.preview_samples == 16, child.hello
 
         ids, shaders, tau, normal = child.guides()
         # Floor, cube, the two spheres, the shade and the sky: six objects and materials.

@@ -38,7 +38,7 @@ def exact(dcm, blender, src, tmp):
         out, stats, smap = (os.path.join(tmp, schedule + e) for e in (".exr", ".json", ".png"))
         code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--sample-map", smap, "--schedule", schedule,
                                  "--blender", blender, "--max-rounds", "8", "--min-round-share", "0", "--variance", "off",
-                                 "--pool-preview", "off"])
+                                 "--pool-preview", "off", "--preview-samples", "8"])
         assert code == 0, se
         img, spec = bs.read_exr(out)
         assert spec.channelnames == ("ViewLayer.Combined.R", "ViewLayer.Combined.G", "ViewLayer.Combined.B",
@@ -79,7 +79,7 @@ def pooled(dcm, blender, src, tmp, blend, alone, is_exact, b):
     image by 1 / (1 + s), s the preview's samples over theirs."""
     out, stats = os.path.join(tmp, "pooled.exr"), os.path.join(tmp, "pooled.json")
     code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--schedule", "preview", "--blender", blender,
-                             "--max-rounds", "8", "--min-round-share", "0", "--variance", "off"])
+                             "--max-rounds", "8", "--min-round-share", "0", "--variance", "off", "--preview-samples", "8"])
     assert code == 0, se
     img = bs.read_exr(out)[0]
     j = json.load(open(stats))
@@ -128,8 +128,10 @@ def variance(dcm, blender, src, tmp):
                         ("unfiltered", ["--variance", "on", "--preview-filter", "0"] + no_error_round),
                         ("error round", ["--variance", "on", "--pool-preview", "off"])):
         out, stats, smap = (os.path.join(tmp, name + e) for e in (".exr", ".json", ".png"))
+        # The preview at 8 of the file's 16 samples (the default, at least 16, would be all of them).
+        preview = [] if name == "exact preview" else ["--preview-samples", "8"]
         code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--sample-map", smap, "--blender", blender,
-                                 "--max-rounds", "8", "--min-round-share", "0", "--schedule", "preview"] + flags)
+                                 "--max-rounds", "8", "--min-round-share", "0", "--schedule", "preview"] + preview + flags)
         assert code == 0, se
         j = json.load(open(stats))
         b = j["blender"]

@@ -83,7 +83,7 @@ struct BlenderFlags {
   std::string frames;      ///< A-B: one output per frame, '#' in -o replaced by the frame number
   std::string viewLayer;   ///< empty: the first that renders
   int samples = 0;         ///< 0: the file's
-  int previewSamples = 0;  ///< 0: samples / 16, at least 8
+  int previewSamples = 0;  ///< 0: samples / 16, at least 16
   /// on: the exact pixels pooled with their preview (its own seeds: PreviewScheduleOptions::poolPreview)
   std::string poolPreview = "on";
   /// Every exact pixel at `samples`, also where a goal in dB needs fewer.
@@ -778,7 +778,7 @@ Registration reg("blender", "Render a .blend with Cycles at the pixels DCM asks 
                                  "renders them at half, a quarter, ... where a full render at as few samples would "
                                  "lose at most a fifth of the target's squared error (docs/BLENDER.md)");
                    app->add_option("--preview-samples", f->previewSamples,
-                                   "samples of the guides and preview render (0: a sixteenth of --samples, at least 8)")
+                                   "samples of the guides and preview render (0: a sixteenth of --samples, at least 16)")
                        ->transform(Integer(0, 1 << 24));
                    app->add_option("--pool-preview", f->poolPreview,
                                    "on: each exact pixel ends as the inverse-variance mean of its samples and its "

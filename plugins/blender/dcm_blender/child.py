@@ -27,7 +27,7 @@ def parse_args(argv):
     ap = argparse.ArgumentParser(prog="dcm_blender child")
     ap.add_argument("--samples", type=int, default=0, help="Cycles samples of the exact pixels (0: the file's)")
     ap.add_argument("--preview-samples", type=int, default=0,
-                    help="samples of the guides and preview render (0: a sixteenth of --samples, at least 8)")
+                    help="samples of the guides and preview render (0: a sixteenth of --samples, at least 16)")
     ap.add_argument("--frame", type=int, default=None, help="frame to render (default: the file's current)")
     ap.add_argument("--view-layer", default="", help="view layer to render (default: the first that renders)")
     ap.add_argument("--threads", type=int, default=0, help="render threads (0: Blender's choice)")

@@ -186,9 +186,10 @@ class Session:
         cy = sc.cycles
         self.samples = a.samples if a.samples > 0 else cy.samples
         self.file_samples = self.samples  # the run's: exact_samples may lower self.samples
-        # At least 8: the preview's error estimate squares differences through the sRGB
-        # curve, whose bias at 4 samples alone costs 35-42 dB (docs/BLENDER.md).
-        self.preview_samples = min(self.samples, a.preview_samples or max(8, self.samples // 16))
+        # At least 16: below it the preview's noise costs what the correction draws from
+        # it (and its error estimate squares differences through the sRGB curve, whose
+        # bias grows as the halves' variance squared; docs/BLENDER.md).
+        self.preview_samples = min(self.samples, a.preview_samples or max(16, self.samples // 16))
         if cy.use_adaptive_sampling:
             self.notes.append("adaptive sampling off: every pixel gets %d samples" % self.samples)
             c.set(cy, "use_adaptive_sampling", False)
