@@ -282,9 +282,9 @@ Status CorrectTowardPreview(SampleProvider& preview, int radius, int downsample,
       // noise; an exact pixel's is its own: the exact share of the preview's
       // variance (pooled: the pooled share), taken through the display at the
       // pixel's value in the result (the interpolated one where the round's
-      // value is filled in later: as good for the slope). A share of the preview's display
-      // variance would understate it where the preview's far larger noise
-      // meets the curve's bend and clip.
+      // value is filled in later: as good for the slope). A share of the
+      // preview's display variance would understate it where the preview's
+      // far larger noise meets the curve's bend and clip.
       std::vector<double> d;
       d.reserve(n);
       std::vector<double> over(excess ? n : 0), noises(excess ? n : 0);

@@ -2,7 +2,6 @@
 // (lib/include/dcm/preview_pooling.h).
 #include "dcm/preview_pooling.h"
 
-#include <algorithm>
 #include <cmath>
 #include <new>
 #include <string>
