@@ -32,11 +32,8 @@ Status PoolExactWithPreview(SampleProvider& preview, double exactShare, int down
                          std::to_string(H));
   try {
     std::vector<Point2i> exact;
-    for (size_t i = 0; i < n; ++i) {
-      const SampleReason r = rec->sampleMap[i];
-      if (r != SampleReason::kInterpolated && r != SampleReason::kPreviewStandIn)
-        exact.push_back({int(i % size_t(W)), int(i / size_t(W))});
-    }
+    for (size_t i = 0; i < n; ++i)
+      if (HoldsExactSample(rec->sampleMap[i])) exact.push_back({int(i % size_t(W)), int(i / size_t(W))});
     if (exact.empty()) return Status::Ok();
     std::vector<ExactSample> p(exact.size());
     if (Status s = preview.Evaluate(exact, SampleRequest{}, p); !s.ok())

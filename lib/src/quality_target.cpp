@@ -377,7 +377,7 @@ std::vector<double> ErrorProxy(const Reconstruction& rec, const QualityGoal& goa
       for (int wy = y * s; all && wy < std::min(rec.workHeight, (y + 1) * s); ++wy)
         for (int wx = x * s; all && wx < std::min(rec.workWidth, (x + 1) * s); ++wx) {
           const SampleReason why = rec.sampleMap[size_t(wy) * size_t(rec.workWidth) + size_t(wx)];
-          all = why != SampleReason::kInterpolated && why != SampleReason::kPreviewStandIn;
+          all = HoldsExactSample(why);
         }
       if (all) proxy[size_t(y) * size_t(outW) + size_t(x)] = 0;
     }
@@ -687,7 +687,7 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   const int workW = caps.width;
   auto sampledBy = [](const Reconstruction& rec) -> SampledFn {
     return [&rec](size_t i) {
-      return rec.sampleMap[i] != SampleReason::kInterpolated && rec.sampleMap[i] != SampleReason::kPreviewStandIn;
+      return HoldsExactSample(rec.sampleMap[i]);
     };
   };
   const SampledFn asked = [&cache](size_t i) { return cache.EngineAsked(i); };

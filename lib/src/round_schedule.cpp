@@ -105,7 +105,7 @@ void MarkStandIns(const std::vector<Point2i>& wanted, Reconstruction* out) {
   const int W = out->workWidth;
   for (const Point2i& p : wanted) {
     SampleReason& reason = out->sampleMap[size_t(p.y) * size_t(W) + size_t(p.x)];
-    if (reason != SampleReason::kInterpolated && reason != SampleReason::kPreviewStandIn) {
+    if (HoldsExactSample(reason)) {
       --out->stats.byReason[size_t(reason)];
       --out->stats.exactPixels;
     }

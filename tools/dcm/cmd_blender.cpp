@@ -116,7 +116,6 @@ std::string PercentDecoded(const std::string& s) {
   return out;
 }
 
-
 /// Times every call of the exact provider: a round each with the preview schedule.
 class TimedProvider final : public SampleProvider {
  public:

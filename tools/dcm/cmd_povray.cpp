@@ -63,7 +63,6 @@ struct PovrayFlags {
   toolkit::ExrFormat exr;
 };
 
-
 int Fail(const std::string& message, int code = kExitFailure) {
   std::cerr << "dcm povray: error: " << message << "\n";
   return code;

@@ -20,9 +20,9 @@ namespace dcm {
 /// pooled pixel's variance as a share of the preview's.
 double PreviewPoolWeight(double exactShare);
 
-/// Moves every exact pixel of `rec` (any reason but kInterpolated and
-/// kPreviewStandIn) toward `preview`'s value there by PreviewPoolWeight(
-/// exactShare), and makes `rec->image` again, downsampled by `downsample`.
+/// Moves every exact pixel of `rec` (HoldsExactSample) toward `preview`'s
+/// value there by PreviewPoolWeight(exactShare), and makes `rec->image`
+/// again, downsampled by `downsample`.
 /// A denoised exact value (noisy samples) takes its raw sample's weight: its
 /// error is more than its reduced variance, and the weight of that variance
 /// alone did worse (docs/TUNING.md).

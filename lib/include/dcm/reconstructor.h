@@ -38,6 +38,13 @@ enum class SampleReason : uint8_t {
 inline constexpr int kSampleReasonCount = int(SampleReason::kCount);
 std::string_view ToString(SampleReason);
 
+/// Whether a pixel of this reason holds an exact sample in the result: any
+/// reason but kInterpolated and kPreviewStandIn (a wanted pixel left at its
+/// preview value).
+inline bool HoldsExactSample(SampleReason r) {
+  return r != SampleReason::kInterpolated && r != SampleReason::kPreviewStandIn;
+}
+
 /// How a block was finally reconstructed.
 enum class BlockType : uint8_t {
   kSmooth,       ///< bilinear from the four corners
