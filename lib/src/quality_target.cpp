@@ -903,8 +903,14 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   }
   // The render's own error does not depend on the search: every draw counts.
   report->renderEstimate = RenderEstimate(v, goal);
-  report->estimate = best->estimate;
+  report->validationEstimate = best->estimate;
   report->secondEstimate = best->second;
+  // The more pessimistic judge speaks: a few validation pixels miss error
+  // that a few pixels carry (where they see none beyond the noise, their
+  // estimate is +inf), the preview's estimate misses error its noise hides.
+  const bool secondLower = !std::isnan(best->second.low) && best->second.psnr < best->estimate.psnr;
+  report->estimate = secondLower ? best->second : best->estimate;
+  report->estimateSource = secondLower ? EstimateSource::kPreview : EstimateSource::kValidation;
   report->levels = std::move(best->levels);
   report->threshold = best->threshold;
   report->targetReached = target <= 0 || meets(*best);

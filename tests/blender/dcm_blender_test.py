@@ -224,9 +224,15 @@ def variance(dcm, blender, src, tmp):
     j = json.load(open(stats))
     assert j["blender"]["variance"] == "halves" and j["settings"]["noisy"], (j["blender"], j["settings"])
     assert j["quality"]["target_render"] and j["estimated_render_psnr"] > 0, j
-    # The preview's estimate, the validation's second judge, in the summary where the stats have it.
-    second = j["quality"].get("second_estimate")
-    assert second and "the second judge, %.2f dB" % second["psnr"] in so, (second, so)
+    # Two judges, the validation and the preview's estimate: the lower is reported (JSON null: +inf),
+    # the summary names the other.
+    judges = {"preview": j["quality"].get("second_estimate"), "validation": j["quality"].get("validation_estimate")}
+    assert all(judges.values()), j["quality"]
+    psnr = {k: math.inf if v["psnr"] is None else v["psnr"] for k, v in judges.items()}
+    lower = min(psnr, key=psnr.get)
+    other = "validation" if lower == "preview" else "preview"
+    assert j["estimated_psnr_from"] == lower and j["estimated_psnr"] == psnr[lower], (j, psnr)
+    assert "the lower of two judges, the %s's estimate %.2f dB" % (other, psnr[other]) in so, (psnr, so)
     print("%.1f %% exact; %.0f %% of them differ between the seeds; %d denoised; auto: noise %.1f dB, %s; first "
           "round %d pixels (%d with an exact preview); with it, the preview's own PSNR %.1f dB, estimate %s"
           % (100 * is_exact.mean(), 100 * differ, runs["on"][2]["denoised_samples"],

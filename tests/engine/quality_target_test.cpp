@@ -418,6 +418,45 @@ TEST(QualityTarget, ASecondJudgeBelowTheTargetKeepsTheSearchGoing) {
   }
 }
 
+TEST(QualityTarget, TheLowerOfTwoJudgesIsReported) {
+  // Noisy samples with their variance and a second judge that does not hold
+  // the search back (its lower bound at the target): the runs are the same,
+  // and the report carries the lower point estimate of the two, each judge's
+  // own kept beside it.
+  const int n = 128;
+  const double target = 30;
+  auto run = [&](std::function<PsnrEstimate()> second) {
+    AnalyticProvider exact(n, n, FurnishedScene(n, n));
+    NoisyProvider noisy(exact, {0.05f, 0.002f, 1, true});
+    QualityGoal goal;
+    goal.targetPsnr = target;
+    goal.secondEstimate = std::move(second);
+    Reconstruction rec;
+    QualityReport report;
+    EXPECT_TRUE(ReconstructToQuality(noisy, ReconstructionOptions{}, goal, &rec, &report).ok());
+    return report;
+  };
+  const QualityReport alone = run({});
+  const double v = alone.estimate.psnr;
+  ASSERT_GT(v, target + 1) << "room below the validation's estimate for a lower judge at the target";
+  EXPECT_EQ(alone.estimateSource, EstimateSource::kValidation);
+  for (double offset : {-1.0, +1.0}) {
+    const PsnrEstimate judge{v + offset, target, v + offset + 1};
+    const QualityReport both = run([&] { return judge; });
+    EXPECT_EQ(both.runs, alone.runs);
+    EXPECT_EQ(both.validationEstimate.psnr, v);
+    EXPECT_EQ(both.secondEstimate.psnr, judge.psnr);
+    if (offset < 0) {
+      EXPECT_EQ(both.estimate.psnr, judge.psnr);
+      EXPECT_EQ(both.estimate.low, judge.low);
+      EXPECT_EQ(both.estimateSource, EstimateSource::kPreview);
+    } else {
+      EXPECT_EQ(both.estimate.psnr, v);
+      EXPECT_EQ(both.estimateSource, EstimateSource::kValidation);
+    }
+  }
+}
+
 TEST(QualityTarget, WithoutVarianceTheEstimateIsAgainstTheFullRender) {
   // The same noisy samples without their variance: the estimate keeps its
   // meaning, the PSNR against the noisy full render, and reports no render

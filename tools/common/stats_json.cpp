@@ -186,9 +186,12 @@ void AddQualityJson(const QualityReport& r, double targetPsnr, double budget, nl
                      {"threshold", r.threshold < 0 ? nlohmann::json(nullptr) : nlohmann::json(r.threshold)},
                      {"levels", levels}};
   if (targetPsnr < 0) (*j)["quality"]["target_render"] = true;
-  if (std::isfinite(r.secondEstimate.psnr))
-    (*j)["quality"]["second_estimate"] = {
-        {"psnr", r.secondEstimate.psnr}, {"low", r.secondEstimate.low}, {"high", r.secondEstimate.high}};
+  if (std::isfinite(r.secondEstimate.psnr)) {
+    // Both judges, where there are two; estimated_psnr is the lower.
+    auto judge = [](const PsnrEstimate& e) { return nlohmann::json{{"psnr", e.psnr}, {"low", e.low}, {"high", e.high}}; };
+    (*j)["quality"]["second_estimate"] = judge(r.secondEstimate);
+    (*j)["quality"]["validation_estimate"] = judge(r.validationEstimate);
+  }
 }
 
 std::optional<bool> CloserThanRender(const QualityReport& r) {

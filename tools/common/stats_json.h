@@ -50,7 +50,9 @@ void AddEstimateMetadata(const PsnrEstimate& estimate, Metadata* metadata);
 /// estimated_psnr_confidence) and quality {target_psnr, budget, target_reached,
 /// confirmed, budget_bound, exact_pixels, exact_fraction, validation_pixels,
 /// validation_exact_pixels, runs, threshold, levels [{level, psnr, low, high}],
-/// second_estimate {psnr, low, high} where QualityReport::secondEstimate is};
+/// second_estimate and validation_estimate {psnr, low, high} where
+/// QualityReport::secondEstimate is (estimated_psnr is then the lower of the
+/// two, estimated_psnr_from names it)};
 /// a target or budget of 0 is null (not asked). A negative targetPsnr is
 /// --target-psnr render: target_psnr is then the render's estimate aimed at,
 /// and quality.target_render true. With samples of known variance

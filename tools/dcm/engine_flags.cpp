@@ -311,10 +311,11 @@ std::string QualityLine(const QualityReport& r, const EngineFlags& f) {
   std::string target;
   if (f.targetPsnr) target = "; --target-psnr " + TargetName(r, f) + (r.targetReached ? " reached" : " NOT reached");
   if (r.budgetBound) target += "; --budget " + G(*f.budget) + " bound";
+  const bool fromPreview = r.estimateSource == EstimateSource::kPreview;
   char from[64];
-  if (r.estimateSource == EstimateSource::kPreview) std::snprintf(from, sizeof from, "from the preview");
+  if (fromPreview && r.validationExactPixels == 0) std::snprintf(from, sizeof from, "from the preview");
   else
-    std::snprintf(from, sizeof from, "validation %.2f %%",
+    std::snprintf(from, sizeof from, "%svalidation %.2f %%", fromPreview ? "from the preview; " : "",
                   r.totalPixels ? 100.0 * double(r.validationExactPixels) / double(r.totalPixels) : 0.0);
   std::snprintf(buf, sizeof buf,
                 "estimated PSNR %.2f dB (%.0f %% interval %.2f to %.2f%s), %.2f %% exact pixels in %d runs "
@@ -323,9 +324,11 @@ std::string QualityLine(const QualityReport& r, const EngineFlags& f) {
                 r.threshold < 0 ? "none (full evaluation)" : G(r.threshold).c_str());
   std::string line = buf;
   if (std::isfinite(r.secondEstimate.psnr)) {
-    char second[128];
-    std::snprintf(second, sizeof second, "; the preview's estimate, the second judge, %.2f dB (%.2f to %.2f)",
-                  r.secondEstimate.psnr, r.secondEstimate.low, r.secondEstimate.high);
+    // Two judges: the line names the one not reported.
+    const PsnrEstimate& other = fromPreview ? r.validationEstimate : r.secondEstimate;
+    char second[160];
+    std::snprintf(second, sizeof second, "; the lower of two judges, the %s's estimate %.2f dB (%.2f to %.2f)",
+                  fromPreview ? "validation" : "preview", other.psnr, other.low, other.high);
     line += second;
   }
   if (!r.againstConverged) return line;

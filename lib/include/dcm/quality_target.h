@@ -112,12 +112,19 @@ enum class EstimateSource : uint8_t {
 
 /// What ReconstructToQuality delivered and what it cost.
 struct QualityReport {
-  /// Of the result: with a target, from a last draw of validation pixels that
-  /// took no part in the search (`confirmed`); else from the search's.
-  /// Against the converged image where `againstConverged`, else against the
-  /// full render (at the samples the provider gives).
+  /// Of the result: the validation's (`validationEstimate`), or where a
+  /// second judge (QualityGoal::secondEstimate) has an opinion and a lower
+  /// point estimate, the second judge's (`estimateSource` kPreview): the
+  /// search meets a target only where both lower bounds do, and each judge
+  /// misses error the other sees (docs/QUALITY.md, "Two judges"). Against
+  /// the converged image where `againstConverged`, else against the full
+  /// render (at the samples the provider gives).
   PsnrEstimate estimate;
   EstimateSource estimateSource = EstimateSource::kValidation;
+  /// The validation pixels' estimate of the result: with a target, from a
+  /// last draw that took no part in the search (`confirmed`); else from the
+  /// search's.
+  PsnrEstimate validationEstimate;
   /// The samples carry their variance: `estimate` is against the converged
   /// image (the noise of the exact values taken out) and `renderEstimate` is
   /// filled (docs/QUALITY.md, "Noise").
