@@ -140,6 +140,7 @@ class PlanningProvider : public SampleProvider {
     return true;
   }
   static int64_t Counted(Reconstruction* rec, int64_t kept) {
+    rec->stats.byReason[size_t(SampleReason::kInterpolated)] -= kept;
     rec->stats.byReason[size_t(SampleReason::kRendered)] += kept;
     rec->stats.exactPixels += kept;
     return kept;

@@ -321,6 +321,9 @@ TEST(RoundSchedule, TheErrorRoundRendersNoPixelTwice) {
   EXPECT_EQ(exact.MostEvaluationsOfAPixel(), 1);
   EXPECT_EQ(asked, evaluated);
   EXPECT_EQ(rec.stats.byReason[size_t(SampleReason::kRendered)], stats.errorRoundPixels);
+  int64_t counted = 0;
+  for (int64_t n : rec.stats.byReason) counted += n;
+  EXPECT_EQ(counted, int64_t(N) * N) << "every pixel counted once, a rendered one no longer as interpolated";
 }
 
 TEST(RoundSchedule, ThePreviewCorrectionCostsLittleWhereThePreviewIsMuchNoisier) {
