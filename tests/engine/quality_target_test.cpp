@@ -374,6 +374,21 @@ TEST(QualityTarget, NoisyEstimateIsAgainstTheConvergedImage) {
   }
 }
 
+/// The furnished scene, 128², noisy samples (with their variance or not),
+/// searched to `target` with `second` as the validation's second judge.
+QualityReport SearchWithSecondJudge(bool variance, double target, std::function<PsnrEstimate()> second) {
+  const int n = 128;
+  AnalyticProvider exact(n, n, FurnishedScene(n, n));
+  NoisyProvider noisy(exact, {0.05f, 0.002f, 1, variance});
+  QualityGoal goal;
+  goal.targetPsnr = target;
+  goal.secondEstimate = std::move(second);
+  Reconstruction rec;
+  QualityReport report;
+  EXPECT_TRUE(ReconstructToQuality(noisy, ReconstructionOptions{}, goal, &rec, &report).ok());
+  return report;
+}
+
 TEST(QualityTarget, ASecondJudgeBelowTheTargetKeepsTheSearchGoing) {
   // Noisy samples with their variance, a target the validation meets at the
   // first run: a second estimate whose lower bound falls short of it for the
@@ -381,20 +396,11 @@ TEST(QualityTarget, ASecondJudgeBelowTheTargetKeepsTheSearchGoing) {
   // any second estimate where the samples carry no variance (the validation
   // is then against the full render, the second against the converged
   // image), changes nothing.
-  const int n = 128;
   const double target = 30;
   for (bool variance : {true, false}) {
     int calls = 0;
     auto run = [&](std::function<PsnrEstimate()> second) {
-      AnalyticProvider exact(n, n, FurnishedScene(n, n));
-      NoisyProvider noisy(exact, {0.05f, 0.002f, 1, variance});
-      QualityGoal goal;
-      goal.targetPsnr = target;
-      goal.secondEstimate = std::move(second);
-      Reconstruction rec;
-      QualityReport report;
-      EXPECT_TRUE(ReconstructToQuality(noisy, ReconstructionOptions{}, goal, &rec, &report).ok());
-      return report;
+      return SearchWithSecondJudge(variance, target, std::move(second));
     };
     const QualityReport alone = run({});
     ASSERT_TRUE(alone.targetReached);
@@ -423,19 +429,8 @@ TEST(QualityTarget, TheLowerOfTwoJudgesIsReported) {
   // the search back (its lower bound at the target): the runs are the same,
   // and the report carries the lower point estimate of the two, each judge's
   // own kept beside it.
-  const int n = 128;
   const double target = 30;
-  auto run = [&](std::function<PsnrEstimate()> second) {
-    AnalyticProvider exact(n, n, FurnishedScene(n, n));
-    NoisyProvider noisy(exact, {0.05f, 0.002f, 1, true});
-    QualityGoal goal;
-    goal.targetPsnr = target;
-    goal.secondEstimate = std::move(second);
-    Reconstruction rec;
-    QualityReport report;
-    EXPECT_TRUE(ReconstructToQuality(noisy, ReconstructionOptions{}, goal, &rec, &report).ok());
-    return report;
-  };
+  auto run = [&](std::function<PsnrEstimate()> second) { return SearchWithSecondJudge(true, target, std::move(second)); };
   const QualityReport alone = run({});
   const double v = alone.estimate.psnr;
   ASSERT_GT(v, target + 1) << "room below the validation's estimate for a lower judge at the target";
