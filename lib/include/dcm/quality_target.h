@@ -107,7 +107,8 @@ struct LevelEstimate {
 /// Where an estimate of the result's PSNR comes from.
 enum class EstimateSource : uint8_t {
   kValidation,  ///< exactly evaluated validation pixels (ReconstructToQuality)
-  kPreview,     ///< the preview at every pixel (ReconstructToTargetFromPreview, dcm/preview_target.h)
+  kPreview,     ///< the preview at every pixel (ReconstructToTargetFromPreview, dcm/preview_target.h; the
+                ///< validation search's second judge where it is the lower)
 };
 
 /// What ReconstructToQuality delivered and what it cost.
