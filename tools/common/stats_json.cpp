@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <string>
+#include <utility>
 
 #include "image_io.h"
 
@@ -151,6 +152,8 @@ void AddEstimateJson(const PsnrEstimate& e, double confidence, nlohmann::json* j
   (*j)["estimated_psnr_confidence"] = confidence;
 }
 
+nlohmann::json EstimateJson(const PsnrEstimate& e) { return {{"psnr", e.psnr}, {"low", e.low}, {"high", e.high}}; }
+
 void AddEstimateMetadata(const PsnrEstimate& e, Metadata* m) {
   for (const auto& [name, v] : {std::pair<const char*, double>{"dcm:estimated_psnr", e.psnr},
                                 {"dcm:estimated_psnr_low", e.low},
@@ -171,8 +174,11 @@ void AddQualityJson(const QualityReport& r, double targetPsnr, double budget, nl
     if (const std::optional<bool> closer = CloserThanRender(r)) (*j)["closer_than_render"] = *closer;
   }
   nlohmann::json levels = nlohmann::json::array();
-  for (const LevelEstimate& l : r.levels)
-    levels.push_back({{"level", l.level}, {"psnr", l.estimate.psnr}, {"low", l.estimate.low}, {"high", l.estimate.high}});
+  for (const LevelEstimate& l : r.levels) {
+    nlohmann::json level = EstimateJson(l.estimate);
+    level["level"] = l.level;
+    levels.push_back(std::move(level));
+  }
   (*j)["quality"] = {{"target_psnr", orNull(targetPsnr < 0 ? r.targetPsnr : targetPsnr)},
                      {"budget", orNull(budget)},
                      {"target_reached", r.targetReached},
@@ -188,9 +194,8 @@ void AddQualityJson(const QualityReport& r, double targetPsnr, double budget, nl
   if (targetPsnr < 0) (*j)["quality"]["target_render"] = true;
   if (std::isfinite(r.secondEstimate.psnr)) {
     // Both judges, where there are two; estimated_psnr is the lower.
-    auto judge = [](const PsnrEstimate& e) { return nlohmann::json{{"psnr", e.psnr}, {"low", e.low}, {"high", e.high}}; };
-    (*j)["quality"]["second_estimate"] = judge(r.secondEstimate);
-    (*j)["quality"]["validation_estimate"] = judge(r.validationEstimate);
+    (*j)["quality"]["second_estimate"] = EstimateJson(r.secondEstimate);
+    (*j)["quality"]["validation_estimate"] = EstimateJson(r.validationEstimate);
   }
 }
 

@@ -41,6 +41,9 @@ nlohmann::json RunToJson(const Reconstruction& r, const std::string& method, con
 /// estimated_psnr_confidence, `confidence`).
 void AddEstimateJson(const PsnrEstimate& estimate, double confidence, nlohmann::json* j);
 
+/// {psnr, low, high} of one estimate: a run's, a level's, a judge's.
+nlohmann::json EstimateJson(const PsnrEstimate& estimate);
+
 /// Adds dcm:estimated_psnr, dcm:estimated_psnr_low, dcm:estimated_psnr_high
 /// (finite values only) to EXR metadata.
 void AddEstimateMetadata(const PsnrEstimate& estimate, Metadata* metadata);

@@ -651,19 +651,19 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       j["quality"]["target_default"] = defaultGoal && targetFromPreview;
       if (targetFromPreview) {
         nlohmann::json ladder = nlohmann::json::array();
-        for (size_t k = 0; k < ptarget.thresholds.size(); ++k)
-          ladder.push_back({{"threshold", ptarget.thresholds[k]},
-                            {"psnr", ptarget.estimates[k].psnr},
-                            {"low", ptarget.estimates[k].low},
-                            {"high", ptarget.estimates[k].high}});
+        for (size_t k = 0; k < ptarget.thresholds.size(); ++k) {
+          nlohmann::json run = toolkit::EstimateJson(ptarget.estimates[k]);
+          run["threshold"] = ptarget.thresholds[k];
+          ladder.push_back(std::move(run));
+        }
         j["quality"]["ladder"] = ladder;
         nlohmann::json predictions = nlohmann::json::array();
-        for (const PreviewTargetStats::Prediction& p : ptarget.predictions)
-          predictions.push_back({{"threshold", p.threshold},
-                                 {"pixels", p.pixels},
-                                 {"psnr", p.estimate.psnr},
-                                 {"low", p.estimate.low},
-                                 {"high", p.estimate.high}});
+        for (const PreviewTargetStats::Prediction& p : ptarget.predictions) {
+          nlohmann::json prediction = toolkit::EstimateJson(p.estimate);
+          prediction["threshold"] = p.threshold;
+          prediction["pixels"] = p.pixels;
+          predictions.push_back(std::move(prediction));
+        }
         j["quality"]["start_predictions"] = predictions;
       } else if (schedule == RoundSchedule::kPreview) {
         j["quality"]["searches"] = qrounds.passes;
