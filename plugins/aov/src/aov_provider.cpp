@@ -702,46 +702,29 @@ bool NeighbourResidual(const Data& d, const std::vector<RGB>& v, int x, int y, R
   return true;
 }
 
-/// Per pixel, the mean of `v` over the (2r+1)^2 window of pixels on the same
-/// surface (equal object and shader IDs where the inputs carry them).
-std::vector<RGB> SurfaceWindowMean(const std::vector<RGB>& v, const Data& d, int r) {
-  return dcm::SurfaceWindowMean(v, d.width(), d.height(), d.objectId, d.shaderId, r);
-}
-
-/// The variance estimate of AovOptions::estimateVariance, in L units.
+/// The variance estimate of AovOptions::estimateVariance, in L units: with
+/// the texture split, of L_i (the texture divided out) times tau^2 plus of L_c,
+/// whose noise hardly correlates with L_i's (0.1 on the tuning room);
+/// without it, of L.
 std::vector<RGB> EstimateVarianceFromData(const Data& d) {
   const int W = d.width(), H = d.height();
-  const bool split = !d.Li.empty() && !d.tau.empty();
-  const std::vector<RGB>& v = split ? d.Li : d.L;
-  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-  std::vector<RGB> r2(v.size(), RGB::Gray(kNaN));
-  for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x) {
-      const size_t i = size_t(y) * size_t(W) + size_t(x);
-      if (!IsFinite(v[i])) continue;
-      RGB res;
-      int count = 0;
-      if (!NeighbourResidual(d, v, x, y, &res, &count)) continue;
-      // r = v - mean of k neighbours has variance sigma^2 (1 + 1/k).
-      r2[i] = res * res * (1.f / (1.f + 1.f / float(count)));
-    }
-  std::vector<RGB> var = SurfaceWindowMean(r2, d, 2);
-  if (split)
-    for (size_t i = 0; i < var.size(); ++i) var[i] = var[i] * d.tau[i] * d.tau[i];
+  if (d.Li.empty() || d.Lc.empty() || d.tau.empty())
+    return dcm::VarianceFromOneRender(d.L, W, H, d.objectId, d.shaderId);
+  std::vector<RGB> var = dcm::VarianceFromOneRender(d.Li, W, H, d.objectId, d.shaderId);
+  const std::vector<RGB> c = dcm::VarianceFromOneRender(d.Lc, W, H, d.objectId, d.shaderId);
+  for (size_t i = 0; i < var.size(); ++i) var[i] = var[i] * d.tau[i] * d.tau[i] + c[i];
   return var;
 }
 
 /// The display-referred PSNR that the samples' noise alone would cost
 /// (AovOptions::detectNoise): the noise's relative variance is the median over
-/// pixels of the squared residual against the same-surface 4-neighbours (as
-/// EstimateVarianceFromData, in L_i: the split's, the texture divided out)
-/// relative to the squared value, over 0.455 (the median of a chi-square of
-/// one degree of freedom:
-/// a renderer's noise is nearly the same in R, G and B); applied to L through
-/// the slope of the sRGB encoding. The median, where the estimate of the
-/// variance takes the mean: real detail the guides do not explain (hard shadow
-/// edges, aliased geometry) is large at few pixels, noise is at every pixel.
-/// +Inf when no pixel shows any.
+/// the image's pixels of the squared residual against the same-surface
+/// 4-neighbours, in L_i (the split's, the texture divided out), relative to
+/// the squared value, over 0.455 (the median of a chi-square of one degree of
+/// freedom: a renderer's noise is nearly the same in R, G and B); applied to L
+/// through the slope of the sRGB encoding. One median over the image: real
+/// detail the guides do not explain (hard shadow edges, aliased geometry) is
+/// large at few pixels, noise is at every pixel. +Inf when no pixel shows any.
 double NoisePsnrFromData(const Data& d) {
   const int W = d.width(), H = d.height();
   const std::vector<RGB>& v = d.Li;  // the caller's condition: the split, the texture divided out

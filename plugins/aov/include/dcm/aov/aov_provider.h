@@ -113,13 +113,14 @@ struct AovOptions {
   /// bright as mid-grey on the display (calibration: docs/TUNING.md).
   float highlightLevel = 1.5f;
   /// Dense mode, one noisy render and no variance channel: the variance is
-  /// estimated from the data, as the mean over a 5x5 window on the same
-  /// surface of r^2 / 1.25, r = the pixel minus the mean of its same-surface
-  /// 4-neighbours (1.25 sigma^2 for independent noise), in L_i when the split
-  /// is available (the texture divided out), else in L. It fails where the
-  /// image has real detail at the pixel scale that the guides do not explain
-  /// (an untextured pattern, hair, aliased geometry inside one object): that
-  /// detail is taken for noise and smoothed over.
+  /// estimated from the data (dcm::VarianceFromOneRender: per pixel the
+  /// residual along the direction the image does not change in, its median
+  /// over a 7x7 window on the same surface), of L_i times tau^2 plus of L_c
+  /// when the split is available (the texture divided out), else of L. It
+  /// fails where the image has real detail at the pixel scale that the guides
+  /// do not explain over half of a window (an untextured pattern, hair,
+  /// grass, aliased geometry inside one object): that detail is taken for
+  /// noise and smoothed over.
   bool estimateVariance = false;
   /// Dense mode with the texture split (L_i, tau), and no variance channel,
   /// second render or estimateVariance:
