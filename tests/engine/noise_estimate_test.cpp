@@ -212,6 +212,45 @@ TEST(NoiseEstimate, AnEdgeALineAndSmallHighlightsAreNotNoise) {
   EXPECT_GT(OneRenderRatio(windowMean, truth, share, nearLine), 10.0);
 }
 
+TEST(NoiseEstimate, OneRenderKeepsNonFiniteAndHugeValuesInTheirPixel) {
+  // A NaN, an Inf and a finite 1e30 in a noisy grey: the NaN and the Inf get
+  // no variance and give none; the huge value's own is finite. Beyond 6 px
+  // (the blur, a pair, the choice over 3x3, the 7x7 median) nothing changes,
+  // bit for bit; within it every pixel's stays finite and their mean within
+  // 25 % of the truth (one window median holds 49 values: the few that cross
+  // the odd pixel or lose a direction hardly move it).
+  const std::vector<RGB> truth(size_t(kOneW) * kOneH, RGB::Gray(0.5f));
+  const std::vector<double> share(truth.size(), 1e-4);
+  const std::vector<RGB> clean = OneRender(truth, share, 0.9, 9);
+  std::vector<RGB> v = clean;
+  const std::vector<Point2i> odd{{40, 40}, {100, 40}, {70, 100}};
+  v[size_t(40) * kOneW + 40] = RGB::Gray(std::numeric_limits<float>::quiet_NaN());
+  v[size_t(40) * kOneW + 100] = RGB::Gray(std::numeric_limits<float>::infinity());
+  v[size_t(100) * kOneW + 70] = RGB::Gray(1e30f);
+  const std::vector<RGB> estimate = VarianceFromOneRender(v, kOneW, kOneH, {}, {});
+  const std::vector<RGB> reference = VarianceFromOneRender(clean, kOneW, kOneH, {}, {});
+  EXPECT_EQ(estimate[size_t(40) * kOneW + 40].g, 0.f);
+  EXPECT_EQ(estimate[size_t(40) * kOneW + 100].g, 0.f);
+  EXPECT_TRUE(IsFinite(estimate[size_t(100) * kOneW + 70]));
+  double sum = 0;
+  int near = 0;
+  for (int y = 0; y < kOneH; ++y)
+    for (int x = 0; x < kOneW; ++x) {
+      const size_t i = size_t(y) * kOneW + size_t(x);
+      int reach = kOneW;
+      for (const Point2i& p : odd) reach = std::min(reach, std::max(std::abs(x - p.x), std::abs(y - p.y)));
+      if (reach == 0) continue;
+      ASSERT_TRUE(IsFinite(estimate[i])) << x << ", " << y;
+      if (reach > 6) {
+        ASSERT_EQ(estimate[i].g, reference[i].g) << x << ", " << y;
+      } else {
+        sum += estimate[i].g / (share[i] * (0.5 + kRelativeVarianceFloor));
+        ++near;
+      }
+    }
+  EXPECT_NEAR(sum / near, 1.0, 0.25);
+}
+
 TEST(NoiseEstimate, OneRenderFollowsTheNoiseAcrossTheImage) {
   // Sixteen times the noise share in the right half (a shadow lit by
   // bounces beside a direct light): each half's estimate is its own, within
