@@ -754,7 +754,8 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
 
   const double threshold = double(ResolveSettings(options, caps).contrastThreshold);
   // Contrasts are at most 1 but for the display-weighted metric's brightest sets.
-  const double t0 = limit > 0 ? std::min(kStartFactorBudget * threshold, 1.0) : kStartFactor * threshold;
+  const double t0 = limit > 0 && !goal.budgetFromThreshold ? std::min(kStartFactorBudget * threshold, 1.0)
+                                                           : kStartFactor * threshold;
   auto meets = [&](const Run& r) {
     return target > 0 && r.estimate.low >= target && !(r.second.low < target);
   };

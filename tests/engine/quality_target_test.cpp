@@ -290,6 +290,41 @@ TEST(QualityTarget, APlateauEndsTheDescentOnlyWithoutABudget) {
   }
 }
 
+TEST(QualityTarget, ABudgetFromTheThresholdSearchesAsWithoutOneUntilItBinds) {
+  // budgetFromThreshold: where the search ends within the budget it is the
+  // search without one, run for run (the first at the options' threshold);
+  // a plain budget starts 16x coarser and ends elsewhere. Where the budget
+  // binds, it is never exceeded and says so.
+  const int N = 256;
+  auto run = [&](double target, double budget, bool fromThreshold) {
+    AnalyticProvider provider(N, N, FurnishedScene(N, N));
+    QualityGoal goal;
+    goal.targetPsnr = target;
+    goal.budget = budget;
+    goal.budgetFromThreshold = fromThreshold;
+    Outcome r = RunGoal(provider, ReconstructionOptions{}, goal);
+    EXPECT_EQ(provider.MaxEvaluationsOfOnePixel(), 1);
+    if (budget > 0) {
+      EXPECT_LE(provider.TotalEvaluations(), int64_t(budget * N * N));
+    }
+    return r;
+  };
+  const Outcome free = run(40, 0, false), bounded = run(40, 0.35, true), plain = run(40, 0.35, false);
+  ASSERT_TRUE(free.report.targetReached);
+  EXPECT_TRUE(bounded.report.targetReached);
+  EXPECT_FALSE(bounded.report.budgetBound);
+  EXPECT_EQ(bounded.report.runs, free.report.runs);
+  EXPECT_EQ(bounded.report.threshold, free.report.threshold);
+  EXPECT_EQ(bounded.report.exactPixels, free.report.exactPixels);
+  EXPECT_EQ(bounded.rec.image, free.rec.image);
+  EXPECT_NE(plain.report.exactPixels, free.report.exactPixels);
+  // A budget below what the target needs: spent, never passed, bound.
+  const Outcome tight = run(70, 0.1, true);
+  EXPECT_FALSE(tight.report.targetReached) << tight.report.estimate.psnr;
+  EXPECT_TRUE(tight.report.budgetBound) << tight.report.exactFraction();
+  EXPECT_GT(tight.report.exactFraction(), 0.5 * 0.1);
+}
+
 TEST(QualityTarget, SupersampledTargetIsMetAtOutputResolution) {
   const int N = 256;
   AnalyticProvider provider(N, N, FurnishedScene(N, N));
