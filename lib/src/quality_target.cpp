@@ -35,13 +35,6 @@ constexpr double kStartFactor = 1.0;
 /// samples spent, and the coarsest run's samples are the ones every later run
 /// needs (the corners, the probes), so the first run must fit.
 constexpr double kStartFactorBudget = 16.0;
-/// But a budget of at least this share beside a target bounds the search for
-/// the target rather than being what to spend, and the search starts where it
-/// would without one: a coarser start costs runs (render calls) and, where
-/// the search stops early, quality (docs/QUALITY.md). The default threshold's
-/// run took 5-20 % of the pixels on the tuning sets (the Cycles room, the
-/// tracer's scenes): a quarter leaves it room to fit.
-constexpr double kBoundingBudget = 0.25;
 /// Below this threshold the next step is the full evaluation.
 constexpr double kMinThreshold = 1e-3;
 /// Threshold steps: at least this ratio (a large jump overshoots the cost),
@@ -761,9 +754,8 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
 
   const double threshold = double(ResolveSettings(options, caps).contrastThreshold);
   // Contrasts are at most 1 but for the display-weighted metric's brightest sets.
-  const bool bounding = hasTarget && goal.budget >= kBoundingBudget;
-  const double t0 =
-      limit > 0 && !bounding ? std::min(kStartFactorBudget * threshold, 1.0) : kStartFactor * threshold;
+  const double t0 = limit > 0 && !goal.budgetFromThreshold ? std::min(kStartFactorBudget * threshold, 1.0)
+                                                           : kStartFactor * threshold;
   auto meets = [&](const Run& r) {
     return target > 0 && r.estimate.low >= target && !(r.second.low < target);
   };

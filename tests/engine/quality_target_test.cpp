@@ -290,17 +290,18 @@ TEST(QualityTarget, APlateauEndsTheDescentOnlyWithoutABudget) {
   }
 }
 
-TEST(QualityTarget, ABudgetWithATargetSearchesAsWithoutOneUntilItBinds) {
-  // A budget of a quarter or more beside a target bounds the search: where
-  // the search ends within it, it is the search without one, run for run
-  // (the first at the options' threshold, not 16x coarser as for a smaller
-  // budget or one alone), never exceeding it.
+TEST(QualityTarget, ABudgetFromTheThresholdSearchesAsWithoutOneUntilItBinds) {
+  // budgetFromThreshold: where the search ends within the budget it is the
+  // search without one, run for run (the first at the options' threshold);
+  // a plain budget starts 16x coarser and ends elsewhere. Where the budget
+  // binds, it is never exceeded and says so.
   const int N = 256;
-  auto run = [&](double target, double budget) {
+  auto run = [&](double target, double budget, bool fromThreshold) {
     AnalyticProvider provider(N, N, FurnishedScene(N, N));
     QualityGoal goal;
     goal.targetPsnr = target;
     goal.budget = budget;
+    goal.budgetFromThreshold = fromThreshold;
     Outcome r = RunGoal(provider, ReconstructionOptions{}, goal);
     EXPECT_EQ(provider.MaxEvaluationsOfOnePixel(), 1);
     if (budget > 0) {
@@ -308,7 +309,7 @@ TEST(QualityTarget, ABudgetWithATargetSearchesAsWithoutOneUntilItBinds) {
     }
     return r;
   };
-  const Outcome free = run(40, 0), bounded = run(40, 0.35);
+  const Outcome free = run(40, 0, false), bounded = run(40, 0.35, true), plain = run(40, 0.35, false);
   ASSERT_TRUE(free.report.targetReached);
   EXPECT_TRUE(bounded.report.targetReached);
   EXPECT_FALSE(bounded.report.budgetBound);
@@ -316,9 +317,12 @@ TEST(QualityTarget, ABudgetWithATargetSearchesAsWithoutOneUntilItBinds) {
   EXPECT_EQ(bounded.report.threshold, free.report.threshold);
   EXPECT_EQ(bounded.report.exactPixels, free.report.exactPixels);
   EXPECT_EQ(bounded.rec.image, free.rec.image);
-  // A smaller budget starts coarser: another route (where it binds:
-  // UnreachableTargetReportsWhatTheBudgetReached).
-  EXPECT_NE(run(40, 0.2).report.exactPixels, free.report.exactPixels);
+  EXPECT_NE(plain.report.exactPixels, free.report.exactPixels);
+  // A budget below what the target needs: spent, never passed, bound.
+  const Outcome tight = run(70, 0.1, true);
+  EXPECT_FALSE(tight.report.targetReached) << tight.report.estimate.psnr;
+  EXPECT_TRUE(tight.report.budgetBound) << tight.report.exactFraction();
+  EXPECT_GT(tight.report.exactFraction(), 0.5 * 0.1);
 }
 
 TEST(QualityTarget, SupersampledTargetIsMetAtOutputResolution) {

@@ -190,13 +190,14 @@ constexpr double kNoisyDefaultBudget = 0.35;
 /// threshold or method of the user's, dcm refines from the default threshold
 /// until the result is estimated at least as close to the converged image as
 /// the render itself, with at most kNoisyDefaultBudget of the pixels exact:
-/// --target-psnr render --budget 0.35 (docs/NOISE.md).
+/// --target-psnr render --budget 0.35, the search starting at the default
+/// threshold (QualityGoal::budgetFromThreshold; docs/NOISE.md).
 bool NoisyDefaultGoal(const aov::AovProvider& provider, bool sparse, EngineFlags* e) {
   if (sparse || !provider.Capabilities().variance) return false;
   if (e->threshold || e->targetPsnr || e->budget || e->full || e->method != "dcm") return false;
   e->targetPsnr = kTargetRender;
   e->budget = kNoisyDefaultBudget;
-  e->defaultGoal = true;
+  e->budgetFromThreshold = true;
   return true;
 }
 

@@ -279,6 +279,7 @@ bool QualityGoalOf(const EngineFlags& f, QualityGoal* goal) {
   if (f.TargetsRender()) goal->targetRender = true;
   else if (f.targetPsnr) goal->targetPsnr = *f.targetPsnr;
   if (f.budget) goal->budget = *f.budget;
+  goal->budgetFromThreshold = f.budgetFromThreshold;
   return f.targetPsnr || f.budget;
 }
 
@@ -360,7 +361,7 @@ std::string WhichIsCloser(double resultPsnr, double renderPsnr) {
 std::string QualityWarning(const QualityReport& r, const EngineFlags& f) {
   if (r.targetReached || !f.targetPsnr) return "";
   std::string within = r.budgetBound && f.budget ? " within --budget " + G(*f.budget) : "";
-  if (!within.empty() && f.defaultGoal) within += " (the default's bound; --target-psnr render alone spends more)";
+  if (!within.empty() && f.budgetFromThreshold) within += " (the default's bound; --target-psnr render alone spends more)";
   char buf[256];
   std::snprintf(buf, sizeof buf, "--target-psnr %s: not reached%s; estimated %.2f dB (lower bound %.2f) at %.2f %% exact pixels",
                 TargetName(r, f).c_str(), within.c_str(), r.estimate.psnr, r.estimate.low, 100 * r.exactFraction());

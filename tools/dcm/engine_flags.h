@@ -24,8 +24,9 @@ struct EngineFlags {
   std::optional<float> threshold, noiseSignificance, creaseAngle, probeLcShare;
   /// --target-psnr (kTargetRender: `render`), --budget (dcm/quality_target.h)
   std::optional<double> targetPsnr, budget;
-  /// Not a flag: the target and budget are a default's (messages say so).
-  bool defaultGoal = false;
+  /// Not a flag: a default's budget that bounds the search from the default
+  /// threshold on (QualityGoal::budgetFromThreshold).
+  bool budgetFromThreshold = false;
   std::optional<int> block, minBlock, directions, tile;
   std::optional<int> neighbourDirections, fallbackShadingChanges, crossingFill, simpleSurfaceChanges;
   int downsample = 1;

@@ -49,6 +49,12 @@ struct QualityGoal {
   /// Largest share of working pixels evaluated exactly, validation pixels and
   /// every run's samples included; 0: no budget (1: the whole image).
   double budget = 0;
+  /// With a budget, the descent starts at the options' threshold, as without
+  /// one, instead of 16 times above it: for a budget that bounds a search for
+  /// a target rather than one to spend (dcm reconstruct's default on noisy
+  /// input: at most 35 %), which the threshold's run is expected to fit. A
+  /// first run the budget refuses is followed by coarser ones, as with any.
+  bool budgetFromThreshold = false;
   /// Judged by the preview (ReconstructToTargetFromPreview): a target that
   /// the render's own noise, as the preview estimates it before the first
   /// round, leaves no room for is still searched for (true), or gets one run
@@ -158,8 +164,7 @@ struct QualityReport {
 };
 
 /// Reconstructs with the contrast threshold that `goal` calls for: from the
-/// options' threshold (sixteen times it, at most 1, with a budget, but for
-/// one of at least a quarter beside a target, which bounds the search) down, until
+/// options' threshold (sixteen times it, at most 1, with a budget) down, until
 /// the estimate's lower bound reaches goal.targetPsnr, stops rising (a
 /// plateau), or the next run would exceed the budget (then bisected between
 /// the two); with a target, a last validation draw by importance estimates
