@@ -301,5 +301,22 @@ TEST(AovNoise, ReconstructWithTheNoiseEstimatedBeatsTheNoisyRender) {
               s["reference"]["psnr"].get<double>(), f["reference"]["psnr"].get<double>());
 }
 
+TEST(AovNoise, AStripTheDefaultsBoundDoesNotFitRunsWithoutIt) {
+  // One row of 1000 noisy pixels: the default's 35 % bound cannot hold the
+  // coarsest lattice and the validation. The default then runs without it
+  // (as --target-psnr render) instead of failing on a --budget nobody gave.
+  ScratchDir dir;
+  const Scene sc{1000, 1};
+  WriteExr(dir / "strip.exr", sc.width, sc.height, NoisyChannels(sc, false, 9));
+  const RunResult r = RunDcm({"reconstruct", dir / "strip.exr", "--estimate-variance", "-o", dir / "out.exr",
+                              "--stats", dir / "s.json", "-v"},
+                             dir);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.err.find("the 35 % bound does not fit this image"), std::string::npos) << r.err;
+  const auto s = nlohmann::json::parse(ReadText(dir / "s.json"));
+  EXPECT_TRUE(s["quality"]["budget"].is_null()) << s["quality"].dump();
+  EXPECT_TRUE(s["quality"]["target_render"].get<bool>());
+}
+
 }  // namespace
 }  // namespace dcm::aov::test

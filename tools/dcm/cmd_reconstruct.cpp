@@ -292,6 +292,18 @@ int RunReconstruct(const ReconstructFlags& f) {
   ExrReconstruction run;
   bool usage = false;
   st = ReconstructWholeExr(cmd, *provider, f.aov, engine, options, f.reference, &run, &usage);
+  if (!st.ok() && engine.budgetFromThreshold) {
+    // The default's bound can be too small for an image's coarsest lattice
+    // and validation (a tiny image, a strip of one row): without it, as
+    // --target-psnr render. A failure that is not the bound's recurs.
+    if (engine.verbose)
+      std::cerr << "dcm " << cmd << ": the 35 % bound does not fit this image (" << st.message()
+                << "): without it\n";
+    engine.budget.reset();
+    engine.budgetFromThreshold = false;
+    usage = false;
+    st = ReconstructWholeExr(cmd, *provider, f.aov, engine, options, f.reference, &run, &usage);
+  }
   if (!st.ok()) return aov_common::Fail(cmd, st.message(), usage ? kExitUsage : kExitFailure);
   const Reconstruction& r = run.result;
   const bool haveRef = run.haveReference;
