@@ -307,6 +307,7 @@ Result ReconstructExr(py::object inputs, const std::string& preset, py::object m
     py::gil_scoped_release release;
     std::unique_ptr<aov::AovProvider> provider;
     st = aov::AovProvider::Open(f.inputs, aovOptions, &provider);  // as the command, without its -v notes
+    if (st.ok()) cli::ApplyNoisyDefaultGoal(*provider, !f.samples.empty(), &engine);
     if (st.ok())
       st = cli::ReconstructWholeExr("reconstruct", *provider, f, engine, s.options, ref.empty() ? "" : ref[0], &run,
                                     &usage);

@@ -107,6 +107,15 @@ class ReconstructExr(unittest.TestCase):
         self.assertEqual(result.stats["quality"]["target_psnr"], 45)
         self.assertIn("estimated_psnr", result.stats)
 
+    def test_noisy_default_bit_identical_to_the_command(self):
+        # With the variance estimated and no goal, the command's noisy default (--target-psnr render,
+        # at most 35 % exact) runs here too: the same bits and statistics.
+        image, stats = self.command("noisy", "--estimate-variance")
+        result = dcm.reconstruct_exr(self.aovs, preset="generic", estimate_variance=True)
+        self.check_same(result, image, stats)
+        self.assertTrue(result.stats["quality"]["target_render"])
+        self.assertEqual(result.stats["quality"]["budget"], 0.35)
+
     def test_missing_file_names_it(self):
         missing = os.path.join(self.tmp.name, "no-such-render.exr")
         with self.assertRaises(dcm.Error) as e:

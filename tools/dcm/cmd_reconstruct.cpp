@@ -181,26 +181,6 @@ int RunReconstructPart(const ReconstructFlags& f, ReconstructionOptions options,
   return kExitOk;
 }
 
-/// The most exact pixels the noisy default spends: issue 26's bound (at the
-/// same samples, at least as close to the converged image as the render, at
-/// most 35 % exact). --target-psnr render alone spends more.
-constexpr double kNoisyDefaultBudget = 0.35;
-
-/// With noisy dense samples (their variance given or estimated) and no goal,
-/// threshold or method of the user's, dcm refines from the default threshold
-/// until the result is estimated at least as close to the converged image as
-/// the render itself, with at most kNoisyDefaultBudget of the pixels exact:
-/// --target-psnr render --budget 0.35, the search starting at the default
-/// threshold (QualityGoal::budgetFromThreshold; docs/NOISE.md).
-bool NoisyDefaultGoal(const aov::AovProvider& provider, bool sparse, EngineFlags* e) {
-  if (sparse || !provider.Capabilities().variance) return false;
-  if (e->threshold || e->targetPsnr || e->budget || e->full || e->method != "dcm") return false;
-  e->targetPsnr = kTargetRender;
-  e->budget = kNoisyDefaultBudget;
-  e->budgetFromThreshold = true;
-  return true;
-}
-
 int RunReconstruct(const ReconstructFlags& f) {
   const std::string cmd = "reconstruct";
   if (!f.pipe.command.empty()) {
@@ -283,7 +263,7 @@ int RunReconstruct(const ReconstructFlags& f) {
   if (f.engine.verbose)
     for (const auto& note : layout.notes) std::cerr << "dcm " << cmd << ": " << note << "\n";
   EngineFlags engine = f.engine;
-  if (NoisyDefaultGoal(*provider, sparse, &engine) && engine.verbose)
+  if (ApplyNoisyDefaultGoal(*provider, sparse, &engine) && engine.verbose)
     std::cerr << "dcm " << cmd << ": noisy samples: refining until the result is estimated at least as close to "
               << "the converged image as the render itself, with at most 35 % of the pixels exact (--target-psnr "
               << "render --budget 0.35; --target-psnr render alone spends more, --threshold T gives one "
@@ -292,18 +272,6 @@ int RunReconstruct(const ReconstructFlags& f) {
   ExrReconstruction run;
   bool usage = false;
   st = ReconstructWholeExr(cmd, *provider, f.aov, engine, options, f.reference, &run, &usage);
-  if (!st.ok() && engine.budgetFromThreshold) {
-    // The default's bound can be too small for an image's coarsest lattice
-    // and validation (a tiny image, a strip of one row): without it, as
-    // --target-psnr render. A failure that is not the bound's recurs.
-    if (engine.verbose)
-      std::cerr << "dcm " << cmd << ": the 35 % bound does not fit this image (" << st.message()
-                << "): without it\n";
-    engine.budget.reset();
-    engine.budgetFromThreshold = false;
-    usage = false;
-    st = ReconstructWholeExr(cmd, *provider, f.aov, engine, options, f.reference, &run, &usage);
-  }
   if (!st.ok()) return aov_common::Fail(cmd, st.message(), usage ? kExitUsage : kExitFailure);
   const Reconstruction& r = run.result;
   const bool haveRef = run.haveReference;

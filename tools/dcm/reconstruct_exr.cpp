@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <iostream>
 #include <map>
 #include <tuple>
 
@@ -77,9 +78,19 @@ Status OutputWindows(const aov::AovProvider& provider, int n, Bounds2i* display,
   return Status::Ok();
 }
 
+bool ApplyNoisyDefaultGoal(const aov::AovProvider& provider, bool sparse, EngineFlags* e) {
+  if (sparse || !provider.Capabilities().variance) return false;
+  if (e->threshold || e->targetPsnr || e->budget || e->full || e->method != "dcm") return false;
+  e->targetPsnr = kTargetRender;
+  e->budget = kNoisyDefaultBudget;
+  e->budgetFromThreshold = true;
+  return true;
+}
+
 Status ReconstructWholeExr(const std::string& cmd, aov::AovProvider& provider, const aov_common::AovFlags& aov,
-                           const EngineFlags& engine, const ReconstructionOptions& options,
+                           const EngineFlags& givenEngine, const ReconstructionOptions& options,
                            const std::string& referencePath, ExrReconstruction* out, bool* usage) {
+  EngineFlags engine = givenEngine;
   *usage = true;
   DCM_RETURN_IF_ERROR(OutputWindows(provider, options.downsample, &out->display, &out->data));
   *usage = false;
@@ -91,7 +102,18 @@ Status ReconstructWholeExr(const std::string& cmd, aov::AovProvider& provider, c
   Reconstruction& r = out->result;
   std::vector<Point2i> pending;
   const auto t0 = std::chrono::steady_clock::now();
-  const Status st = aov_common::Run(provider, options, engine, &r, &pending, nullptr, nullptr, &out->quality);
+  Status st = aov_common::Run(provider, options, engine, &r, &pending, nullptr, nullptr, &out->quality);
+  if (!st.ok() && !st.pending() && engine.budgetFromThreshold) {
+    // The default's bound can be too small for an image's coarsest lattice
+    // and validation: without it, as --target-psnr render. A failure that is
+    // not the bound's recurs.
+    if (engine.verbose)
+      std::cerr << "dcm " << cmd << ": the 35 % bound does not fit this image (" << st.message() << "): without it\n";
+    engine.budget.reset();
+    engine.budgetFromThreshold = false;
+    out->quality.reset();
+    st = aov_common::Run(provider, options, engine, &r, &pending, nullptr, nullptr, &out->quality);
+  }
   const double wall = toolkit::SecondsSince(t0);
   if (st.pending()) return Status::Error(MissingSamplesMessage(provider, pending, ""));
   DCM_RETURN_IF_ERROR(st);

@@ -51,10 +51,28 @@ struct ExrReconstruction {
   std::optional<QualityReport> quality;  ///< with --target-psnr / --budget
 };
 
+/// The most exact pixels the noisy default spends: issue 26's bound (at the
+/// same samples, at least as close to the converged image as the render, at
+/// most 35 % exact). --target-psnr render alone spends more.
+inline constexpr double kNoisyDefaultBudget = 0.35;
+
+/// `dcm reconstruct`'s default on noisy dense samples (their variance given
+/// or estimated) without a goal, threshold or method of the user's: refine
+/// from the default threshold until the result is estimated at least as close
+/// to the converged image as the render itself, with at most
+/// kNoisyDefaultBudget of the pixels exact (--target-psnr render --budget
+/// 0.35, the search starting at the default threshold:
+/// QualityGoal::budgetFromThreshold; docs/NOISE.md). Sets the goal in `e`;
+/// false (and `e` unchanged) where it does not apply.
+bool ApplyNoisyDefaultGoal(const aov::AovProvider& provider, bool sparse, EngineFlags* e);
+
 /// Reconstructs the whole frame of `provider` as `dcm reconstruct` does:
 /// checks the output windows, reads `referencePath` (when not empty), runs
 /// the engine (progress on stderr unless engine.quiet), compares with the
 /// reference (or the full input, dense mode) and fills the statistics.
+/// Where the noisy default's bound (ApplyNoisyDefaultGoal) cannot hold the
+/// image's coarsest lattice and validation (a tiny image, a strip of one
+/// row), runs again without it, as --target-psnr render (-v says why).
 /// `*usage` tells whether an error is the caller's (exit 2) rather than a
 /// failure.
 Status ReconstructWholeExr(const std::string& cmd, aov::AovProvider& provider, const aov_common::AovFlags& aov,
