@@ -678,7 +678,7 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   };
   if (Status st = drawMore(&v, nullptr); !st.ok()) {
     if (cache.BudgetHit())
-      return Status::Error("--budget " + Num(goal.budget) + ": too small for the validation pixels");
+      return Status::OverBudget("--budget " + Num(goal.budget) + ": too small for the validation pixels");
     return st;
   }
   report->totalPixels = total;
@@ -841,8 +841,8 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
       if (!best) refused = up;
     }
     if (!best)
-      return Status::Error("--budget " + Num(goal.budget) +
-                           ": below what the coarsest reconstruction needs (the block corners and the validation)");
+      return Status::OverBudget("--budget " + Num(goal.budget) +
+                                ": below what the coarsest reconstruction needs (the block corners and the validation)");
   }
   if (refused && !meets(*best) && best->threshold > 0) {
     // Between the last run within the budget and the one beyond: the samples

@@ -312,7 +312,7 @@ TEST(AovNoise, AStripTheDefaultsBoundDoesNotFitRunsWithoutIt) {
                               "--stats", dir / "s.json", "-v"},
                              dir);
   ASSERT_EQ(r.exitCode, 0) << r.err;
-  EXPECT_NE(r.err.find("the 35 % bound does not fit this image"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the default's bound of 35 % does not fit this image"), std::string::npos) << r.err;
   const auto s = nlohmann::json::parse(ReadText(dir / "s.json"));
   EXPECT_TRUE(s["quality"]["budget"].is_null()) << s["quality"].dump();
   EXPECT_TRUE(s["quality"]["target_render"].get<bool>());

@@ -265,9 +265,9 @@ int RunReconstruct(const ReconstructFlags& f) {
   EngineFlags engine = f.engine;
   if (ApplyNoisyDefaultGoal(*provider, sparse, &engine) && engine.verbose)
     std::cerr << "dcm " << cmd << ": noisy samples: refining until the result is estimated at least as close to "
-              << "the converged image as the render itself, with at most 35 % of the pixels exact (--target-psnr "
-              << "render --budget 0.35; --target-psnr render alone spends more, --threshold T gives one "
-              << "threshold's result)\n";
+              << "the converged image as the render itself, with at most " << 100 * kNoisyDefaultBudget
+              << " % of the pixels exact (--target-psnr render --budget " << kNoisyDefaultBudget
+              << "; --target-psnr render alone spends more, --threshold T gives one threshold's result)\n";
   aov_common::Outputs outputs(cmd);  // before the run: --progressive writes during it
   ExrReconstruction run;
   bool usage = false;

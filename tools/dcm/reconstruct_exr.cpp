@@ -103,12 +103,12 @@ Status ReconstructWholeExr(const std::string& cmd, aov::AovProvider& provider, c
   std::vector<Point2i> pending;
   const auto t0 = std::chrono::steady_clock::now();
   Status st = aov_common::Run(provider, options, engine, &r, &pending, nullptr, nullptr, &out->quality);
-  if (!st.ok() && !st.pending() && engine.budgetFromThreshold) {
-    // The default's bound can be too small for an image's coarsest lattice
-    // and validation: without it, as --target-psnr render. A failure that is
-    // not the bound's recurs.
+  if (st.overBudget() && engine.budgetFromThreshold) {
+    // The default's bound is too small for this image's coarsest lattice and
+    // validation: without it, as --target-psnr render.
     if (engine.verbose)
-      std::cerr << "dcm " << cmd << ": the 35 % bound does not fit this image (" << st.message() << "): without it\n";
+      std::cerr << "dcm " << cmd << ": the default's bound of " << 100 * kNoisyDefaultBudget
+                << " % does not fit this image (" << st.message() << "): without it\n";
     engine.budget.reset();
     engine.budgetFromThreshold = false;
     out->quality.reset();

@@ -72,7 +72,8 @@ bool ApplyNoisyDefaultGoal(const aov::AovProvider& provider, bool sparse, Engine
 /// reference (or the full input, dense mode) and fills the statistics.
 /// Where the noisy default's bound (ApplyNoisyDefaultGoal) cannot hold the
 /// image's coarsest lattice and validation (a tiny image, a strip of one
-/// row), runs again without it, as --target-psnr render (-v says why).
+/// row: the search's Status::OverBudget), runs again without it, as
+/// --target-psnr render (-v says why).
 /// `*usage` tells whether an error is the caller's (exit 2) rather than a
 /// failure.
 Status ReconstructWholeExr(const std::string& cmd, aov::AovProvider& provider, const aov_common::AovFlags& aov,

@@ -11,7 +11,8 @@ namespace dcm {
 /// evaluate the requested samples now (the file-based round trip: the samples
 /// are rendered by another process and come back in the next round), or
 /// "over budget" — an evaluation refused because it would pass the exact-pixel
-/// budget of a quality search (an error to everyone who does not ask).
+/// budget of a quality search, or a budget too small for that search's
+/// validation or coarsest run (an error to everyone who does not ask).
 class [[nodiscard]] Status {
  public:
   enum class Code { kOk, kError, kPending, kOverBudget };
