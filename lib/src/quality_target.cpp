@@ -45,8 +45,17 @@ constexpr double kMinStep = 0.5, kMaxStep = 0.85, kDefaultStep = 0.7;
 /// does not.
 constexpr int kMaxSearchDraws = 4;
 /// The descent stops where two runs raised the lower bound by less than
-/// this many dB while the pixels spent grew by more than this factor.
+/// this many dB while the pixels spent grew by more than this factor, and
+/// the samples are noisy or fewer than kPlateauEffective validation pixels
+/// carry the estimate (PsnrEstimate::effective).
 constexpr double kPlateauDb = 0.5, kPlateauGrowth = 1.25;
+/// Below this many effective pixels a plateau of noise-free samples is a few
+/// pixels' error that no threshold removes (a highlight on a thin wire, hit
+/// by a validation pixel that stands for a hundred): the descent stops and
+/// the last, independent draw judges. At or above it the error is spread over
+/// the image and only lower thresholds remove it: the descent goes on (a
+/// target asked for is spent for). Chosen on the tuning set (docs/TUNING.md, Q).
+constexpr double kPlateauEffective = 4;
 /// The share of the budget left that a run of the descent may spend.
 constexpr double kDescentShare = 0.6;
 /// The pixels a run of the descent may reach: `used` and the share of the rest.
@@ -586,8 +595,12 @@ Status QualityGoal::Validate() const {
 PsnrEstimate EstimatePsnr(const std::vector<double>& d, const std::vector<double>& w, double total) {
   PsnrEstimate e;
   const size_t n = std::min(d.size(), w.size());
-  double W = 0, sum = 0;
-  for (size_t i = 0; i < n; ++i) W += w[i], sum += w[i] * d[i];
+  double W = 0, sum = 0, positive = 0, squares = 0;
+  for (size_t i = 0; i < n; ++i) {
+    W += w[i], sum += w[i] * d[i];
+    if (d[i] > 0) positive += w[i] * d[i], squares += (w[i] * d[i]) * (w[i] * d[i]);
+  }
+  e.effective = squares > 0 ? positive * positive / squares : kInf;
   if (total > 0 && n >= 2) {
     // Hansen-Hurwitz: each pixel an independent estimate y = n w d / total
     // of the mean; dividing by the realized sum of weights instead (Hajek)
@@ -600,7 +613,7 @@ PsnrEstimate EstimatePsnr(const std::vector<double>& d, const std::vector<double
       var += (y - m) * (y - m);
     }
     const double se = std::sqrt(var / (double(n) * double(n - 1)));
-    return {PsnrOf(m), PsnrOf(m + kZ * se), PsnrOf(std::max(0.0, m - kZ * se))};
+    return {PsnrOf(m), PsnrOf(m + kZ * se), PsnrOf(std::max(0.0, m - kZ * se)), e.effective};
   }
   if (n == 0 || !(W > 0)) {
     e.psnr = e.low = e.high = kNaN;
@@ -788,16 +801,19 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
     const double low = best->estimate.low;
     if (meets(*best) || t < 0) break;
     // A plateau: the bound barely moved over the last two runs while the
-    // samples grew. What the validation sees is then error that a lower
-    // threshold does not remove (a feature the lattice misses at any
-    // threshold, hit by a validation pixel); the last draw judges the result.
-    // With a budget, the budget ends the descent instead: a target asked for
-    // within one spends it before it says "not reached".
+    // samples grew. Where a few validation pixels carry the estimate, what
+    // they see is error that a lower threshold does not remove (a feature the
+    // lattice misses at any threshold); with noisy samples, the exact
+    // samples' own noise, which more of them at the same samples per pixel
+    // do not lower. The last draw then judges the result. With a budget, the
+    // budget ends the descent instead: a target asked for within one spends
+    // it before it says "not reached".
     lows.push_back(low);
     spends.push_back(double(cache.Distinct()));
     const size_t n = lows.size();
     if (target > 0 && limit <= 0 && n >= 3 && std::isfinite(lows[n - 3]) && lows[n - 1] - lows[n - 3] < kPlateauDb &&
-        spends[n - 1] > kPlateauGrowth * spends[n - 3])
+        spends[n - 1] > kPlateauGrowth * spends[n - 3] &&
+        (best->estimate.effective < kPlateauEffective || !v.variance.empty()))
       break;
     if (t <= kMinThreshold) {
       // The threshold cannot go lower: the full evaluation reaches any target.

@@ -527,6 +527,9 @@ TEST(DcmReconstruct, TargetPsnrReportsTheEstimateBesideTheTruth) {
   const auto s = ReadJson(dir / "s.json");
   ASSERT_TRUE(s.contains("estimated_psnr"));
   EXPECT_EQ(double(s["estimated_psnr_confidence"]), 0.9);
+  // How many validation pixels carry it: null only where none saw an error.
+  ASSERT_TRUE(s.contains("estimated_psnr_effective_pixels"));
+  if (!s["estimated_psnr_effective_pixels"].is_null()) EXPECT_GE(double(s["estimated_psnr_effective_pixels"]), 1.0);
   std::printf("target 40: estimate %s [%s, %s], true %s dB, reached %s\n", s["estimated_psnr"].dump().c_str(),
               s["estimated_psnr_low"].dump().c_str(), s["estimated_psnr_high"].dump().c_str(),
               s["reference"]["psnr"].dump().c_str(), s["quality"]["target_reached"].dump().c_str());

@@ -54,6 +54,15 @@ TEST(QualityTarget, EstimateOfAConstantErrorIsExact) {
   EXPECT_TRUE(std::isnan(EstimatePsnr({}, {}).psnr));
 }
 
+TEST(QualityTarget, EffectivePixelsCountThoseThatCarryTheEstimate) {
+  // Kish: (sum w d)^2 / sum (w d)^2 over the positive errors.
+  EXPECT_NEAR(EstimatePsnr({1e-4, 1e-4, 1e-4, 1e-4}, {1, 1, 1, 1}).effective, 4.0, 1e-12);
+  EXPECT_NEAR(EstimatePsnr({1e-2, 0, 0, 0, 0, 0}, {1, 1, 1, 1, 1, 1}).effective, 1.0, 1e-12);
+  // Weights count as the pixels they stand for; negative (noise-corrected) errors carry nothing.
+  EXPECT_NEAR(EstimatePsnr({1e-4, 2e-4, -1e-4}, {2, 1, 1}, 4).effective, 2.0, 1e-12);
+  EXPECT_TRUE(std::isinf(EstimatePsnr({0, 0}, {1, 1}).effective));
+}
+
 /// A smooth ramp with `spots` bright 3x3 highlights, each inside a 16-pixel
 /// block away from its corners and centre, on the same surface: the lattice
 /// misses them and most of the error sits in their few pixels.
@@ -264,8 +273,9 @@ TEST(QualityTarget, ConfirmingDrawsThatFindTheTargetMissedSpendTheBudget) {
 }
 
 TEST(QualityTarget, APlateauEndsTheDescentOnlyWithoutABudget) {
-  // Twelve highlights no threshold finds: the validation's lower bound stops
-  // rising while the pixels grow. Without a budget the descent stops there
+  // Twelve highlights no threshold finds, one of them under a validation
+  // pixel that carries the estimate alone: the lower bound stops rising
+  // while the pixels grow. Without a budget the descent stops there
   // (a few per cent of the pixels); with one, the budget ends it: spent
   // within the last run's share (60 % of what was left, then the bisection).
   const int n = 256;
@@ -289,6 +299,47 @@ TEST(QualityTarget, APlateauEndsTheDescentOnlyWithoutABudget) {
       EXPECT_LE(provider.TotalEvaluations(), int64_t(budget * n * n));
     }
   }
+}
+
+TEST(QualityTarget, APlateauOfSpreadErrorDoesNotEndTheDescent) {
+  // Sixty highlights no threshold finds: the lower bound stops rising while
+  // the pixels grow, as with twelve (above), but here about ten validation
+  // pixels carry the estimate, not one: the error is spread over the image,
+  // and what a target asked for needs is spent. Only the full evaluation
+  // finds these highlights; the descent goes on to it and meets the target.
+  const int n = 256;
+  AnalyticProvider provider(n, n, SpottedRamp(n, 60));
+  QualityGoal goal;
+  goal.targetPsnr = 40;
+  goal.seed = 8 * 7919;  // the seed of the twelve above
+  const Outcome r = RunGoal(provider, ReconstructionOptions{}, goal);
+  EXPECT_TRUE(r.report.targetReached);
+  EXPECT_LT(r.report.threshold, 0) << "the full evaluation";
+  EXPECT_GE(r.truePsnr, 40.0);
+  EXPECT_EQ(provider.MaxEvaluationsOfOnePixel(), 1);
+}
+
+TEST(QualityTarget, WithNoisySamplesAPlateauEndsTheDescent) {
+  // The sixty highlights above under noise of known variance: the error is
+  // as spread, but the bound's plateau is now the exact samples' own noise
+  // as much as the highlights, and more exact pixels at the same samples per
+  // pixel do not lower it: the descent stops there, far from the full
+  // evaluation, and says the target is not reached.
+  const int n = 256;
+  AnalyticProvider exact(n, n, SpottedRamp(n, 60));
+  NoiseModel noise;
+  noise.relative = 0.05f;
+  noise.absolute = 0.002f;
+  NoisyProvider noisy(exact, noise);
+  QualityGoal goal;
+  goal.targetPsnr = 40;
+  goal.seed = 8 * 7919;
+  Reconstruction rec;
+  QualityReport report;
+  ASSERT_TRUE(ReconstructToQuality(noisy, ReconstructionOptions{}, goal, &rec, &report).ok());
+  EXPECT_FALSE(report.targetReached);
+  EXPECT_GT(report.threshold, 0) << "not the full evaluation";
+  EXPECT_LT(report.exactFraction(), 0.2);
 }
 
 TEST(QualityTarget, ABudgetFromTheThresholdSearchesAsWithoutOneUntilItBinds) {

@@ -150,6 +150,7 @@ void AddEstimateJson(const PsnrEstimate& e, double confidence, nlohmann::json* j
   (*j)["estimated_psnr_low"] = e.low;
   (*j)["estimated_psnr_high"] = e.high;
   (*j)["estimated_psnr_confidence"] = confidence;
+  (*j)["estimated_psnr_effective_pixels"] = std::isfinite(e.effective) ? nlohmann::json(e.effective) : nlohmann::json(nullptr);
 }
 
 nlohmann::json EstimateJson(const PsnrEstimate& e) { return {{"psnr", e.psnr}, {"low", e.low}, {"high", e.high}}; }

@@ -38,7 +38,8 @@ nlohmann::json RunToJson(const Reconstruction& r, const std::string& method, con
 
 /// Adds an estimate of the result's PSNR to a --stats object:
 /// estimated_psnr, estimated_psnr_low, estimated_psnr_high (the interval at
-/// estimated_psnr_confidence, `confidence`).
+/// estimated_psnr_confidence, `confidence`) and
+/// estimated_psnr_effective_pixels (PsnrEstimate::effective; null: no error seen).
 void AddEstimateJson(const PsnrEstimate& estimate, double confidence, nlohmann::json* j);
 
 /// {psnr, low, high} of one estimate: a run's, a level's, a judge's.
@@ -50,7 +51,7 @@ void AddEstimateMetadata(const PsnrEstimate& estimate, Metadata* metadata);
 
 /// Adds what --target-psnr / --budget delivered to a --stats object:
 /// estimated_psnr, estimated_psnr_low, estimated_psnr_high (the interval at
-/// estimated_psnr_confidence) and quality {target_psnr, budget, target_reached,
+/// estimated_psnr_confidence), estimated_psnr_effective_pixels and quality {target_psnr, budget, target_reached,
 /// confirmed, budget_bound, exact_pixels, exact_fraction, validation_pixels,
 /// validation_exact_pixels, runs, threshold, levels [{level, psnr, low, high}],
 /// second_estimate and validation_estimate {psnr, low, high} where

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -32,6 +33,10 @@ struct PsnrEstimate {
   /// Bounds of the two-sided 90 % interval (CLT on the weighted mean of the
   /// squared errors): `low` is also the one-sided 95 % lower bound.
   double low = 0, high = 0;
+  /// Kish's effective number of validation pixels, (sum w d)^2 / sum (w
+  /// d)^2 over the positive errors d with weights w: near 1 where one pixel
+  /// carries the estimate (+inf with no error).
+  double effective = std::numeric_limits<double>::infinity();
 };
 
 /// What to deliver: a target, a budget, or both (whichever binds first).
