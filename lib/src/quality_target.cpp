@@ -108,7 +108,8 @@ class CachingProvider : public SampleProvider {
  public:
   CachingProvider(SampleProvider& inner, int64_t limit, SampleRequest widest)
       : inner_(inner), caps_(inner.Capabilities()), limit_(limit), widest_(widest),
-        index_(size_t(std::max(0, caps_.width)) * size_t(std::max(0, caps_.height)), -1) {}
+        index_(size_t(std::max(0, caps_.width)) * size_t(std::max(0, caps_.height)), -1),
+        reserved_(index_.size(), 0) {}
 
   ProviderCapabilities Capabilities() const override { return caps_; }
 
@@ -127,11 +128,32 @@ class CachingProvider : public SampleProvider {
     return Status::Ok();
   }
 
+  /// With a budget, reserves the pixels of `pixels` never evaluated nor
+  /// reserved before, or refuses them all: the engine's batches of one
+  /// request then run within the budget whatever their order.
+  Status Admit(std::span<const Point2i> pixels, const SampleRequest& asked) override {
+    (void)asked;
+    if (limit_ <= 0) return Status::Ok();
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<size_t> fresh;
+    for (const Point2i& p : pixels)
+      if (index_[Index(p)] < 0 && !reserved_[Index(p)]) fresh.push_back(Index(p));
+    std::sort(fresh.begin(), fresh.end());
+    fresh.erase(std::unique(fresh.begin(), fresh.end()), fresh.end());
+    if (distinct_ + int64_t(fresh.size()) > limit_) {
+      budgetHit_ = true;
+      return Status::OverBudget(kBudgetMessage);
+    }
+    for (size_t i : fresh) reserved_[i] = 1;
+    distinct_ += int64_t(fresh.size());
+    return Status::Ok();
+  }
+
   Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& asked, std::span<ExactSample> out) override {
     const SampleRequest what{asked.split || widest_.split, asked.variance || widest_.variance};
     const uint8_t need = detail::RequestMask(what);
     std::vector<size_t> misses;
-    int64_t fresh = 0;  // pixels never evaluated before, reserved in the budget
+    int64_t fresh = 0;  // pixels neither evaluated nor admitted before, reserved in the budget
     {
       std::lock_guard<std::mutex> lock(mutex_);
       for (size_t k = 0; k < pixels.size(); ++k) {
@@ -143,7 +165,7 @@ class CachingProvider : public SampleProvider {
       misses.erase(std::unique(misses.begin(), misses.end(),
                                [&](size_t a, size_t b) { return Index(pixels[a]) == Index(pixels[b]); }),
                    misses.end());
-      for (size_t k : misses) fresh += index_[Index(pixels[k])] < 0 ? 1 : 0;
+      for (size_t k : misses) fresh += index_[Index(pixels[k])] < 0 && !reserved_[Index(pixels[k])] ? 1 : 0;
       if (limit_ > 0 && distinct_ + fresh > limit_) {
         budgetHit_ = true;
         return Status::OverBudget(kBudgetMessage);
@@ -244,6 +266,7 @@ class CachingProvider : public SampleProvider {
   SampleRequest widest_;
   mutable std::mutex mutex_;
   std::vector<int32_t> index_;  ///< per working pixel: its sample, -1 none
+  std::vector<uint8_t> reserved_;  ///< per working pixel: counted in the budget by Admit
   std::vector<ExactSample> samples_;
   std::vector<uint8_t> masks_;  ///< what each sample holds (detail::RequestMask)
   int64_t distinct_ = 0;

@@ -106,6 +106,8 @@ Status SampleStore::Flush(SampleProvider& provider, const SampleRequest& what, i
   }
   if (pixels.empty()) return Status::Ok();
 
+  // All or none: a budget refuses the whole request before any batch runs.
+  DCM_RETURN_IF_ERROR(provider.Admit(pixels, what));
   std::vector<ExactSample> samples(pixels.size());
   // Batches of at most batchSize, and small enough that a short phase still
   // keeps every worker busy (results do not depend on the batching).

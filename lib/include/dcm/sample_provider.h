@@ -98,6 +98,16 @@ class SampleProvider {
   virtual Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what,
                           std::span<ExactSample> out) = 0;
 
+  /// Called once before the engine asks for `pixels` in several Evaluate()
+  /// calls, which may run concurrently: a provider that bounds what it
+  /// evaluates (a budget) accepts or refuses them together, so that what it
+  /// evaluated does not depend on which call came first. Default: accepted.
+  virtual Status Admit(std::span<const Point2i> pixels, const SampleRequest& what) {
+    (void)pixels;
+    (void)what;
+    return Status::Ok();
+  }
+
   /// Moves into `pixels` and `samples` the pixels that the last Evaluate()
   /// computed exactly besides those asked for, as asked for (a renderer whose
   /// call traces every ray of some other pixels too: Cycles with a wide pixel
