@@ -46,16 +46,10 @@ constexpr double kMinStep = 0.5, kMaxStep = 0.85, kDefaultStep = 0.7;
 constexpr int kMaxSearchDraws = 4;
 /// The descent stops where two runs raised the lower bound by less than
 /// this many dB while the pixels spent grew by more than this factor, and
-/// the samples are noisy or fewer than kPlateauEffective validation pixels
-/// carry the estimate (PsnrEstimate::effective).
+/// the samples are noisy or fewer than kFewEffectivePixels carry the
+/// estimate; elsewhere the error is spread over the image, only lower
+/// thresholds remove it, and a target asked for is spent for.
 constexpr double kPlateauDb = 0.5, kPlateauGrowth = 1.25;
-/// Below this many effective pixels a plateau of noise-free samples is a few
-/// pixels' error that no threshold removes (a highlight on a thin wire, hit
-/// by a validation pixel that stands for a hundred): the descent stops and
-/// the last, independent draw judges. At or above it the error is spread over
-/// the image and only lower thresholds remove it: the descent goes on (a
-/// target asked for is spent for). Chosen on the tuning set (docs/TUNING.md, Q).
-constexpr double kPlateauEffective = 4;
 /// The share of the budget left that a run of the descent may spend.
 constexpr double kDescentShare = 0.6;
 /// The pixels a run of the descent may reach: `used` and the share of the rest.
@@ -836,7 +830,7 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
     const size_t n = lows.size();
     if (target > 0 && limit <= 0 && n >= 3 && std::isfinite(lows[n - 3]) && lows[n - 1] - lows[n - 3] < kPlateauDb &&
         spends[n - 1] > kPlateauGrowth * spends[n - 3] &&
-        (best->estimate.effective < kPlateauEffective || !v.variance.empty()))
+        (best->estimate.effective < kFewEffectivePixels || !v.variance.empty()))
       break;
     if (t <= kMinThreshold) {
       // The threshold cannot go lower: the full evaluation reaches any target.

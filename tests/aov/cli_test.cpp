@@ -20,6 +20,7 @@
 
 #include "common/metrics.h"
 #include "common/sample_map.h"
+#include "engine_flags.h"
 #include "test_util.h"
 
 namespace dcm::aov::test {
@@ -515,6 +516,25 @@ TEST(DcmPlan, RoundTripToATargetMatchesDense) {
   EXPECT_EQ(int64_t(rendered.size()), int64_t(ds["quality"]["exact_pixels"]));
 }
 
+TEST(QualityLine, SaysWhereAFewValidationPixelsCarryTheEstimate) {
+  using cli::EngineFlags;
+  using cli::QualityLine;
+  QualityReport r;
+  r.estimate = {40.71, 37.95, 50.17, 1.6};
+  r.targetPsnr = 40;
+  r.runs = 3;
+  EngineFlags f;
+  f.targetPsnr = 40;
+  EXPECT_THAT(QualityLine(r, f), HasSubstr("carried by 1.6 effective validation pixels"));
+  r.estimate.effective = 12;  // enough for the interval's normal approximation
+  EXPECT_THAT(QualityLine(r, f), Not(HasSubstr("effective")));
+  r.estimate.effective = std::numeric_limits<double>::infinity();  // no error seen
+  EXPECT_THAT(QualityLine(r, f), Not(HasSubstr("effective")));
+  r.estimate.effective = 1.6;  // the preview's estimate sees every pixel
+  r.estimateSource = EstimateSource::kPreview;
+  EXPECT_THAT(QualityLine(r, f), Not(HasSubstr("effective")));
+}
+
 TEST(DcmReconstruct, TargetPsnrReportsTheEstimateBesideTheTruth) {
   ScratchDir dir;
   Scene sc{64, 48};
@@ -529,7 +549,13 @@ TEST(DcmReconstruct, TargetPsnrReportsTheEstimateBesideTheTruth) {
   EXPECT_EQ(double(s["estimated_psnr_confidence"]), 0.9);
   // How many validation pixels carry it: null only where none saw an error.
   ASSERT_TRUE(s.contains("estimated_psnr_effective_pixels"));
-  if (!s["estimated_psnr_effective_pixels"].is_null()) EXPECT_GE(double(s["estimated_psnr_effective_pixels"]), 1.0);
+  const auto& effective = s["estimated_psnr_effective_pixels"];
+  if (!effective.is_null()) {
+    EXPECT_GE(double(effective), 1.0);
+  }
+  // The quality line says where a few of them carry it.
+  const bool few = !effective.is_null() && double(effective) < kFewEffectivePixels;
+  EXPECT_EQ(r.err.find("effective validation pixels") != std::string::npos, few) << r.err;
   std::printf("target 40: estimate %s [%s, %s], true %s dB, reached %s\n", s["estimated_psnr"].dump().c_str(),
               s["estimated_psnr_low"].dump().c_str(), s["estimated_psnr_high"].dump().c_str(),
               s["reference"]["psnr"].dump().c_str(), s["quality"]["target_reached"].dump().c_str());

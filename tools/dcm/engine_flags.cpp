@@ -324,6 +324,12 @@ std::string QualityLine(const QualityReport& r, const EngineFlags& f) {
                 e.psnr, 100 * r.confidence, e.low, e.high, target.c_str(), 100 * r.exactFraction(), r.runs, from,
                 r.threshold < 0 ? "none (full evaluation)" : G(r.threshold).c_str());
   std::string line = buf;
+  if (!fromPreview && e.effective < kFewEffectivePixels) {
+    char few[160];
+    std::snprintf(few, sizeof few, "; carried by %.1f effective validation pixels: a few pixels hold the error it sees",
+                  e.effective);
+    line += few;
+  }
   if (std::isfinite(r.secondEstimate.psnr)) {
     // Two judges: the line names the one not reported.
     const PsnrEstimate& other = fromPreview ? r.validationEstimate : r.secondEstimate;

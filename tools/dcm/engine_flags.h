@@ -101,7 +101,9 @@ Status ReconstructFor(SampleProvider& provider, const ReconstructionOptions& opt
 /// "estimated PSNR 40.8 dB (90 % interval 40.3 to 41.4; --target-psnr 40
 /// reached), 6.12 % exact pixels in 7 runs (validation 1.00 %), threshold
 /// 0.061", for -v and the summaries; where two judges spoke, "; the lower of
-/// two judges, the preview's estimate 42.1 dB (41.0 to 43.3)" names the other.
+/// two judges, the preview's estimate 42.1 dB (41.0 to 43.3)" names the other;
+/// where fewer than kFewEffectivePixels carry the validation's estimate, "; carried
+/// by 1.6 effective validation pixels: ..." says so.
 std::string QualityLine(const QualityReport& report, const EngineFlags& flags);
 
 /// "this result is closer, by X dB" or "the full render is closer, by X dB"

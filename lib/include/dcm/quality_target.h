@@ -27,6 +27,14 @@
 
 namespace dcm {
 
+/// Fewer effective pixels (PsnrEstimate::effective) than this carry a
+/// noise-free estimate: a few pixels hold the error it sees (a highlight on a
+/// thin wire, hit by a validation pixel that stands for a hundred), and the
+/// normal approximation behind its interval does not hold. A plateau of the
+/// search then ends the descent (no threshold removes such error), and the
+/// quality line says so. Chosen on the tuning set (docs/TUNING.md, Q).
+inline constexpr double kFewEffectivePixels = 4;
+
 /// The estimate of the PSNR of an image against the full render.
 struct PsnrEstimate {
   double psnr = 0;  ///< from the mean squared error at the validation pixels; +inf with none
