@@ -15,7 +15,6 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
-#include <limits>
 #include <span>
 #include <vector>
 
