@@ -711,6 +711,7 @@ DCM_API double dcmGetStat(DCMReconstructor r, const char* name) {
     if (n == "estimated_psnr") return q.estimate.psnr;
     if (n == "estimated_psnr_low") return q.estimate.low;
     if (n == "estimated_psnr_high") return q.estimate.high;
+    if (n == "estimated_psnr_effective_pixels") return q.estimate.effective;
     if (n == "estimated_render_psnr") return q.renderEstimate.psnr;
     if (n == "estimated_render_psnr_low") return q.renderEstimate.low;
     if (n == "estimated_render_psnr_high") return q.renderEstimate.high;

@@ -364,6 +364,7 @@ TEST(CApi, TargetAndBudgetReportTheEstimateAndStayWithinTheBudget) {
   ASSERT_EQ(dcmExecute(r), DCM_ERROR_NONE) << TakeError(r);
   // The ramp is reconstructed exactly: no validation pixel errs (+inf dB).
   EXPECT_GE(dcmGetStat(r, "estimated_psnr_low"), 40.0);
+  EXPECT_GE(dcmGetStat(r, "estimated_psnr_effective_pixels"), 1.0);  // a count of pixels, or +inf
   EXPECT_EQ(dcmGetStat(r, "target_reached"), 1.0);
   EXPECT_GT(dcmGetStat(r, "validation_pixels"), 1.0);
   // Every pixel evaluated (validation included) is counted once, within the budget.
@@ -415,6 +416,7 @@ TEST(CApi, ATargetWithAPreviewOfKnownVarianceIsJudgedByThePreview) {
   EXPECT_EQ(dcmGetStat(r, "validation_pixels"), 0.0);
   EXPECT_EQ(dcmGetStat(r, "target_reached"), 1.0);
   EXPECT_GE(dcmGetStat(r, "estimated_psnr_low"), 35.0);
+  EXPECT_GE(dcmGetStat(r, "estimated_psnr_effective_pixels"), 1.0);
   // A round the target did not need leaves its pixels at their preview value.
   const double stopped = dcmGetStat(r, "stopped_at_target");
   EXPECT_TRUE(stopped == 0.0 || (stopped == 1.0 && dcmGetStat(r, "preview_stand_ins") > 0)) << stopped;

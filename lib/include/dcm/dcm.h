@@ -53,8 +53,9 @@ extern "C" {
  *  "budget" (alone or with "target_psnr") is judged by the preview's estimate
  *  where "target_psnr" alone was. Version 9: a target judged by the preview
  *  leaves a round after the first unrendered where the result reaches the
- *  target without it (the statistic "stopped_at_target"). */
-#define DCM_C_API_VERSION 9
+ *  target without it (the statistic "stopped_at_target"). Version 10: the
+ *  statistic "estimated_psnr_effective_pixels". */
+#define DCM_C_API_VERSION 10
 
 /** A reconstructor: options, guides, the sample callback and the last result. */
 typedef struct DCMReconstructorImpl* DCMReconstructor;
@@ -324,7 +325,9 @@ DCM_API const uint8_t* dcmGetSampleMap(DCMReconstructor r, int* width, int* heig
  *  "stopped_at_target" (0/1: the stand-ins' round was not rendered, a target
  *  judged by the preview being met without it; since API version 9); with "target_psnr" or "budget" set also
  *  "estimated_psnr", "estimated_psnr_low", "estimated_psnr_high" (the 90 %
- *  interval), "validation_pixels", "quality_runs", "target_reached" and
+ *  interval), "estimated_psnr_effective_pixels" (how many validation pixels
+ *  carry the estimate, dcm::PsnrEstimate::effective; +inf where none saw an
+ *  error; since API version 10), "validation_pixels", "quality_runs", "target_reached" and
  *  "budget_bound" (0/1), "estimate_against_converged" (1: the provider
  *  reports variance, and the estimate is against the converged image),
  *  "estimated_render_psnr", "estimated_render_psnr_low",
