@@ -131,15 +131,11 @@ class CachingProvider : public SampleProvider {
     std::lock_guard<std::mutex> lock(mutex_);
     std::vector<size_t> fresh;
     for (const Point2i& p : pixels)
-      if (index_[Index(p)] < 0 && !reserved_[Index(p)]) fresh.push_back(Index(p));
+      if (Uncounted(Index(p))) fresh.push_back(Index(p));
     std::sort(fresh.begin(), fresh.end());
     fresh.erase(std::unique(fresh.begin(), fresh.end()), fresh.end());
-    if (distinct_ + int64_t(fresh.size()) > limit_) {
-      budgetHit_ = true;
-      return Status::OverBudget(kBudgetMessage);
-    }
+    if (!Reserve(int64_t(fresh.size()))) return Status::OverBudget(kBudgetMessage);
     for (size_t i : fresh) reserved_[i] = 1;
-    distinct_ += int64_t(fresh.size());
     return Status::Ok();
   }
 
@@ -159,14 +155,10 @@ class CachingProvider : public SampleProvider {
       misses.erase(std::unique(misses.begin(), misses.end(),
                                [&](size_t a, size_t b) { return Index(pixels[a]) == Index(pixels[b]); }),
                    misses.end());
-      for (size_t k : misses) fresh += index_[Index(pixels[k])] < 0 && !reserved_[Index(pixels[k])] ? 1 : 0;
-      if (limit_ > 0 && distinct_ + fresh > limit_) {
-        budgetHit_ = true;
-        return Status::OverBudget(kBudgetMessage);
-      }
+      for (size_t k : misses) fresh += Uncounted(Index(pixels[k])) ? 1 : 0;
       // Reserved before the (unlocked) evaluation: concurrent batches are
       // disjoint, so no pixel is counted twice.
-      distinct_ += fresh;
+      if (!Reserve(fresh)) return Status::OverBudget(kBudgetMessage);
       if (marking_)
         for (const Point2i& p : pixels) engine_[Index(p)] = 1;
     }
@@ -253,6 +245,19 @@ class CachingProvider : public SampleProvider {
 
  private:
   size_t Index(Point2i p) const { return size_t(p.y) * size_t(caps_.width) + size_t(p.x); }
+  /// Working pixel i is not yet in the distinct count: neither evaluated nor
+  /// admitted. With mutex_ held.
+  bool Uncounted(size_t i) const { return index_[i] < 0 && !reserved_[i]; }
+  /// Counts `fresh` more distinct pixels, or refuses them where they would
+  /// pass the budget (BudgetHit). With mutex_ held.
+  bool Reserve(int64_t fresh) {
+    if (limit_ > 0 && distinct_ + fresh > limit_) {
+      budgetHit_ = true;
+      return false;
+    }
+    distinct_ += fresh;
+    return true;
+  }
 
   SampleProvider& inner_;
   ProviderCapabilities caps_;
