@@ -107,6 +107,7 @@ ProviderCapabilities EmbreeProvider::Capabilities() const {
   c.objectId = true;
   c.shaderId = true;
   c.texture = effects_.textures;
+  c.normal = true;
   c.splitRadiance = effects_.textures;
   c.variance = scene_.render.samplesPerPixel > 1;
   // Point lights cast the only hard shadows; the shadow guide marks them.
@@ -127,7 +128,8 @@ Status EmbreeProvider::Guides(const Bounds2i& region, const GuideRequest& what, 
   out->shaderId.assign(what.shaderId ? n : 0, 0u);
   const bool tau = what.texture && effects_.textures;
   out->texture.assign(what.texture ? n : 0, RGB::Gray(1.f));
-  if (!what.objectId && !what.shaderId && !tau) return Status::Ok();
+  out->normal.assign(what.normal ? n : 0, Vec3f{0.f, 0.f, 0.f});
+  if (!what.objectId && !what.shaderId && !tau && !what.normal) return Status::Ok();
   // Rows in parallel: primary rays are independent and deterministic.
   tbb::parallel_for(region.min.y, region.max.y, [&](int y) {
     RayCounts counts;
@@ -139,6 +141,7 @@ Status EmbreeProvider::Guides(const Bounds2i& region, const GuideRequest& what, 
       if (what.objectId) out->objectId[i] = g.objectId;
       if (what.shaderId) out->shaderId[i] = g.shaderId;
       if (tau) out->texture[i] = g.tau;
+      if (what.normal) out->normal[i] = Vec3f{g.normal.x, g.normal.y, g.normal.z};
     }
     AddCounts(counts);
   });

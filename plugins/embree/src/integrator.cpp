@@ -347,12 +347,14 @@ PixelGuide Integrator::GuideFromHit(const CameraRay& cr, SurfaceHit h, bool want
   const uint32_t lightShaderBase = uint32_t(materials_.size()) + 1;
   for (;;) {
     if (h.light >= 0) {
+      g.normal = Vec3{0.f, 0.f, 0.f};
       objects[n] = lightId_[size_t(h.light)];
       shaders[n] = lightShaderBase + uint32_t(h.light);
       ++n;
       break;
     }
     const int mat = objectMaterial_[size_t(h.object)];
+    g.normal = h.ns;
     objects[n] = objectId_[size_t(h.object)];
     shaders[n] = uint32_t(mat) + 1;
     ++n;
@@ -374,6 +376,7 @@ PixelGuide Integrator::GuideFromHit(const CameraRay& cr, SurfaceHit h, bool want
     Vec3 org = EmbreeScene::Offset(h.p, h.ng);
     dir = next;
     if (!bvh_.Intersect(org, dir, 0.f, kInf, &h)) {
+      g.normal = Vec3{0.f, 0.f, 0.f};
       objects[n] = 0;
       shaders[n] = 0;
       ++n;

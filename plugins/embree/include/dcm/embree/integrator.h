@@ -47,6 +47,9 @@ struct PixelGuide {
   uint32_t objectId = 0;  ///< 0: background
   uint32_t shaderId = 0;  ///< 0: background
   RGB tau{1.f, 1.f, 1.f};
+  /// Shading normal of the surface shown (at the end of a mirror chain, as the
+  /// IDs); zero for the background and lights.
+  Vec3 normal{0.f, 0.f, 0.f};
 };
 
 /// What the integrator may trace; set from the scene (only the effects the
