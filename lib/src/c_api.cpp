@@ -36,6 +36,7 @@ static_assert(DCM_REASON_FALLBACK == int(dcm::SampleReason::kFallback));
 static_assert(DCM_REASON_FULL == int(dcm::SampleReason::kFull));
 static_assert(DCM_REASON_PREVIEW_STAND_IN == int(dcm::SampleReason::kPreviewStandIn));
 static_assert(DCM_REASON_RENDERED == int(dcm::SampleReason::kRendered));
+static_assert(DCM_REASON_VALIDATION == int(dcm::SampleReason::kValidation));
 static_assert(DCM_REASON_COUNT == dcm::kSampleReasonCount);
 
 /// The object behind a DCMReconstructor handle.

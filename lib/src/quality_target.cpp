@@ -218,6 +218,12 @@ class CachingProvider : public SampleProvider {
     std::lock_guard<std::mutex> lock(mutex_);
     return distinct_;
   }
+  /// The sample of working pixel p, or null where none was evaluated.
+  const ExactSample* SampleAt(Point2i p) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const int32_t i = index_[Index(p)];
+    return i < 0 ? nullptr : &samples_[size_t(i)];
+  }
   bool BudgetHit() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return budgetHit_;
@@ -588,6 +594,41 @@ Status EvaluateValidation(CachingProvider& cache, const ReconstructionOptions& o
 }
 
 /// One finished run.
+/// Gives the result's interpolated working pixels in the boxes of the
+/// validation pixels their exact samples, which were paid for, and their
+/// output pixels the box mean again. Without variance only: a noisy exact
+/// value need not be closer to the converged image than the engine's
+/// denoised interpolation. The estimate stays that of the result without
+/// them, which the search judged: conservative by the error they remove.
+void KeepValidationPixels(const Validation& v, const CachingProvider& cache, int s, Reconstruction* rec) {
+  if (!v.variance.empty()) return;
+  const int W = rec->workWidth, H = rec->workHeight;
+  for (const Point2i& p : v.pixels) {
+    double sum[3] = {0, 0, 0};  // as BoxDownsample sums
+    int n = 0;
+    for (int wy = p.y * s; wy < std::min(H, (p.y + 1) * s); ++wy)
+      for (int wx = p.x * s; wx < std::min(W, (p.x + 1) * s); ++wx) {
+        const size_t k = size_t(wy) * size_t(W) + size_t(wx);
+        SampleReason& why = rec->sampleMap[k];
+        if (why == SampleReason::kInterpolated || why == SampleReason::kPreviewStandIn) {
+          if (const ExactSample* e = cache.SampleAt({wx, wy})) {
+            --rec->stats.byReason[size_t(why)];
+            ++rec->stats.byReason[size_t(SampleReason::kValidation)];
+            why = SampleReason::kValidation;
+            rec->workImage[k] = e->L;
+            if (rec->interpolation) rec->interpolation->MarkExact(int64_t(k));
+          }
+        }
+        const RGB& c = rec->workImage[k];
+        sum[0] += c.r, sum[1] += c.g, sum[2] += c.b;
+        ++n;
+      }
+    if (n > 0)
+      rec->image[size_t(p.y) * size_t(rec->width) + size_t(p.x)] =
+          RGB(float(sum[0] / n), float(sum[1] / n), float(sum[2] / n));
+  }
+}
+
 struct Run {
   Reconstruction rec;
   PsnrEstimate estimate;
@@ -954,6 +995,7 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   report->threshold = best->threshold;
   report->targetReached = target <= 0 || meets(*best);
   report->exactPixels = cache.Distinct();
+  KeepValidationPixels(v, cache, s, &best->rec);
   *out = std::move(best->rec);
   // The cost of the whole search: every pixel evaluated, every run's time.
   out->stats.exactPixels = report->exactPixels;

@@ -30,6 +30,7 @@ std::string_view ToString(SampleReason r) {
     case SampleReason::kFull: return "full";
     case SampleReason::kPreviewStandIn: return "preview_stand_in";
     case SampleReason::kRendered: return "rendered";
+    case SampleReason::kValidation: return "validation";
     case SampleReason::kCount: break;
   }
   return "?";

@@ -82,6 +82,7 @@ std::array<uint8_t, 3> ReasonColor(SampleReason reason) {
     case SampleReason::kFull: return {150, 150, 255};           // lavender
     case SampleReason::kPreviewStandIn: return {120, 80, 160};  // dull purple
     case SampleReason::kRendered: return {140, 200, 170};       // sage
+    case SampleReason::kValidation: return {255, 130, 190};     // pink
     case SampleReason::kCount: break;
   }
   return {128, 64, 0};  // brown: an unknown reason (never expected)

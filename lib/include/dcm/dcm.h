@@ -54,8 +54,10 @@ extern "C" {
  *  where "target_psnr" alone was. Version 9: a target judged by the preview
  *  leaves a round after the first unrendered where the result reaches the
  *  target without it (the statistic "stopped_at_target"). Version 10: the
- *  statistic "estimated_psnr_effective_pixels". */
-#define DCM_C_API_VERSION 10
+ *  statistic "estimated_psnr_effective_pixels". Version 11 adds
+ *  DCM_REASON_VALIDATION: a quality target's or budget's validation pixels
+ *  keep their exact values where the samples carry no variance. */
+#define DCM_C_API_VERSION 11
 
 /** A reconstructor: options, guides, the sample callback and the last result. */
 typedef struct DCMReconstructorImpl* DCMReconstructor;
@@ -99,7 +101,8 @@ enum {
   DCM_REASON_FULL = 8,
   DCM_REASON_PREVIEW_STAND_IN = 9, /**< left at its preview value (dcmSetRoundCost); since API version 3 */
   DCM_REASON_RENDERED = 10, /**< rendered in a round that the final plan did not need; since API version 6 */
-  DCM_REASON_COUNT = 11
+  DCM_REASON_VALIDATION = 11, /**< a validation pixel of "target_psnr" or "budget", kept exact; since API version 11 */
+  DCM_REASON_COUNT = 12
 };
 
 /** Evaluates `count` pixels exactly. `xy` holds 2*count ints (x0, y0, x1, y1,

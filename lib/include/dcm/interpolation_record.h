@@ -57,6 +57,10 @@ class InterpolationRecord {
   const Bounds2i& window() const { return window_; }
   /// Whether pixel i (row-major in window()) was evaluated exactly.
   bool IsExact(int64_t i) const { return exact_[size_t(i)] != 0; }
+  /// Marks pixel i exact: a pixel the result took an exact value for after
+  /// the reconstruction (a quality target's validation pixel), so that every
+  /// channel takes its own value there too.
+  void MarkExact(int64_t i) { exact_[size_t(i)] = 1; }
 
   /// Reconstructs one channel: `exact` holds its value at every pixel of
   /// window() (row-major; only the exact pixels' values are read), `out`

@@ -33,6 +33,9 @@ enum class SampleReason : uint8_t {
   /// evaluated in a round planned on the preview that the final run did not
   /// ask for: keeps its exact value (RoundSchedule::kPreview)
   kRendered,
+  /// a validation pixel of a quality target or budget (dcm/quality_target.h)
+  /// the final run interpolated: keeps the exact value it was evaluated for
+  kValidation,
   kCount
 };
 inline constexpr int kSampleReasonCount = int(SampleReason::kCount);
