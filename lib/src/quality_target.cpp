@@ -218,7 +218,8 @@ class CachingProvider : public SampleProvider {
     std::lock_guard<std::mutex> lock(mutex_);
     return distinct_;
   }
-  /// The sample of working pixel p, or null where none was evaluated.
+  /// The sample of working pixel p, or null where none was evaluated; valid
+  /// until the next Evaluate().
   const ExactSample* SampleAt(Point2i p) const {
     std::lock_guard<std::mutex> lock(mutex_);
     const int32_t i = index_[Index(p)];
@@ -593,7 +594,6 @@ Status EvaluateValidation(CachingProvider& cache, const ReconstructionOptions& o
   return Status::Ok();
 }
 
-/// One finished run.
 /// Gives the result's interpolated working pixels in the boxes of the
 /// validation pixels their exact samples, which were paid for, and their
 /// output pixels the box mean again. Without variance only: a noisy exact
@@ -604,8 +604,6 @@ void KeepValidationPixels(const Validation& v, const CachingProvider& cache, int
   if (!v.variance.empty()) return;
   const int W = rec->workWidth, H = rec->workHeight;
   for (const Point2i& p : v.pixels) {
-    double sum[3] = {0, 0, 0};  // as BoxDownsample sums
-    int n = 0;
     for (int wy = p.y * s; wy < std::min(H, (p.y + 1) * s); ++wy)
       for (int wx = p.x * s; wx < std::min(W, (p.x + 1) * s); ++wx) {
         const size_t k = size_t(wy) * size_t(W) + size_t(wx);
@@ -619,16 +617,12 @@ void KeepValidationPixels(const Validation& v, const CachingProvider& cache, int
             if (rec->interpolation) rec->interpolation->MarkExact(int64_t(k));
           }
         }
-        const RGB& c = rec->workImage[k];
-        sum[0] += c.r, sum[1] += c.g, sum[2] += c.b;
-        ++n;
       }
-    if (n > 0)
-      rec->image[size_t(p.y) * size_t(rec->width) + size_t(p.x)] =
-          RGB(float(sum[0] / n), float(sum[1] / n), float(sum[2] / n));
+    rec->image[size_t(p.y) * size_t(rec->width) + size_t(p.x)] = BoxMean(rec->workImage, W, H, s, p.x, p.y);
   }
 }
 
+/// One finished run.
 struct Run {
   Reconstruction rec;
   PsnrEstimate estimate;

@@ -13,4 +13,10 @@ namespace dcm {
 /// size ceil(w/s) x ceil(h/s); all zero when `in` holds fewer than w*h pixels.
 std::vector<RGB> BoxDownsample(std::span<const RGB> in, int w, int h, int s, int* outW, int* outH);
 
+/// Output pixel (ox, oy) of BoxDownsample(in, w, h, s, ...), bit for bit:
+/// the mean of the pixels of its s x s box that lie in the w x h image.
+/// `in` holds w*h pixels; the box holds at least one (ox < ceil(w/s), oy <
+/// ceil(h/s)).
+RGB BoxMean(std::span<const RGB> in, int w, int h, int s, int ox, int oy);
+
 }  // namespace dcm
