@@ -26,7 +26,7 @@ using detail::Quote;
 namespace {
 
 constexpr std::array<std::string_view, kRoleCount> kRoleNames = {
-    "id",   "shader", "u",    "v",    "tau.R", "tau.G", "tau.B", "N.X",   "N.Y",   "N.Z", "shadow", "highlight", "Li.R",  "Li.G",  "Li.B",
+    "id",   "shader", "u",    "v",    "tau.R", "tau.G", "tau.B", "N.X",   "N.Y",   "N.Z", "shadow", "highlight", "albedo.R", "albedo.G", "albedo.B", "Li.R",  "Li.G",  "Li.B",
     "Lc.R", "Lc.G",   "Lc.B", "L.R",  "L.G",   "L.B",   "var.R", "var.G", "var.B", "mask"};
 
 constexpr const char* kComp[3] = {"R", "G", "B"};
@@ -34,7 +34,7 @@ constexpr const char* kComp[3] = {"R", "G", "B"};
 /// First role of each RGB group.
 constexpr Role kNormal = Role::kNX;
 constexpr Role kTau = Role::kTauR, kLi = Role::kLiR, kLc = Role::kLcR, kL = Role::kLR,
-               kVar = Role::kVarR;
+               kVar = Role::kVarR, kAlbedo = Role::kAlbedoR;
 
 Role Comp(Role first, int c) { return Role(int(first) + c); }
 
@@ -181,6 +181,7 @@ Status PresetExprs(Preset preset, const std::string& viewLayer, const ChannelSet
       for (int c = 0; c < 3; ++c) set1(Comp(kNormal, c), std::string("N.") + "XYZ"[c]);
       set1(Role::kShadow, "shadow");
       set1(Role::kHighlight, "highlight");
+      setRgb(kAlbedo, "albedo.");
     }
     setRgb(kLi, "Li.");
     setRgb(kLc, "Lc.");
@@ -217,6 +218,7 @@ Status PresetExprs(Preset preset, const std::string& viewLayer, const ChannelSet
     set1(Role::kU, p + "UV.U");
     set1(Role::kV, p + "UV.V");
     setRgb(kTau, p + "DiffCol.");
+    setRgb(kAlbedo, p + "Denoising Albedo.");
     for (int c = 0; c < 3; ++c) set1(Comp(kNormal, c), p + "Normal." + "XYZ"[c]);
     // The guides: the first ShadowGuide* layer's Combined and the first
     // HighlightGuide* layer's GlossDir, R + G + B each.
@@ -400,7 +402,7 @@ Status ParseRole(std::string_view name, Role* role) {
   std::string all;
   for (auto n : kRoleNames) all += (all.empty() ? "" : ", ") + std::string(n);
   return Status::Error("unknown role '" + std::string(name) + "' (roles: " + all +
-                       "; tau, Li, Lc, L, var map all three components)");
+                       "; tau, albedo, Li, Lc, L, var map all three components)");
 }
 
 Status ParsePreset(std::string_view name, Preset* preset) {
@@ -416,7 +418,7 @@ Status ParseMapping(std::string_view text, std::vector<Mapping>* out) {
     return Status::Error("--map '" + std::string(text) + "': expected ROLE=CHANNEL");
   const std::string role(OIIO::Strutil::strip(text.substr(0, eq)));
   const std::string expr(OIIO::Strutil::strip(text.substr(eq + 1)));
-  for (const char* group : {"tau", "Li", "Lc", "L", "var", "N"}) {
+  for (const char* group : {"tau", "albedo", "Li", "Lc", "L", "var", "N"}) {
     if (role == group) {
       const bool vector = role == "N";  // components X, Y, Z
       const char* const comps[3] = {vector ? "X" : "R", vector ? "Y" : "G", vector ? "Z" : "B"};
@@ -462,6 +464,10 @@ struct AovProvider::Data {
   bool dense = true;
   std::vector<uint32_t> objectId, shaderId;
   std::vector<RGB> tau, L, Li, Lc, var;
+  std::vector<RGB> albedo;  ///< Role::kAlbedoR..B; empty: none
+  /// With the split and an albedo: 1 where tau was about 0 and is the albedo now
+  /// (SplitThroughMirrors); empty: nowhere.
+  std::vector<uint8_t> throughMirror;
   std::vector<Vec3f> normal;
   /// Sparse mode: where a sample was read, 1 + the index of the last
   /// samples file that holds it (the one whose values the pixel has); 0 elsewhere.
@@ -657,7 +663,12 @@ Status ComputeSamples(const ChannelSet& set, Evaluator& ev, const RoleExprs& rol
   for (size_t i = 0; i < n; ++i) {
     if (mask && !(*mask)[i]) continue;
     const RGB t = d->tau.empty() ? RGB::Gray(1.f) : d->tau[i];
-    if (split) {
+    if (split && !d->throughMirror.empty() && d->throughMirror[i]) {
+      // tau was about 0: L is what the albedo modulates.
+      d->L[i] = hasL ? L[i] : Lc[i];
+      d->Li[i] = RGB{d->L[i].r / t.r, d->L[i].g / t.g, d->L[i].b / t.b};
+      d->Lc[i] = RGB{};
+    } else if (split) {
       d->Li[i] = Li[i];
       if (hasLc) {
         d->Lc[i] = Lc[i];
@@ -673,6 +684,17 @@ Status ComputeSamples(const ChannelSet& set, Evaluator& ev, const RoleExprs& rol
   }
   return Status::Ok();
 }
+
+/// The texture split through mirrors: where tau is below kAlbedoFloor (no
+/// diffuse colour: a mirror, glass, a metal, also the sky and black surfaces;
+/// their anti-aliased rims, whose L_c must not be interpolated from
+/// neighbours that have none) and an albedo is
+/// given, tau becomes that albedo (at least kAlbedoFloor per channel), and
+/// ComputeSamples makes L_i = L / tau, L_c = 0 there. Cycles' Denoising Albedo
+/// continues through sharp mirrors and glass to the surface they show, so
+/// that a reflected texture is re-applied per pixel as a diffuse one is, and
+/// the engine interpolates the light it reflects instead.
+void SplitThroughMirrors(Data* d);
 
 /// Pixels i and j lie on the same surface for the noise estimates: equal
 /// object and shader IDs where the inputs carry them.
@@ -702,18 +724,61 @@ bool NeighbourResidual(const Data& d, const std::vector<RGB>& v, int x, int y, R
   return true;
 }
 
+/// Below this an albedo channel divides as this: a black surface, or a
+/// diffuse one whose colour tau already explains its albedo, keeps its values
+/// up to a constant factor (the one-render estimate is relative).
+constexpr float kAlbedoFloor = 0.02f;
+
+/// VarianceFromOneRender of `v` with the albedo `a` (per pixel, less `minus`
+/// where given) divided out and multiplied back in: a texture that `v` shows,
+/// also one seen in a mirror, is then no residual that looks like noise. No
+/// albedo: `v` as it is.
+std::vector<RGB> VarianceWithAlbedoOut(const Data& d, const std::vector<RGB>& v, const std::vector<RGB>& minus) {
+  const int W = d.width(), H = d.height();
+  if (d.albedo.empty()) return dcm::VarianceFromOneRender(v, W, H, d.objectId, d.shaderId);
+  std::vector<RGB> a(v.size()), q(v.size());
+  for (size_t i = 0; i < v.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      const float rest = d.albedo[i][c] - (minus.empty() ? 0.f : minus[i][c]);
+      a[i][c] = std::isfinite(rest) ? std::max(rest, kAlbedoFloor) : kAlbedoFloor;
+      q[i][c] = v[i][c] / a[i][c];
+    }
+  std::vector<RGB> var = dcm::VarianceFromOneRender(q, W, H, d.objectId, d.shaderId);
+  for (size_t i = 0; i < var.size(); ++i) var[i] = var[i] * a[i] * a[i];
+  return var;
+}
+
 /// The variance estimate of AovOptions::estimateVariance, in L units: with
 /// the texture split, of L_i (the texture divided out) times tau^2 plus of L_c,
 /// whose noise hardly correlates with L_i's (0.1 on the tuning room);
-/// without it, of L.
+/// without it, of L. With an albedo (Role::kAlbedoR), L_c is divided by what
+/// of it tau does not explain (a mirror's or glass's: the albedo of what it
+/// shows), L without the split by the albedo.
 std::vector<RGB> EstimateVarianceFromData(const Data& d) {
   const int W = d.width(), H = d.height();
-  if (d.Li.empty() || d.Lc.empty() || d.tau.empty())
-    return dcm::VarianceFromOneRender(d.L, W, H, d.objectId, d.shaderId);
+  if (d.Li.empty() || d.Lc.empty() || d.tau.empty()) return VarianceWithAlbedoOut(d, d.L, {});
   std::vector<RGB> var = dcm::VarianceFromOneRender(d.Li, W, H, d.objectId, d.shaderId);
-  const std::vector<RGB> c = dcm::VarianceFromOneRender(d.Lc, W, H, d.objectId, d.shaderId);
+  const std::vector<RGB> c = VarianceWithAlbedoOut(d, d.Lc, d.tau);
   for (size_t i = 0; i < var.size(); ++i) var[i] = var[i] * d.tau[i] * d.tau[i] + c[i];
   return var;
+}
+
+void SplitThroughMirrors(Data* d) {
+  d->throughMirror.clear();
+  if (d->albedo.empty() || d->tau.empty()) return;
+  d->throughMirror.assign(d->tau.size(), 0);
+  for (size_t i = 0; i < d->tau.size(); ++i) {
+    const RGB a = d->albedo[i];
+    const RGB t = d->tau[i];
+    if (!(t.r < kAlbedoFloor && t.g < kAlbedoFloor && t.b < kAlbedoFloor) || !IsFinite(a)) continue;
+    d->tau[i] = RGB{std::max(a.r, kAlbedoFloor), std::max(a.g, kAlbedoFloor), std::max(a.b, kAlbedoFloor)};
+    d->throughMirror[i] = 1;
+  }
+}
+
+/// What the notes say of the albedo that the noise estimate divides out.
+std::string AlbedoNote(const Data& d, const RoleExprs& roles) {
+  return d.albedo.empty() ? std::string() : ", " + RgbText(roles, kAlbedo) + " divided out";
 }
 
 /// The display-referred PSNR that the samples' noise alone would cost
@@ -864,6 +929,12 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
     d->notes.push_back("tau: " + RgbText(roles, kTau));
     DCM_RETURN_IF_ERROR(guideEval.Report(roles, {kTau}, nullptr, &d->warnings));
   }
+  bool hasAlbedo = false;
+  DCM_RETURN_IF_ERROR(RgbPresent(roles, kAlbedo, guides, &hasAlbedo));
+  if (hasAlbedo) {
+    DCM_RETURN_IF_ERROR(guideEval.EvalRgb(roles, kAlbedo, &d->albedo));
+    DCM_RETURN_IF_ERROR(guideEval.Report(roles, {kAlbedo}, nullptr, &d->warnings));
+  }
   bool hasNormal = false;
   DCM_RETURN_IF_ERROR(RgbPresent(roles, kNormal, guides, &hasNormal));
   if (hasNormal) {
@@ -888,6 +959,7 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
     DCM_RETURN_IF_ERROR(RgbPresent(sroles, kLc, guides, &hasLc));
     DCM_RETURN_IF_ERROR(RgbPresent(sroles, kVar, guides, &hasVar));
     split = options.split && hasTau && hasLi && (hasL || hasLc);
+    if (split) SplitThroughMirrors(d.get());
     DCM_RETURN_IF_ERROR(CheckSampleRoles(sroles, split, hasTau, guides, guides.Paths()));
     d->L.assign(n, RGB{});
     if (split) {
@@ -922,6 +994,7 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
       DCM_RETURN_IF_ERROR(CheckSampleRoles(roles2, split, hasTau, second, "second render " + Quote(options.secondRender[0])));
       Data b;
       b.tau = d->tau;
+      b.throughMirror = d->throughMirror;
       b.L.assign(n, RGB{});
       if (split) b.Li.assign(n, RGB{}), b.Lc.assign(n, RGB{});
       second.Want(ChannelsOf(second, roles2));
@@ -943,7 +1016,7 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
     } else if (options.estimateVariance) {
       d->var = EstimateVarianceFromData(*d);
       d->notes.push_back("variance: estimated from the data (residual against the 4-neighbours, 5x5 window on "
-                         "each surface)");
+                         "each surface)" + AlbedoNote(*d, roles));
     } else if (options.detectNoise && !hasVar && !split) {
       // Without the split a texture at the pixel scale would look like noise at most pixels.
       d->notes.push_back("samples: taken as noise-free (no texture split to tell noise from texture; "
@@ -954,8 +1027,8 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
       if (psnr < kNoisyPsnr) {
         d->var = EstimateVarianceFromData(*d);
         d->notes.push_back("samples: noisy (their noise alone would cost about " + figure +
-                           " dB PSNR): variance estimated from the data, as --estimate-variance "
-                           "(--no-detect-noise: take them as noise-free)");
+                           " dB PSNR): variance estimated from the data, as --estimate-variance" +
+                           AlbedoNote(*d, roles) + " (--no-detect-noise: take them as noise-free)");
       } else {
         d->notes.push_back("samples: taken as noise-free (their noise, if any, would cost about " + figure +
                            " dB PSNR, above " + OIIO::Strutil::fmt::format("{:.0f}", kNoisyPsnr) + " dB)");
@@ -969,6 +1042,7 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
     // Capabilities come from the guides and the options alone, so that they
     // are the same in every round; the samples must then match them.
     split = options.split && hasTau;
+    if (split) SplitThroughMirrors(d.get());
     d->dense = false;
     d->L.assign(n, RGB{});
     if (split) {

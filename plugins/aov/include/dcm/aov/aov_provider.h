@@ -35,6 +35,11 @@ enum class Role : int {
   kNX, kNY, kNZ,        ///< "N.X/Y/Z": surface normal (creases inside one object)
   kShadow,    ///< "shadow": light-visibility guide, > 0 where the light reaches the surface
   kHighlight, ///< "highlight": direct glossy light, a highlight where > AovOptions::highlightLevel
+  /// "albedo.R/G/B": the albedo a denoiser reads, which continues through
+  /// mirrors to the surface they show (Cycles' Denoising Albedo): divided out
+  /// before the noise is estimated from one render, so that a texture, also
+  /// a reflected one, is not taken for noise
+  kAlbedoR, kAlbedoG, kAlbedoB,
   kLiR, kLiG, kLiB,     ///< "Li.R/G/B": radiance before texturing
   kLcR, kLcG, kLcB,     ///< "Lc.R/G/B": radiance not modulated by the texture
   kLR, kLG, kLB,        ///< "L.R/G/B": beauty radiance
@@ -52,7 +57,7 @@ Status ParseRole(std::string_view name, Role* role);
 
 /// Where the channel names come from.
 enum class Preset {
-  /// Plain names: id, shader, u, v, tau.R/G/B, N.X/Y/Z, shadow, highlight, Li.R/G/B,
+  /// Plain names: id, shader, u, v, tau.R/G/B, N.X/Y/Z, shadow, highlight, albedo.R/G/B, Li.R/G/B,
   /// Lc.R/G/B, beauty R/G/B, var.R/G/B, mask.
   kGeneric,
   /// Blender Cycles multilayer EXR: <layer>.IndexOB.X, IndexMA.X (or the
@@ -62,6 +67,7 @@ enum class Preset {
   /// Gloss, Trans, Volume, Emit and Env contributions). The Combined of a
   /// view layer named ShadowGuide* is the shadow guide (R + G + B); the
   /// GlossDir of one named HighlightGuide* is the highlight guide (R + G + B).
+  /// albedo = Denoising Albedo (the view layer's Denoising Data), where written.
   kBlender,
 };
 Status ParsePreset(std::string_view name, Preset* preset);
