@@ -45,6 +45,17 @@ def main():
         assert child.preview_samples == 16, child.hello
 
         ids, shaders, tau, normal = child.guides()
+        # The guides render's DiffCol: below 0.02 in every channel the texture guide is
+        # the Denoising Albedo (at least 0.02), which continues through mirrors.
+        import glob
+        guides_npz = np.load(glob.glob(os.path.join(keep, "*_guides.npz"))[0])
+        diffcol = np.stack([guides_npz["DiffCol." + c] for c in "RGB"], -1)
+        albedo = np.stack([guides_npz["Denoising Albedo." + c] for c in "RGB"], -1)
+        through_mirror = (diffcol < 0.02).all(axis=-1)
+        assert through_mirror.any() and not through_mirror.all(), through_mirror.mean()
+        tau = tau.reshape(h, w, 3)
+        assert np.allclose(tau[through_mirror], np.maximum(albedo[through_mirror], 0.02), atol=1e-6)
+        assert np.allclose(tau[~through_mirror], diffcol[~through_mirror], atol=1e-6)
         # Floor, cube, the two spheres, the shade and the sky: six objects and materials.
         assert len(set(ids.tolist())) == 6 and len(set(shaders.tolist())) == 6, (set(ids), set(shaders))
 
@@ -56,7 +67,12 @@ def main():
         for r, sel in enumerate(rounds):
             xs, ys = sel % w, sel // w
             L, Li, Lc = child.eval(xs, ys)
-            lit_by_round.append(Li.max(axis=1) > 0)
+            # Through a mirror (no diffuse colour in the guides: here the sky) L_i is
+            # L over the texture guide, the Denoising Albedo, and L_c is 0.
+            mirror = through_mirror[ys, xs]
+            assert np.allclose(Li[mirror] * tau[ys, xs][mirror], L[mirror], rtol=1e-5, atol=1e-7)
+            assert np.allclose(Lc[mirror], 0, atol=1e-6 * max(1.0, float(np.abs(L).max())))
+            lit_by_round.append((Li.max(axis=1) > 0) & ~mirror)
             want = ref[ys, xs]
             # The same samples of the same pixels: equal but for the order of
             # float additions in Cycles' film (relative 1e-5 is far below the
@@ -81,7 +97,6 @@ def main():
             assert r == 2 or len(ex) > 0, "round %d rendered no extra pixel" % r
         # The mask rendered was the mask asked for: the second round shows
         # surfaces (diffuse colour) only around its own pixels, not around the first's.
-        import glob
         second = np.zeros((h, w), bool)
         for f in sorted(glob.glob(os.path.join(keep, "*_eval2.npz"))):
             second |= np.load(f)["DiffCol.R"] > 0
@@ -115,8 +130,12 @@ def main():
         halves = [np.load(f) for f in sorted(glob.glob(os.path.join(keep_h, "*_guides.npz")))]
         assert len(halves) == 2, os.listdir(keep_h)
         rgb = lambda d, name: np.stack([d[name + "." + c] for c in "RGB"], -1).reshape(-1, 3)
-        (ta, tb), (la, lb) = ([rgb(d, name) for d in halves] for name in ("DiffCol", "Combined"))
-        assert np.allclose(tau, (ta + tb) / 2, atol=1e-6)
+        (ta, tb), (la, lb), (aa, ab) = ([rgb(d, name) for d in halves]
+                                        for name in ("DiffCol", "Combined", "Denoising Albedo"))
+        mirror = ((ta + tb) / 2 < 0.02).all(axis=-1)
+        ta[mirror], tb[mirror] = np.maximum(aa[mirror], 0.02), np.maximum(ab[mirror], 0.02)
+        assert np.allclose(tau[~mirror], ((ta + tb) / 2)[~mirror], atol=1e-6)
+        assert np.allclose(tau[mirror], np.maximum((aa + ab)[mirror] / 2, 0.02), atol=1e-6)
         assert np.allclose(rec[:, 9:12], (la - lb) ** 2 / 4, rtol=1e-5, atol=1e-9)
         assert np.allclose(rec[:, 12:15], (ta - tb) * (la - lb) / 4, rtol=1e-5, atol=1e-9)
         assert (rec[:, 12:15] != 0).any(), "no pixel where the halves' tau and L co-vary: a flat scene"

@@ -693,8 +693,9 @@ Status ComputeSamples(const ChannelSet& set, Evaluator& ev, const RoleExprs& rol
 /// ComputeSamples makes L_i = L / tau, L_c = 0 there. Cycles' Denoising Albedo
 /// continues through sharp mirrors and glass to the surface they show, so
 /// that a reflected texture is re-applied per pixel as a diffuse one is, and
-/// the engine interpolates the light it reflects instead.
-void SplitThroughMirrors(Data* d);
+/// the engine interpolates the light it reflects instead. `albedo` names the
+/// channels in the note it adds.
+void SplitThroughMirrors(const std::string& albedo, Data* d);
 
 /// Pixels i and j lie on the same surface for the noise estimates: equal
 /// object and shader IDs where the inputs carry them.
@@ -763,17 +764,21 @@ std::vector<RGB> EstimateVarianceFromData(const Data& d) {
   return var;
 }
 
-void SplitThroughMirrors(Data* d) {
+void SplitThroughMirrors(const std::string& albedo, Data* d) {
   d->throughMirror.clear();
   if (d->albedo.empty() || d->tau.empty()) return;
   d->throughMirror.assign(d->tau.size(), 0);
+  int64_t count = 0;
   for (size_t i = 0; i < d->tau.size(); ++i) {
     const RGB a = d->albedo[i];
     const RGB t = d->tau[i];
     if (!(t.r < kAlbedoFloor && t.g < kAlbedoFloor && t.b < kAlbedoFloor) || !IsFinite(a)) continue;
     d->tau[i] = RGB{std::max(a.r, kAlbedoFloor), std::max(a.g, kAlbedoFloor), std::max(a.b, kAlbedoFloor)};
     d->throughMirror[i] = 1;
+    ++count;
   }
+  d->notes.push_back("tau through mirrors: " + albedo + " where tau is below " +
+                     OIIO::Strutil::fmt::format("{}", kAlbedoFloor) + " (" + std::to_string(count) + " pixels)");
 }
 
 /// What the notes say of the albedo that the noise estimate divides out.
@@ -959,7 +964,7 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
     DCM_RETURN_IF_ERROR(RgbPresent(sroles, kLc, guides, &hasLc));
     DCM_RETURN_IF_ERROR(RgbPresent(sroles, kVar, guides, &hasVar));
     split = options.split && hasTau && hasLi && (hasL || hasLc);
-    if (split) SplitThroughMirrors(d.get());
+    if (split) SplitThroughMirrors(RgbText(roles, kAlbedo), d.get());
     DCM_RETURN_IF_ERROR(CheckSampleRoles(sroles, split, hasTau, guides, guides.Paths()));
     d->L.assign(n, RGB{});
     if (split) {
@@ -1042,7 +1047,7 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
     // Capabilities come from the guides and the options alone, so that they
     // are the same in every round; the samples must then match them.
     split = options.split && hasTau;
-    if (split) SplitThroughMirrors(d.get());
+    if (split) SplitThroughMirrors(RgbText(roles, kAlbedo), d.get());
     d->dense = false;
     d->L.assign(n, RGB{});
     if (split) {

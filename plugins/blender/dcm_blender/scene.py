@@ -26,6 +26,12 @@ import numpy as np
 
 from . import exr
 
+# Below this in every channel DiffCol says no diffuse colour (a mirror, glass,
+# metal; also the sky, black surfaces and their rims), and the texture guide is
+# the Denoising Albedo, at least this: dcm's kAlbedoFloor (the AOV provider's
+# albedo role, docs/AOV.md).
+ALBEDO_FLOOR = 0.02
+
 
 class SceneError(Exception):
     """A scene dcm cannot render, with the reason for the user."""
@@ -117,6 +123,7 @@ class Session:
         self.scene = bpy.context.scene
         self.notes = []
         self._guides = None   # planes of the guides/preview render
+        self._through_mirror = None  # [height, width]: texture from the Denoising Albedo
         self._mask_image = None
         self._round = 0
         self.noise_psnr = None  # of the exact pixels' samples, from the preview's halves
@@ -180,6 +187,8 @@ class Session:
                      "use_pass_cryptomatte_material"):
             c.set(vl, attr, True)
         c.set(vl, "pass_cryptomatte_depth", 2)
+        # The Denoising Albedo: the texture seen through mirrors and glass.
+        c.set(vl.cycles, "denoising_store_passes", True)
         # How many samples each pixel took: an exact pixel that stopped early is rendered again.
         c.set(vl.cycles, "pass_debug_sample_count", True)
 
@@ -448,11 +457,19 @@ class Session:
             g["object_id"] = pl["CryptoObject00.r"].view(np.uint32).copy()
             g["shader_id"] = pl["CryptoMaterial00.r"].view(np.uint32).copy()
             g["texture"] = mean("DiffCol")
+            # The texture split through mirrors: there L_i = L / texture and L_c = 0
+            # (_exact_values), so that what a mirror shows is re-applied per pixel.
+            mirror = np.zeros((self.height, self.width), bool)
+            if "Denoising Albedo.R" in pl:
+                mirror = (g["texture"] < ALBEDO_FLOOR).all(axis=-1)
+                g["texture"][mirror] = np.maximum(mean("Denoising Albedo")[mirror], ALBEDO_FLOOR)
+            self._through_mirror = mirror
             g["normal"] = self._rgb(pl, "Normal", "XYZ")
             g["L"] = mean("Combined")
             # Each half's render alone (_careful, _stopped_early).
             g["L_of_half"] = [self._rgb(p, "Combined") for p in pls]
             g["Li"] = mean("DiffDir") + mean("DiffInd")
+            g["Li"][mirror] = g["L"][mirror] / g["texture"][mirror]
             g["Lc"] = g["L"] - g["Li"] * g["texture"]
             if len(pls) == 2:
                 # The preview's variance (dcm::HalvesVariance), at the exact pixels' samples.
@@ -462,6 +479,9 @@ class Session:
                 # The texture guide is these renders' DiffCol: the covariance of its
                 # estimate and the preview's, which dcm's estimate of its error takes out.
                 ta, tb = self._rgb(pls[0], "DiffCol"), self._rgb(pls[1], "DiffCol")
+                if mirror.any():
+                    ta[mirror] = np.maximum(self._rgb(pls[0], "Denoising Albedo")[mirror], ALBEDO_FLOOR)
+                    tb[mirror] = np.maximum(self._rgb(pls[1], "Denoising Albedo")[mirror], ALBEDO_FLOOR)
                 g["texcov"] = ((ta - tb) * (a - b) * (counts[0] * counts[1] / float(ps) ** 2)).astype(np.float32)
                 self.noise_psnr = _noise_psnr(g["var"] * (ps / float(self.samples)), g["L"])
             self._guides = g
@@ -590,8 +610,14 @@ class Session:
         return (xs >= rect[0]) & (xs < rect[2]) & (ys >= rect[1]) & (ys < rect[3])
 
     def _exact_values(self, pl, xs, ys):
-        """L and L_i = DiffDir + DiffInd of pixels (xs, ys) in a render's planes."""
-        return self._rgb(pl, "Combined")[ys, xs], (self._rgb(pl, "DiffDir") + self._rgb(pl, "DiffInd"))[ys, xs]
+        """L and L_i = DiffDir + DiffInd of pixels (xs, ys) in a render's planes;
+        through a mirror (guides()) L_i = L / the texture guide."""
+        texture = self.guides()["texture"]
+        L = self._rgb(pl, "Combined")[ys, xs]
+        Li = (self._rgb(pl, "DiffDir") + self._rgb(pl, "DiffInd"))[ys, xs]
+        mirror = self._through_mirror[ys, xs]
+        Li[mirror] = L[mirror] / texture[ys, xs][mirror]
+        return L, Li
 
     def _render_all_samples(self, n, label, seed, xs, ys):
         """Renders pixels (xs, ys) with every one of the n samples (adaptive
