@@ -27,14 +27,14 @@ namespace {
 
 constexpr std::array<std::string_view, kRoleCount> kRoleNames = {
     "id",   "shader", "u",    "v",    "tau.R", "tau.G", "tau.B", "N.X",   "N.Y",   "N.Z", "shadow", "highlight", "albedo.R", "albedo.G", "albedo.B", "Li.R",  "Li.G",  "Li.B",
-    "Lc.R", "Lc.G",   "Lc.B", "L.R",  "L.G",   "L.B",   "var.R", "var.G", "var.B", "mask"};
+    "Lc.R", "Lc.G",   "Lc.B", "Lr.R", "Lr.G", "Lr.B", "L.R",  "L.G",   "L.B",   "var.R", "var.G", "var.B", "mask"};
 
 constexpr const char* kComp[3] = {"R", "G", "B"};
 
 /// First role of each RGB group.
 constexpr Role kNormal = Role::kNX;
 constexpr Role kTau = Role::kTauR, kLi = Role::kLiR, kLc = Role::kLcR, kL = Role::kLR,
-               kVar = Role::kVarR, kAlbedo = Role::kAlbedoR;
+               kVar = Role::kVarR, kAlbedo = Role::kAlbedoR, kLr = Role::kLrR;
 
 Role Comp(Role first, int c) { return Role(int(first) + c); }
 
@@ -185,6 +185,7 @@ Status PresetExprs(Preset preset, const std::string& viewLayer, const ChannelSet
     }
     setRgb(kLi, "Li.");
     setRgb(kLc, "Lc.");
+    setRgb(kLr, "Lr.");
     setRgb(kL, "");
     setRgb(kVar, "var.");
     if (samples) set1(Role::kMask, "mask");
@@ -243,6 +244,11 @@ Status PresetExprs(Preset preset, const std::string& viewLayer, const ChannelSet
     for (const char* pass : {"DiffDir.", "DiffInd."})
       if (set.Has(p + pass + comp)) li.terms.push_back({p + pass + comp});
     if (!li.terms.empty()) (*roles)[size_t(Comp(kLi, c))] = li;
+    Expr lr;
+    for (const char* kind : {"Gloss", "Trans"})
+      if (set.Has(p + kind + "Col." + comp) && set.Has(p + kind + "Ind." + comp))
+        lr.terms.push_back({p + kind + "Col." + comp, p + kind + "Ind." + comp});
+    if (!lr.terms.empty()) (*roles)[size_t(Comp(kLr, c))] = lr;
     // Without Combined, L_c is the sum of what Blender's compositor adds to
     // the diffuse: Gloss = GlossCol*(GlossDir+GlossInd), likewise Trans, then
     // Volume, Emit and Env. With Combined, L_c = Combined - L_i*tau (below).
@@ -402,7 +408,7 @@ Status ParseRole(std::string_view name, Role* role) {
   std::string all;
   for (auto n : kRoleNames) all += (all.empty() ? "" : ", ") + std::string(n);
   return Status::Error("unknown role '" + std::string(name) + "' (roles: " + all +
-                       "; tau, albedo, Li, Lc, L, var map all three components)");
+                       "; tau, albedo, Li, Lc, Lr, L, var map all three components)");
 }
 
 Status ParsePreset(std::string_view name, Preset* preset) {
@@ -418,7 +424,7 @@ Status ParseMapping(std::string_view text, std::vector<Mapping>* out) {
     return Status::Error("--map '" + std::string(text) + "': expected ROLE=CHANNEL");
   const std::string role(OIIO::Strutil::strip(text.substr(0, eq)));
   const std::string expr(OIIO::Strutil::strip(text.substr(eq + 1)));
-  for (const char* group : {"tau", "albedo", "Li", "Lc", "L", "var", "N"}) {
+  for (const char* group : {"tau", "albedo", "Li", "Lc", "Lr", "L", "var", "N"}) {
     if (role == group) {
       const bool vector = role == "N";  // components X, Y, Z
       const char* const comps[3] = {vector ? "X" : "R", vector ? "Y" : "G", vector ? "Z" : "B"};
@@ -649,25 +655,29 @@ Status LookupTextures(const ChannelSet& set, const RoleExprs& roles,
 /// (all when null), from the sample roles of `set`.
 Status ComputeSamples(const ChannelSet& set, Evaluator& ev, const RoleExprs& roles, bool split,
                       bool variance, const std::vector<uint8_t>* mask, Data* d) {
-  bool hasL = false, hasLi = false, hasLc = false, hasVar = false;
+  bool hasL = false, hasLi = false, hasLc = false, hasVar = false, hasLr = false;
   DCM_RETURN_IF_ERROR(RgbPresent(roles, kL, set, &hasL));
   DCM_RETURN_IF_ERROR(RgbPresent(roles, kLi, set, &hasLi));
   DCM_RETURN_IF_ERROR(RgbPresent(roles, kLc, set, &hasLc));
   DCM_RETURN_IF_ERROR(RgbPresent(roles, kVar, set, &hasVar));
-  std::vector<RGB> L, Li, Lc, var;
+  const bool mirrors = split && !d->throughMirror.empty();
+  if (mirrors) DCM_RETURN_IF_ERROR(RgbPresent(roles, kLr, set, &hasLr));
+  std::vector<RGB> L, Li, Lc, Lr, var;
   if (hasL) DCM_RETURN_IF_ERROR(ev.EvalRgb(roles, kL, &L));
   if (hasLi) DCM_RETURN_IF_ERROR(ev.EvalRgb(roles, kLi, &Li));
   if (hasLc) DCM_RETURN_IF_ERROR(ev.EvalRgb(roles, kLc, &Lc));
+  if (hasLr) DCM_RETURN_IF_ERROR(ev.EvalRgb(roles, kLr, &Lr));
   if (variance && hasVar) DCM_RETURN_IF_ERROR(ev.EvalRgb(roles, kVar, &var));
   const size_t n = set.pixels();
   for (size_t i = 0; i < n; ++i) {
     if (mask && !(*mask)[i]) continue;
     const RGB t = d->tau.empty() ? RGB::Gray(1.f) : d->tau[i];
-    if (split && !d->throughMirror.empty() && d->throughMirror[i]) {
-      // tau was about 0: L is what the albedo modulates.
+    if (mirrors && d->throughMirror[i]) {
+      // tau was about 0: the albedo modulates Lr (without it, all of L).
       d->L[i] = hasL ? L[i] : Lc[i];
-      d->Li[i] = RGB{d->L[i].r / t.r, d->L[i].g / t.g, d->L[i].b / t.b};
-      d->Lc[i] = RGB{};
+      const RGB m = hasLr ? Lr[i] : d->L[i];
+      d->Li[i] = RGB{m.r / t.r, m.g / t.g, m.b / t.b};
+      d->Lc[i] = d->L[i] - d->Li[i] * t;
     } else if (split) {
       d->Li[i] = Li[i];
       if (hasLc) {
@@ -767,18 +777,34 @@ std::vector<RGB> EstimateVarianceFromData(const Data& d) {
 void SplitThroughMirrors(const std::string& albedo, Data* d) {
   d->throughMirror.clear();
   if (d->albedo.empty() || d->tau.empty()) return;
+  auto dark = [&](size_t i) {
+    const RGB t = d->tau[i];
+    return t.r < kAlbedoFloor && t.g < kAlbedoFloor && t.b < kAlbedoFloor;
+  };
+  // A surface goes through wholly or not at all: its anti-aliased rim (some
+  // diffuse colour of what lies behind) must not interpolate an L_i of
+  // another meaning from its interior. Through: most of its pixels are dark.
+  std::map<std::pair<uint32_t, uint32_t>, std::pair<int64_t, int64_t>> surfaces;  // (dark, all)
+  auto key = [&](size_t i) {
+    return std::pair{d->objectId.empty() ? 0u : d->objectId[i], d->shaderId.empty() ? 0u : d->shaderId[i]};
+  };
+  for (size_t i = 0; i < d->tau.size(); ++i) {
+    auto& [darkCount, all] = surfaces[key(i)];
+    darkCount += dark(i), ++all;
+  }
   d->throughMirror.assign(d->tau.size(), 0);
   int64_t count = 0;
   for (size_t i = 0; i < d->tau.size(); ++i) {
+    const auto [darkCount, all] = surfaces[key(i)];
     const RGB a = d->albedo[i];
-    const RGB t = d->tau[i];
-    if (!(t.r < kAlbedoFloor && t.g < kAlbedoFloor && t.b < kAlbedoFloor) || !IsFinite(a)) continue;
+    if (2 * darkCount <= all || !IsFinite(a)) continue;
     d->tau[i] = RGB{std::max(a.r, kAlbedoFloor), std::max(a.g, kAlbedoFloor), std::max(a.b, kAlbedoFloor)};
     d->throughMirror[i] = 1;
     ++count;
   }
-  d->notes.push_back("tau through mirrors: " + albedo + " where tau is below " +
-                     OIIO::Strutil::fmt::format("{}", kAlbedoFloor) + " (" + std::to_string(count) + " pixels)");
+  d->notes.push_back("tau through mirrors: " + albedo + " on the surfaces whose tau is below " +
+                     OIIO::Strutil::fmt::format("{}", kAlbedoFloor) + " at most pixels (" + std::to_string(count) +
+                     " pixels)");
 }
 
 /// What the notes say of the albedo that the noise estimate divides out.
@@ -974,11 +1000,17 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
     if (hasVar) d->var.assign(n, RGB{});
     Evaluator ev(guides);
     DCM_RETURN_IF_ERROR(ComputeSamples(guides, ev, sroles, split, hasVar, nullptr, d.get()));
-    DCM_RETURN_IF_ERROR(ev.Report(sroles, {kL, kLi, kLc, kVar}, nullptr, &d->warnings));
+    DCM_RETURN_IF_ERROR(ev.Report(sroles, {kL, kLi, kLc, kLr, kVar}, nullptr, &d->warnings));
     if (hasL) d->notes.push_back("L: " + RgbText(sroles, kL));
     if (split) {
       d->notes.push_back("L_i: " + RgbText(sroles, kLi));
       d->notes.push_back(hasLc ? "L_c: " + RgbText(sroles, kLc) : "L_c: L - L_i*tau");
+      if (!d->throughMirror.empty()) {
+        bool hasLr = false;
+        DCM_RETURN_IF_ERROR(RgbPresent(sroles, kLr, guides, &hasLr));
+        d->notes.push_back("through mirrors: L_i = " + (hasLr ? RgbText(sroles, kLr) : std::string("L")) +
+                           " over tau, L_c = L - L_i*tau");
+      }
     }
     if (hasVar) d->notes.push_back("variance: " + RgbText(sroles, kVar));
     if (hasVar && (!options.secondRender.empty() || options.estimateVariance))
@@ -1107,7 +1139,7 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
       std::vector<uint8_t> mask(n);
       for (size_t i = 0; i < n; ++i) mask[i] = maskPlane[i] > 0.f ? 1 : 0;
       DCM_RETURN_IF_ERROR(ComputeSamples(s, ev, fileRoles, split, variance, &mask, d.get()));
-      DCM_RETURN_IF_ERROR(ev.Report(fileRoles, {kL, kLi, kLc, kVar}, &mask, &d->warnings));
+      DCM_RETURN_IF_ERROR(ev.Report(fileRoles, {kL, kLi, kLc, kLr, kVar}, &mask, &d->warnings));
       int64_t count = 0;
       for (size_t i = 0; i < n; ++i) {
         count += mask[i];

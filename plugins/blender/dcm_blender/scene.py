@@ -187,8 +187,12 @@ class Session:
                      "use_pass_cryptomatte_material"):
             c.set(vl, attr, True)
         c.set(vl, "pass_cryptomatte_depth", 2)
-        # The Denoising Albedo: the texture seen through mirrors and glass.
+        # The Denoising Albedo: the texture seen through mirrors and glass, and what it
+        # modulates there, the light they pass on (GlossCol*GlossInd + TransCol*TransInd).
         c.set(vl.cycles, "denoising_store_passes", True)
+        for attr in ("use_pass_glossy_color", "use_pass_glossy_indirect", "use_pass_transmission_color",
+                     "use_pass_transmission_indirect"):
+            c.set(vl, attr, True)
         # How many samples each pixel took: an exact pixel that stopped early is rendered again.
         c.set(vl.cycles, "pass_debug_sample_count", True)
 
@@ -454,14 +458,20 @@ class Session:
                 return sum(n * self._rgb(p, name, comps) for n, p in zip(counts, pls)) / float(ps)
             pl = pls[0]
             g = {}
+            g["texture"] = mean("DiffCol")
             g["object_id"] = pl["CryptoObject00.r"].view(np.uint32).copy()
             g["shader_id"] = pl["CryptoMaterial00.r"].view(np.uint32).copy()
-            g["texture"] = mean("DiffCol")
-            # The texture split through mirrors: there L_i = L / texture and L_c = 0
-            # (_exact_values), so that what a mirror shows is re-applied per pixel.
+            # The texture split through mirrors (the AOV provider's albedo role): on a
+            # surface whose DiffCol is below ALBEDO_FLOOR at most pixels, the texture is
+            # the Denoising Albedo and L_i the light it modulates over it (_reflected),
+            # so that what a mirror shows is re-applied per pixel.
             mirror = np.zeros((self.height, self.width), bool)
             if "Denoising Albedo.R" in pl:
-                mirror = (g["texture"] < ALBEDO_FLOOR).all(axis=-1)
+                dark = (g["texture"] < ALBEDO_FLOOR).all(axis=-1)
+                surface = g["object_id"].astype(np.uint64) << np.uint64(32) | g["shader_id"].astype(np.uint64)
+                keys, inverse = np.unique(surface, return_inverse=True)
+                share = np.bincount(inverse.ravel(), dark.ravel()) / np.bincount(inverse.ravel())
+                mirror = (share > 0.5)[inverse].reshape(dark.shape)
                 g["texture"][mirror] = np.maximum(mean("Denoising Albedo")[mirror], ALBEDO_FLOOR)
             self._through_mirror = mirror
             g["normal"] = self._rgb(pl, "Normal", "XYZ")
@@ -469,7 +479,8 @@ class Session:
             # Each half's render alone (_careful, _stopped_early).
             g["L_of_half"] = [self._rgb(p, "Combined") for p in pls]
             g["Li"] = mean("DiffDir") + mean("DiffInd")
-            g["Li"][mirror] = g["L"][mirror] / g["texture"][mirror]
+            reflected = sum(n * self._reflected(p) for n, p in zip(counts, pls)) / float(ps)
+            g["Li"][mirror] = reflected[mirror] / g["texture"][mirror]
             g["Lc"] = g["L"] - g["Li"] * g["texture"]
             if len(pls) == 2:
                 # The preview's variance (dcm::HalvesVariance), at the exact pixels' samples.
@@ -609,14 +620,20 @@ class Session:
             return np.ones(len(xs), bool)
         return (xs >= rect[0]) & (xs < rect[2]) & (ys >= rect[1]) & (ys < rect[3])
 
+    def _reflected(self, planes):
+        """What a mirror or glass passes on from the surfaces it shows, which their
+        albedo modulates: GlossCol * GlossInd + TransCol * TransInd (the AOV preset's Lr)."""
+        return (self._rgb(planes, "GlossCol") * self._rgb(planes, "GlossInd")
+                + self._rgb(planes, "TransCol") * self._rgb(planes, "TransInd"))
+
     def _exact_values(self, pl, xs, ys):
         """L and L_i = DiffDir + DiffInd of pixels (xs, ys) in a render's planes;
-        through a mirror (guides()) L_i = L / the texture guide."""
+        through a mirror (guides()) L_i = _reflected() / the texture guide."""
         texture = self.guides()["texture"]
         L = self._rgb(pl, "Combined")[ys, xs]
         Li = (self._rgb(pl, "DiffDir") + self._rgb(pl, "DiffInd"))[ys, xs]
         mirror = self._through_mirror[ys, xs]
-        Li[mirror] = L[mirror] / texture[ys, xs][mirror]
+        Li[mirror] = self._reflected(pl)[ys, xs][mirror] / texture[ys, xs][mirror]
         return L, Li
 
     def _render_all_samples(self, n, label, seed, xs, ys):

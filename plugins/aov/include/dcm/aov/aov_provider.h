@@ -42,6 +42,11 @@ enum class Role : int {
   kAlbedoR, kAlbedoG, kAlbedoB,
   kLiR, kLiG, kLiB,     ///< "Li.R/G/B": radiance before texturing
   kLcR, kLcG, kLcB,     ///< "Lc.R/G/B": radiance not modulated by the texture
+  /// "Lr.R/G/B": the radiance that a mirror or glass passes on from the
+  /// surfaces it shows (indirect glossy and transmitted light), which their
+  /// albedo modulates; with the albedo, L_i = Lr / tau there and the rest of
+  /// L (a light's highlight) is L_c
+  kLrR, kLrG, kLrB,
   kLR, kLG, kLB,        ///< "L.R/G/B": beauty radiance
   kVarR, kVarG, kVarB,  ///< "var.R/G/B": variance of the estimate of L
   kMask,      ///< "mask": in a samples EXR, > 0 where the pixel was rendered
@@ -58,7 +63,7 @@ Status ParseRole(std::string_view name, Role* role);
 /// Where the channel names come from.
 enum class Preset {
   /// Plain names: id, shader, u, v, tau.R/G/B, N.X/Y/Z, shadow, highlight, albedo.R/G/B, Li.R/G/B,
-  /// Lc.R/G/B, beauty R/G/B, var.R/G/B, mask.
+  /// Lc.R/G/B, Lr.R/G/B, beauty R/G/B, var.R/G/B, mask.
   kGeneric,
   /// Blender Cycles multilayer EXR: <layer>.IndexOB.X, IndexMA.X (or the
   /// CryptoObject / CryptoMaterial layers), UV.U/V, Normal.X/Y/Z, tau = DiffCol,
@@ -67,7 +72,8 @@ enum class Preset {
   /// Gloss, Trans, Volume, Emit and Env contributions). The Combined of a
   /// view layer named ShadowGuide* is the shadow guide (R + G + B); the
   /// GlossDir of one named HighlightGuide* is the highlight guide (R + G + B).
-  /// albedo = Denoising Albedo (the view layer's Denoising Data), where written.
+  /// albedo = Denoising Albedo (the view layer's Denoising Data), where written;
+  /// Lr = GlossCol*GlossInd + TransCol*TransInd.
   kBlender,
 };
 Status ParsePreset(std::string_view name, Preset* preset);
