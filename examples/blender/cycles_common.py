@@ -122,7 +122,8 @@ def enable_dcm_passes(vl):
     """The passes `dcm reconstruct --preset blender` reads, on view layer vl:
     Combined, Normal (creases inside one object, --crease-angle), IndexOB,
     IndexMA, UV, Diffuse/Glossy/Transmission Color+Direct+Indirect, Emit, Env,
-    Cryptomatte object and material."""
+    Cryptomatte object and material, and Denoising Data (its Denoising Albedo:
+    the texture seen in mirrors and through glass, docs/NOISE.md)."""
     vl.use_pass_combined = True
     vl.use_pass_normal = True
     vl.use_pass_object_index = True
@@ -135,6 +136,7 @@ def enable_dcm_passes(vl):
     vl.use_pass_environment = True
     vl.use_pass_cryptomatte_object = True
     vl.use_pass_cryptomatte_material = True
+    vl.cycles.denoising_store_passes = True
 
 
 def setup_render(args):

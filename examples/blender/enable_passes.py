@@ -6,7 +6,8 @@
 #
 # What it changes (in memory; your .blend is untouched unless --save):
 #  - Cycles, every view layer: Combined, IndexOB, IndexMA, UV, Diffuse/Glossy/
-#    Transmission Color+Direct+Indirect, Emit, Env, Cryptomatte object+material;
+#    Transmission Color+Direct+Indirect, Emit, Env, Cryptomatte object+material,
+#    Denoising Data (the Denoising Albedo: textures seen in mirrors);
 #  - object and material pass indices that are 0 get distinct numbers (dcm
 #    prefers the Cryptomatte layers, but IndexOB/IndexMA then mean something too);
 #  - adaptive sampling and denoising off (dcm compares against a plain estimate);

@@ -70,8 +70,8 @@ def main():
         for r, sel in enumerate(rounds):
             xs, ys = sel % w, sel // w
             L, Li, Lc = child.eval(xs, ys)
-            # Through a mirror L_i is the light passed on (GlossCol * GlossInd + TransCol *
-            # TransInd) over the texture guide; the sky passes on none: L_i = 0, L_c = L.
+            # Through a mirror L_i is the light it reflects (GlossCol * GlossInd) over the
+            # texture guide; the sky reflects none: L_i = 0, L_c = L.
             mirror = through_mirror[ys, xs]
             assert r == 2 or mirror.any(), "round %d: no sky pixel to look at" % r
             assert (Li[mirror] == 0).all() and np.array_equal(Lc[mirror], L[mirror])

@@ -244,11 +244,14 @@ Status PresetExprs(Preset preset, const std::string& viewLayer, const ChannelSet
     for (const char* pass : {"DiffDir.", "DiffInd."})
       if (set.Has(p + pass + comp)) li.terms.push_back({p + pass + comp});
     if (!li.terms.empty()) (*roles)[size_t(Comp(kLi, c))] = li;
-    Expr lr;
-    for (const char* kind : {"Gloss", "Trans"})
-      if (set.Has(p + kind + "Col." + comp) && set.Has(p + kind + "Ind." + comp))
-        lr.terms.push_back({p + kind + "Col." + comp, p + kind + "Ind." + comp});
-    if (!lr.terms.empty()) (*roles)[size_t(Comp(kLr, c))] = lr;
+    // What a mirror reflects of the surfaces it shows. Light through glass
+    // stays in L_c: through a glass ball it has edges as sharp as the texture
+    // (the contact shadow under it, docs/NOISE.md).
+    if (set.Has(p + "GlossCol." + comp) && set.Has(p + "GlossInd." + comp)) {
+      Expr lr;
+      lr.terms.push_back({p + "GlossCol." + comp, p + "GlossInd." + comp});
+      (*roles)[size_t(Comp(kLr, c))] = lr;
+    }
     // Without Combined, L_c is the sum of what Blender's compositor adds to
     // the diffuse: Gloss = GlossCol*(GlossDir+GlossInd), likewise Trans, then
     // Volume, Emit and Env. With Combined, L_c = Combined - L_i*tau (below).

@@ -187,11 +187,10 @@ class Session:
                      "use_pass_cryptomatte_material"):
             c.set(vl, attr, True)
         c.set(vl, "pass_cryptomatte_depth", 2)
-        # The Denoising Albedo: the texture seen through mirrors and glass, and what it
-        # modulates there, the light they pass on (GlossCol*GlossInd + TransCol*TransInd).
+        # The Denoising Albedo: the texture seen in mirrors, and what it modulates
+        # there, the light they reflect (GlossCol * GlossInd).
         c.set(vl.cycles, "denoising_store_passes", True)
-        for attr in ("use_pass_glossy_color", "use_pass_glossy_indirect", "use_pass_transmission_color",
-                     "use_pass_transmission_indirect"):
+        for attr in ("use_pass_glossy_color", "use_pass_glossy_indirect"):
             c.set(vl, attr, True)
         # How many samples each pixel took: an exact pixel that stopped early is rendered again.
         c.set(vl.cycles, "pass_debug_sample_count", True)
@@ -621,10 +620,10 @@ class Session:
         return (xs >= rect[0]) & (xs < rect[2]) & (ys >= rect[1]) & (ys < rect[3])
 
     def _reflected(self, planes):
-        """What a mirror or glass passes on from the surfaces it shows, which their
-        albedo modulates: GlossCol * GlossInd + TransCol * TransInd (the AOV preset's Lr)."""
-        return (self._rgb(planes, "GlossCol") * self._rgb(planes, "GlossInd")
-                + self._rgb(planes, "TransCol") * self._rgb(planes, "TransInd"))
+        """What a mirror reflects of the surfaces it shows, which their albedo
+        modulates: GlossCol * GlossInd (the AOV preset's Lr; light through glass
+        stays in L_c)."""
+        return self._rgb(planes, "GlossCol") * self._rgb(planes, "GlossInd")
 
     def _exact_values(self, pl, xs, ys):
         """L and L_i = DiffDir + DiffInd of pixels (xs, ys) in a render's planes;

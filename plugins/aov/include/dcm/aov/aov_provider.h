@@ -42,10 +42,10 @@ enum class Role : int {
   kAlbedoR, kAlbedoG, kAlbedoB,
   kLiR, kLiG, kLiB,     ///< "Li.R/G/B": radiance before texturing
   kLcR, kLcG, kLcB,     ///< "Lc.R/G/B": radiance not modulated by the texture
-  /// "Lr.R/G/B": the radiance that a mirror or glass passes on from the
-  /// surfaces it shows (indirect glossy and transmitted light), which their
-  /// albedo modulates; with the albedo, L_i = Lr / tau there and the rest of
-  /// L (a light's highlight) is L_c
+  /// "Lr.R/G/B": the radiance that a mirror reflects of the surfaces it
+  /// shows (indirect glossy light), which their albedo modulates; with the
+  /// albedo, L_i = Lr / tau there and the rest of L (a light's highlight,
+  /// light through glass) is L_c
   kLrR, kLrG, kLrB,
   kLR, kLG, kLB,        ///< "L.R/G/B": beauty radiance
   kVarR, kVarG, kVarB,  ///< "var.R/G/B": variance of the estimate of L
@@ -73,7 +73,7 @@ enum class Preset {
   /// view layer named ShadowGuide* is the shadow guide (R + G + B); the
   /// GlossDir of one named HighlightGuide* is the highlight guide (R + G + B).
   /// albedo = Denoising Albedo (the view layer's Denoising Data), where written;
-  /// Lr = GlossCol*GlossInd + TransCol*TransInd.
+  /// Lr = GlossCol*GlossInd.
   kBlender,
 };
 Status ParsePreset(std::string_view name, Preset* preset);
