@@ -743,18 +743,18 @@ bool NeighbourResidual(const Data& d, const std::vector<RGB>& v, int x, int y, R
 /// up to a constant factor (the one-render estimate is relative).
 constexpr float kAlbedoFloor = 0.02f;
 
-/// VarianceFromOneRender of `v` with the albedo `a` (per pixel, less `minus`
-/// where given) divided out and multiplied back in: a texture that `v` shows,
-/// also one seen in a mirror, is then no residual that looks like noise. No
-/// albedo: `v` as it is.
-std::vector<RGB> VarianceWithAlbedoOut(const Data& d, const std::vector<RGB>& v, const std::vector<RGB>& minus) {
+/// VarianceFromOneRender of `v` with the albedo divided out (at least
+/// kAlbedoFloor) and multiplied back in: a texture that `v` shows, also one
+/// seen in a mirror, is then no residual that looks like noise. No albedo:
+/// `v` as it is.
+std::vector<RGB> VarianceWithAlbedoOut(const Data& d, const std::vector<RGB>& v) {
   const int W = d.width(), H = d.height();
   if (d.albedo.empty()) return dcm::VarianceFromOneRender(v, W, H, d.objectId, d.shaderId);
   std::vector<RGB> a(v.size()), q(v.size());
   for (size_t i = 0; i < v.size(); ++i)
     for (int c = 0; c < 3; ++c) {
-      const float rest = d.albedo[i][c] - (minus.empty() ? 0.f : minus[i][c]);
-      a[i][c] = std::isfinite(rest) ? std::max(rest, kAlbedoFloor) : kAlbedoFloor;
+      const float albedo = d.albedo[i][c];
+      a[i][c] = std::isfinite(albedo) ? std::max(albedo, kAlbedoFloor) : kAlbedoFloor;
       q[i][c] = v[i][c] / a[i][c];
     }
   std::vector<RGB> var = dcm::VarianceFromOneRender(q, W, H, d.objectId, d.shaderId);
@@ -763,16 +763,15 @@ std::vector<RGB> VarianceWithAlbedoOut(const Data& d, const std::vector<RGB>& v,
 }
 
 /// The variance estimate of AovOptions::estimateVariance, in L units: with
-/// the texture split, of L_i (the texture divided out) times tau^2 plus of L_c,
-/// whose noise hardly correlates with L_i's (0.1 on the tuning room);
-/// without it, of L. With an albedo (Role::kAlbedoR), L_c is divided by what
-/// of it tau does not explain (a mirror's or glass's: the albedo of what it
-/// shows), L without the split by the albedo.
+/// the texture split, of L_i (the texture divided out; through mirrors the
+/// albedo, SplitThroughMirrors) times tau^2 plus of L_c, whose noise hardly
+/// correlates with L_i's (0.1 on the tuning room); without it, of L with the
+/// albedo divided out where there is one.
 std::vector<RGB> EstimateVarianceFromData(const Data& d) {
   const int W = d.width(), H = d.height();
-  if (d.Li.empty() || d.Lc.empty() || d.tau.empty()) return VarianceWithAlbedoOut(d, d.L, {});
+  if (d.Li.empty() || d.Lc.empty() || d.tau.empty()) return VarianceWithAlbedoOut(d, d.L);
   std::vector<RGB> var = dcm::VarianceFromOneRender(d.Li, W, H, d.objectId, d.shaderId);
-  const std::vector<RGB> c = VarianceWithAlbedoOut(d, d.Lc, d.tau);
+  const std::vector<RGB> c = dcm::VarianceFromOneRender(d.Lc, W, H, d.objectId, d.shaderId);
   for (size_t i = 0; i < var.size(); ++i) var[i] = var[i] * d.tau[i] * d.tau[i] + c[i];
   return var;
 }
