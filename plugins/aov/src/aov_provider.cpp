@@ -474,7 +474,7 @@ struct AovProvider::Data {
   std::vector<uint32_t> objectId, shaderId;
   std::vector<RGB> tau, L, Li, Lc, var;
   std::vector<RGB> albedo;  ///< Role::kAlbedoR..B; empty: none
-  /// With the split and an albedo: 1 where tau was about 0 and is the albedo now
+  /// With the split and an albedo: 1 where tau is the albedo now
   /// (SplitThroughMirrors); empty: nowhere.
   std::vector<uint8_t> throughMirror;
   std::vector<Vec3f> normal;
@@ -676,7 +676,7 @@ Status ComputeSamples(const ChannelSet& set, Evaluator& ev, const RoleExprs& rol
     if (mask && !(*mask)[i]) continue;
     const RGB t = d->tau.empty() ? RGB::Gray(1.f) : d->tau[i];
     if (mirrors && d->throughMirror[i]) {
-      // tau was about 0: the albedo modulates Lr (without it, all of L).
+      // Through a mirror: the albedo modulates Lr (without it, all of L).
       d->L[i] = hasL ? L[i] : Lc[i];
       const RGB m = hasLr ? Lr[i] : d->L[i];
       d->Li[i] = RGB{m.r / t.r, m.g / t.g, m.b / t.b};
@@ -697,18 +697,6 @@ Status ComputeSamples(const ChannelSet& set, Evaluator& ev, const RoleExprs& rol
   }
   return Status::Ok();
 }
-
-/// The texture split through mirrors: where tau is below kAlbedoFloor (no
-/// diffuse colour: a mirror, glass, a metal, also the sky and black surfaces;
-/// their anti-aliased rims, whose L_c must not be interpolated from
-/// neighbours that have none) and an albedo is
-/// given, tau becomes that albedo (at least kAlbedoFloor per channel), and
-/// ComputeSamples makes L_i = L / tau, L_c = 0 there. Cycles' Denoising Albedo
-/// continues through sharp mirrors and glass to the surface they show, so
-/// that a reflected texture is re-applied per pixel as a diffuse one is, and
-/// the engine interpolates the light it reflects instead. `albedo` names the
-/// channels in the note it adds.
-void SplitThroughMirrors(const std::string& albedo, Data* d);
 
 /// Pixels i and j lie on the same surface for the noise estimates: equal
 /// object and shader IDs where the inputs carry them.
@@ -738,9 +726,9 @@ bool NeighbourResidual(const Data& d, const std::vector<RGB>& v, int x, int y, R
   return true;
 }
 
-/// Below this an albedo channel divides as this: a black surface, or a
-/// diffuse one whose colour tau already explains its albedo, keeps its values
-/// up to a constant factor (the one-render estimate is relative).
+/// Below this a channel of tau is no diffuse colour (SplitThroughMirrors), and
+/// an albedo channel is taken as this: a black surface then keeps its values
+/// up to a constant factor.
 constexpr float kAlbedoFloor = 0.02f;
 
 /// VarianceFromOneRender of `v` with the albedo divided out (at least
@@ -776,6 +764,15 @@ std::vector<RGB> EstimateVarianceFromData(const Data& d) {
   return var;
 }
 
+/// The texture split through mirrors: on a surface whose tau is below
+/// kAlbedoFloor at most of its pixels (no diffuse colour: a mirror, metal,
+/// glass, also the sky and black surfaces), tau becomes the albedo (at least
+/// kAlbedoFloor per channel) at every pixel, and ComputeSamples makes L_i =
+/// Lr / tau (all of L without Lr) and L_c the rest there. Cycles' Denoising
+/// Albedo continues through sharp mirrors to the surface they show, so that
+/// a reflected texture is re-applied per pixel as a diffuse one is, and the
+/// engine interpolates the light the mirror reflects instead. `albedo` names
+/// the channels in the note it adds.
 void SplitThroughMirrors(const std::string& albedo, Data* d) {
   d->throughMirror.clear();
   if (d->albedo.empty() || d->tau.empty()) return;
