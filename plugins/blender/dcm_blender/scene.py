@@ -27,8 +27,8 @@ import numpy as np
 from . import exr
 
 # Below this in every channel DiffCol says no diffuse colour (a mirror, glass,
-# metal; also the sky, black surfaces and their rims), and the texture guide is
-# the Denoising Albedo, at least this: dcm's kAlbedoFloor (the AOV provider's
+# metal; also the sky and black surfaces), and the texture guide there is the
+# Denoising Albedo, at least this: dcm's kAlbedoFloor (the AOV provider's
 # albedo role, docs/AOV.md).
 ALBEDO_FLOOR = 0.02
 
@@ -468,7 +468,7 @@ class Session:
             if "Denoising Albedo.R" in pl:
                 dark = (g["texture"] < ALBEDO_FLOOR).all(axis=-1)
                 surface = g["object_id"].astype(np.uint64) << np.uint64(32) | g["shader_id"].astype(np.uint64)
-                keys, inverse = np.unique(surface, return_inverse=True)
+                _, inverse = np.unique(surface, return_inverse=True)
                 share = np.bincount(inverse.ravel(), dark.ravel()) / np.bincount(inverse.ravel())
                 mirror = (share > 0.5)[inverse].reshape(dark.shape)
                 g["texture"][mirror] = np.maximum(mean("Denoising Albedo")[mirror], ALBEDO_FLOOR)
