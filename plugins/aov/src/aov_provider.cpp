@@ -771,9 +771,9 @@ std::vector<RGB> EstimateVarianceFromData(const Data& d) {
 /// Lr / tau (all of L without Lr) and L_c the rest there. Cycles' Denoising
 /// Albedo continues through sharp mirrors to the surface they show, so that
 /// a reflected texture is re-applied per pixel as a diffuse one is, and the
-/// engine interpolates the light the mirror reflects instead. `albedo` names
-/// the channels in the note it adds.
-void SplitThroughMirrors(const std::string& albedo, Data* d) {
+/// engine interpolates the light the mirror reflects instead; `roles` name
+/// the albedo's channels in the note it adds.
+void SplitThroughMirrors(const RoleExprs& roles, Data* d) {
   d->throughMirror.clear();
   if (d->albedo.empty() || d->tau.empty()) return;
   auto dark = [&](size_t i) {
@@ -801,7 +801,7 @@ void SplitThroughMirrors(const std::string& albedo, Data* d) {
     d->throughMirror[i] = 1;
     ++count;
   }
-  d->notes.push_back("tau through mirrors: " + albedo + " on the surfaces whose tau is below " +
+  d->notes.push_back("tau through mirrors: " + RgbText(roles, kAlbedo) + " on the surfaces whose tau is below " +
                      OIIO::Strutil::fmt::format("{}", kAlbedoFloor) + " at most pixels (" + std::to_string(count) +
                      " pixels)");
 }
@@ -989,7 +989,7 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
     DCM_RETURN_IF_ERROR(RgbPresent(sroles, kLc, guides, &hasLc));
     DCM_RETURN_IF_ERROR(RgbPresent(sroles, kVar, guides, &hasVar));
     split = options.split && hasTau && hasLi && (hasL || hasLc);
-    if (split) SplitThroughMirrors(RgbText(roles, kAlbedo), d.get());
+    if (split) SplitThroughMirrors(roles, d.get());
     DCM_RETURN_IF_ERROR(CheckSampleRoles(sroles, split, hasTau, guides, guides.Paths()));
     d->L.assign(n, RGB{});
     if (split) {
@@ -1078,7 +1078,7 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
     // Capabilities come from the guides and the options alone, so that they
     // are the same in every round; the samples must then match them.
     split = options.split && hasTau;
-    if (split) SplitThroughMirrors(RgbText(roles, kAlbedo), d.get());
+    if (split) SplitThroughMirrors(roles, d.get());
     d->dense = false;
     d->L.assign(n, RGB{});
     if (split) {
