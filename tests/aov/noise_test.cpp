@@ -326,6 +326,56 @@ TEST(AovAlbedo, LightTheAlbedoDoesNotModulateStaysInLc) {
   EXPECT_GT(overL, 100 * overLr);
 }
 
+TEST(AovAlbedo, WithoutABeautyTheMirrorsLKeepsItsDiffuseLight) {
+  // No R, G, B: L is L_i tau + L_c. A mirror's tau (0.01 here, below the
+  // floor) is replaced by the albedo for the split through mirrors, but L
+  // must still be made of the tau the inputs gave, diffuse light included.
+  ScratchDir dir;
+  const MirrorScene sc;
+  constexpr float kMirrorTau = 0.01f;
+  auto tau = [&](int x) { return sc.Mirror(x) ? kMirrorTau : 0.5f; };
+  auto lc = [&](int x, int y) { return sc.Mirror(x) ? sc.L(x, y) : 0.f; };
+  std::vector<TestChannel> ch;
+  for (const char* c : {"Li.R", "Li.G", "Li.B"})
+    ch.push_back(Fill(c, sc.width, sc.height, [&](int x, int y) { return sc.Light(x, y); }));
+  for (const char* c : {"Lc.R", "Lc.G", "Lc.B"}) ch.push_back(Fill(c, sc.width, sc.height, lc));
+  for (const char* c : {"tau.R", "tau.G", "tau.B"})
+    ch.push_back(Fill(c, sc.width, sc.height, [&](int x, int) { return tau(x); }));
+  for (const char* c : {"albedo.R", "albedo.G", "albedo.B"})
+    ch.push_back(Fill(c, sc.width, sc.height, [&](int x, int y) { return sc.Albedo(x, y); }));
+  TestChannel id{"id", {}, {}}, shader{"shader", {}, {}};
+  for (int y = 0; y < sc.height; ++y)
+    for (int x = 0; x < sc.width; ++x) {
+      id.ids.push_back(sc.Mirror(x) ? 2u : 1u);
+      shader.ids.push_back(sc.Mirror(x) ? 2u : 1u);
+    }
+  ch.push_back(id);
+  ch.push_back(shader);
+  WriteExr(dir / "nobeauty.exr", sc.width, sc.height, ch);
+  auto p = Open({dir / "nobeauty.exr"}, AovOptions{});
+  ASSERT_TRUE(p);
+  std::vector<Point2i> px;
+  for (int y = 0; y < sc.height; ++y)
+    for (int x = 0; x < sc.width; ++x) px.push_back({x, y});
+  std::vector<ExactSample> s(px.size());
+  SampleRequest req;
+  req.split = true;
+  const Status st = p->Evaluate(px, req, s);
+  ASSERT_TRUE(st.ok()) << st.message();
+  for (int y = 0; y < sc.height; ++y)
+    for (int x = 0; x < sc.width; ++x) {
+      const ExactSample& e = s[size_t(y * sc.width + x)];
+      // One product and one sum in float: a few ulps of values up to 0.7;
+      // dropping L_i tau would be off by 0.01 times a light of 0.3 to 0.9.
+      const float want = sc.Light(x, y) * tau(x) + lc(x, y);
+      ASSERT_NEAR(e.L.g, want, 1e-6f) << "pixel " << x << "," << y;
+      // On the mirror the split went through: L_i is L over the albedo.
+      if (sc.Mirror(x)) {
+        ASSERT_NEAR(e.Li.g, want / sc.Albedo(x, y), 1e-5f) << "pixel " << x << "," << y;
+      }
+    }
+}
+
 TEST(AovNoise, ConflictingVarianceSourcesAreErrors) {
   ScratchDir dir;
   const Scene sc{32, 32};

@@ -477,6 +477,9 @@ struct AovProvider::Data {
   /// With the split and an albedo: 1 where tau is the albedo now
   /// (SplitThroughMirrors); empty: nowhere.
   std::vector<uint8_t> throughMirror;
+  /// tau as the inputs give it, where throughMirror is set: L = L_i tau + L_c
+  /// of an input without a beauty.
+  std::vector<RGB> inputTau;
   std::vector<Vec3f> normal;
   /// Sparse mode: where a sample was read, 1 + the index of the last
   /// samples file that holds it (the one whose values the pixel has); 0 elsewhere.
@@ -677,7 +680,7 @@ Status ComputeSamples(const ChannelSet& set, Evaluator& ev, const RoleExprs& rol
     const RGB t = d->tau.empty() ? RGB::Gray(1.f) : d->tau[i];
     if (mirrors && d->throughMirror[i]) {
       // Through a mirror: the albedo modulates Lr (without it, all of L).
-      d->L[i] = hasL ? L[i] : Lc[i];
+      d->L[i] = hasL ? L[i] : Li[i] * d->inputTau[i] + Lc[i];
       const RGB m = hasLr ? Lr[i] : d->L[i];
       d->Li[i] = RGB{m.r / t.r, m.g / t.g, m.b / t.b};
       d->Lc[i] = d->L[i] - d->Li[i] * t;
@@ -775,6 +778,7 @@ std::vector<RGB> EstimateVarianceFromData(const Data& d) {
 /// the albedo's channels in the note it adds.
 void SplitThroughMirrors(const RoleExprs& roles, Data* d) {
   d->throughMirror.clear();
+  d->inputTau.clear();
   if (d->albedo.empty() || d->tau.empty()) return;
   auto dark = [&](size_t i) {
     const RGB t = d->tau[i];
@@ -792,6 +796,7 @@ void SplitThroughMirrors(const RoleExprs& roles, Data* d) {
     darkCount += dark(i), ++all;
   }
   d->throughMirror.assign(d->tau.size(), 0);
+  d->inputTau = d->tau;
   int64_t count = 0;
   for (size_t i = 0; i < d->tau.size(); ++i) {
     const auto [darkCount, all] = surfaces[key(i)];
@@ -1031,6 +1036,7 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
       Data b;
       b.tau = d->tau;
       b.throughMirror = d->throughMirror;
+      b.inputTau = d->inputTau;
       b.L.assign(n, RGB{});
       if (split) b.Li.assign(n, RGB{}), b.Lc.assign(n, RGB{});
       second.Want(ChannelsOf(second, roles2));
