@@ -2,6 +2,7 @@
 // second render or estimated from the data, and dcm reconstruct on noisy input.
 #include <gtest/gtest.h>
 
+#include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -166,11 +167,34 @@ TEST(AovNoise, NoiseDetectedWhereItMatters) {
     auto p = Open({path}, o);
     ASSERT_TRUE(p);
     EXPECT_EQ(p->Capabilities().variance, c.noisy) << "sigma " << c.sigma << ", noise PSNR " << psnr << " dB";
-    std::printf("sigma %.3f: noise %.1f dB PSNR, %s\n", c.sigma, psnr, p->Capabilities().variance ? "noisy" : "clean");
+    const double detected = p->Noise().detectedPsnr;
+    std::printf("sigma %.3f: noise %.1f dB PSNR, detected %.1f dB, %s\n", c.sigma, psnr, detected,
+                p->Capabilities().variance ? "noisy" : "clean");
+    // What it says is what it decided: the figure on the side of 42 dB it chose.
+    EXPECT_EQ(p->Noise().variance, c.noisy ? "detected" : "none");
+    EXPECT_FALSE(std::isnan(detected));
+    EXPECT_EQ(detected < kNoisyPsnr, c.noisy) << detected;
+    // The command says the same in its stats and the output's metadata (an
+    // infinite figure, no noise seen at all, is null in JSON and absent there).
+    const RunResult r = RunDcm({"reconstruct", path, "-o", dir / "out.exr", "--stats", dir / "s.json", "-q"}, dir);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto stats = nlohmann::json::parse(ReadText(dir / "s.json"));
+    EXPECT_EQ(stats["noise"]["variance"], p->Noise().variance);
+    auto in = OIIO::ImageInput::open(dir / "out.exr");
+    ASSERT_TRUE(in);
+    EXPECT_EQ(in->spec().get_string_attribute("dcm:variance"), p->Noise().variance);
+    if (std::isfinite(detected)) {
+      EXPECT_NEAR(stats["noise"]["detected_psnr"].get<double>(), detected, 1e-9);
+      EXPECT_FLOAT_EQ(in->spec().get_float_attribute("dcm:detected_noise_psnr"), float(detected));
+    } else {
+      EXPECT_TRUE(stats["noise"]["detected_psnr"].is_null());
+    }
     // Without the flag nothing is estimated.
     auto q = Open({path}, AovOptions{});
     ASSERT_TRUE(q);
     EXPECT_FALSE(q->Capabilities().variance);
+    EXPECT_EQ(q->Noise().variance, "none");
+    EXPECT_TRUE(std::isnan(q->Noise().detectedPsnr));
   }
 }
 
@@ -431,6 +455,7 @@ TEST(AovNoise, ReconstructFromTwoNoisyRendersBeatsTheirMean) {
   ASSERT_EQ(mean.exitCode, 0) << mean.err;
   const auto s = nlohmann::json::parse(ReadText(dir / "s.json"));
   const auto m = nlohmann::json::parse(ReadText(dir / "m.json"));
+  EXPECT_EQ(s["noise"]["variance"], "second render");
   EXPECT_LE(s["exact_fraction"].get<double>(), 0.35);
   EXPECT_GE(s["reference"]["psnr"].get<double>(), m["reference"]["psnr"].get<double>())
       << "dcm " << s["reference"].dump() << " vs mean of the renders " << m["reference"].dump();

@@ -68,6 +68,9 @@ toolkit::Metadata ProvenanceMetadata(const ReconstructFlags& f, const aov::AovPr
   std::string inputs;
   for (const auto& in : f.aov.inputs) inputs += (inputs.empty() ? "" : " ") + in;
   meta.strings.push_back({"dcm:inputs", inputs});
+  meta.strings.push_back({"dcm:variance", provider.Noise().variance});
+  if (std::isfinite(provider.Noise().detectedPsnr))
+    meta.floats.push_back({"dcm:detected_noise_psnr", float(provider.Noise().detectedPsnr)});
   return meta;
 }
 

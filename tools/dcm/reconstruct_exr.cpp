@@ -45,6 +45,13 @@ nlohmann::json ExrStatsJson(const std::string& cmd, const aov_common::AovFlags& 
   stats["time_reconstruct_s"] = wallS;
   stats["options"] = toolkit::OptionsToJson(options);
   stats["warnings"] = provider.Warnings();
+  const aov::AovProvider::NoiseInfo& noise = provider.Noise();
+  stats["noise"] = {{"variance", noise.variance}};
+  // Absent where the detector did not run; null where it saw no noise at all
+  // (an infinite PSNR, as ErrorJson's).
+  if (!std::isnan(noise.detectedPsnr))
+    stats["noise"]["detected_psnr"] =
+        std::isfinite(noise.detectedPsnr) ? nlohmann::json(noise.detectedPsnr) : nlohmann::json(nullptr);
   return stats;
 }
 

@@ -489,6 +489,7 @@ struct AovProvider::Data {
   std::vector<std::string> beautyChannels;  ///< AovProvider::BeautyChannels
   std::vector<std::string> idChannels;      ///< AovProvider::IdChannels
   std::vector<std::string> maskChannels;    ///< AovProvider::MaskChannels
+  AovProvider::NoiseInfo noise;
 };
 
 namespace {
@@ -1016,7 +1017,10 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
                            " over tau, L_c = L - L_i*tau");
       }
     }
-    if (hasVar) d->notes.push_back("variance: " + RgbText(sroles, kVar));
+    if (hasVar) {
+      d->notes.push_back("variance: " + RgbText(sroles, kVar));
+      d->noise.variance = "channels";
+    }
     if (hasVar && (!options.secondRender.empty() || options.estimateVariance))
       return Status::Error("the inputs carry variance (" + RgbText(sroles, kVar) +
                            "): a second render or an estimate from the data would replace it; use one");
@@ -1053,10 +1057,12 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
         }
       }
       d->var = dcm::SurfaceWindowRelativeMean(diff2, d->L, d->width(), d->height(), d->objectId, d->shaderId, 2);
+      d->noise.variance = "second render";
       d->notes.push_back("samples: the mean of the inputs and the second render " + Quote(options.secondRender[0]) +
                          "; variance from their difference (5x5 window on each surface)");
     } else if (options.estimateVariance) {
       d->var = EstimateVarianceFromData(*d);
+      d->noise.variance = "estimated";
       d->notes.push_back("variance: estimated from the data (residual against the 4-neighbours, 5x5 window on "
                          "each surface)" + AlbedoNote(*d, roles));
     } else if (options.detectNoise && !hasVar && !split) {
@@ -1065,9 +1071,11 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
                          "--estimate-variance for a noisy render)");
     } else if (options.detectNoise && !hasVar) {
       const double psnr = NoisePsnrFromData(*d);
+      d->noise.detectedPsnr = psnr;
       const std::string figure = OIIO::Strutil::fmt::format("{:.1f}", psnr);
       if (psnr < kNoisyPsnr) {
         d->var = EstimateVarianceFromData(*d);
+        d->noise.variance = "detected";
         d->notes.push_back("samples: noisy (their noise alone would cost about " + figure +
                            " dB PSNR): variance estimated from the data, as --estimate-variance" +
                            AlbedoNote(*d, roles) + " (--no-detect-noise: take them as noise-free)");
@@ -1093,7 +1101,10 @@ Status AovProvider::Open(const std::vector<std::string>& inputs, const AovOption
     }
     bool variance = false;
     for (const auto& m : options.mappings) variance |= (m.role == Role::kVarR);
-    if (variance) d->var.assign(n, RGB{});
+    if (variance) {
+      d->var.assign(n, RGB{});
+      d->noise.variance = "channels";
+    }
     d->have.assign(n, 0);
     for (size_t file = 0; file < options.samples.size(); ++file) {
       const std::string& path = options.samples[file];
@@ -1285,6 +1296,7 @@ const std::vector<std::string>& AovProvider::IdChannels() const { return d_->idC
 const std::vector<std::string>& AovProvider::MaskChannels() const { return d_->maskChannels; }
 const std::vector<std::string>& AovProvider::Notes() const { return d_->notes; }
 const std::vector<std::string>& AovProvider::Warnings() const { return d_->warnings; }
+const AovProvider::NoiseInfo& AovProvider::Noise() const { return d_->noise; }
 std::vector<std::string> AovProvider::SampleChannels() const { return d_->sampleChannels; }
 
 }  // namespace dcm::aov

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <span>
 #include <string>
@@ -200,6 +201,18 @@ class AovProvider final : public SampleProvider {
   const std::vector<std::string>& Notes() const;
   /// Suspicious data kept as is (NaN/Inf/negative samples, per file and channel).
   const std::vector<std::string>& Warnings() const;
+  /// Where the samples' variance comes from, and what the noise detector
+  /// (AovOptions::detectNoise) found: for the stats and the EXR metadata.
+  struct NoiseInfo {
+    /// "channels" (a variance pass, var.R/G/B), "second render",
+    /// "estimated" (AovOptions::estimateVariance), "detected" (the detector
+    /// called the samples noisy and estimated it), "none" (noise-free).
+    std::string variance = "none";
+    /// The PSNR that the samples' noise alone would cost, by the detector;
+    /// NaN where it did not run (another source, no texture split, sparse).
+    double detectedPsnr = std::numeric_limits<double>::quiet_NaN();
+  };
+  const NoiseInfo& Noise() const;
   /// The channel names a samples EXR must carry for this configuration
   /// (including the mask channel), for `dcm plan` to tell the renderer.
   std::vector<std::string> SampleChannels() const;
