@@ -202,12 +202,12 @@ void AddQualityJson(const QualityReport& r, double targetPsnr, double budget, nl
 
 std::optional<bool> CloserThanRender(const QualityReport& r) {
   if (!r.againstConverged) return {};
-  return CloserThanRender(r.estimate.psnr, r.renderEstimate.psnr);
+  return CloserThanRender(r.estimate, r.renderEstimate.psnr);
 }
 
-std::optional<bool> CloserThanRender(double resultPsnr, double renderPsnr) {
-  if (!std::isfinite(renderPsnr) || std::isnan(resultPsnr)) return {};
-  return resultPsnr >= renderPsnr;
+std::optional<bool> CloserThanRender(const PsnrEstimate& result, double renderPsnr) {
+  if (!std::isfinite(renderPsnr) || std::isnan(result.low)) return {};
+  return result.low >= renderPsnr;
 }
 
 void AddQualityMetadata(const QualityReport& r, Metadata* m) {

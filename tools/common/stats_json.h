@@ -62,17 +62,19 @@ void AddEstimateMetadata(const PsnrEstimate& estimate, Metadata* metadata);
 /// and quality.target_render true. With samples of known variance
 /// (QualityReport::againstConverged) also estimated_psnr_against "converged"
 /// and estimated_render_psnr, _low, _high (the full render's own PSNR
-/// against the converged image), and closer_than_render (the result's
-/// estimate at least the render's) where both are known.
+/// against the converged image), and closer_than_render (CloserThanRender) where both are known.
 void AddQualityJson(const QualityReport& report, double targetPsnr, double budget, nlohmann::json* j);
 
-/// Whether the result is at least as close to the converged image as the
-/// full render, by the two estimates; empty where either is not known.
+/// Whether the result is shown to be at least as close to the converged
+/// image as the full render: the lower end of its estimate's interval at
+/// least the render's estimate (a point estimate above the render's whose
+/// interval reaches below it is no claim); empty where either is not known.
 std::optional<bool> CloserThanRender(const QualityReport& report);
 
-/// The same from the two PSNRs against the converged image: empty where the
-/// render's is not finite or the result's is NaN.
-std::optional<bool> CloserThanRender(double resultPsnr, double renderPsnr);
+/// The same from the result's estimate against the converged image and the
+/// render's PSNR: empty where the render's is not finite or the result's
+/// lower end is NaN.
+std::optional<bool> CloserThanRender(const PsnrEstimate& result, double renderPsnr);
 
 /// Adds AddEstimateMetadata() of the report's estimate and, with samples of
 /// known variance, dcm:estimated_render_psnr (finite values only) to EXR

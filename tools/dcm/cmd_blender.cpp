@@ -641,7 +641,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       toolkit::AddEstimateJson(fromPreview, 0.90, &j);  // EstimatePsnr's interval
       j["estimated_psnr_against"] = "converged";
       j["estimated_psnr_from"] = "preview";
-      if (const std::optional<bool> closer = toolkit::CloserThanRender(fromPreview.psnr, renderFromPreview)) {
+      if (const std::optional<bool> closer = toolkit::CloserThanRender(fromPreview, renderFromPreview)) {
         j["estimated_render_psnr"] = renderFromPreview;
         j["closer_than_render"] = *closer;
       }
@@ -713,7 +713,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     std::printf("  estimate       PSNR %.2f dB against the converged image, from the preview (90 %% interval %.2f to "
                 "%.2f; the preview's own %.2f dB%s%s)\n",
                 fromPreview.psnr, fromPreview.low, fromPreview.high, sched.correction.previewPsnr, render,
-                *render ? WhichIsCloser(fromPreview.psnr, renderFromPreview).c_str() : "");
+                *render ? WhichIsCloser(fromPreview, renderFromPreview).c_str() : "");
   }
   if (quality) {
     std::printf("  quality        %s%s\n", QualityLine(*quality, engine).c_str(), defaultGoal ? " (the default goal)" : "");

@@ -348,19 +348,28 @@ std::string QualityLine(const QualityReport& r, const EngineFlags& f) {
     std::snprintf(noise, sizeof noise, " (%.2f to %.2f)", n.low, n.high);
     line += noise;
   }
-  if (toolkit::CloserThanRender(r)) {
-    // Issue 26's question: which is closer to the converged image.
-    if (std::isinf(e.psnr)) line += ": this result is closer (its validation pixels show no error beyond the noise)";
-    else line += ": " + WhichIsCloser(e.psnr, n.psnr);
-  }
+  // Issue 26's question: which is closer to the converged image.
+  if (toolkit::CloserThanRender(r)) line += ": " + WhichIsCloser(e, n.psnr);
   return line;
 }
 
-std::string WhichIsCloser(double resultPsnr, double renderPsnr) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%s is closer, by %.2f dB",
-                toolkit::CloserThanRender(resultPsnr, renderPsnr).value_or(false) ? "this result" : "the full render",
-                std::fabs(resultPsnr - renderPsnr));
+std::string WhichIsCloser(const PsnrEstimate& result, double renderPsnr) {
+  char buf[160];
+  if (toolkit::CloserThanRender(result, renderPsnr).value_or(false)) {
+    if (std::isinf(result.psnr)) return "this result is closer (its validation pixels show no error beyond the noise)";
+    std::snprintf(buf, sizeof buf, "this result is closer, by %.2f dB", result.psnr - renderPsnr);
+  } else if (result.psnr < renderPsnr) {
+    std::snprintf(buf, sizeof buf, "the full render is closer, by %.2f dB", renderPsnr - result.psnr);
+  } else if (std::isinf(result.psnr)) {
+    return "this result's validation pixels show no error beyond the noise, but its interval reaches below the full "
+           "render's estimate: not shown to be closer";
+  } else {
+    // A claim needs the interval: a point estimate a little above can be a few lucky validation pixels.
+    std::snprintf(buf, sizeof buf,
+                  "this result's estimate lies %.2f dB above the full render's, but its interval reaches below it: "
+                  "not shown to be closer",
+                  result.psnr - renderPsnr);
+  }
   return buf;
 }
 

@@ -106,9 +106,12 @@ Status ReconstructFor(SampleProvider& provider, const ReconstructionOptions& opt
 /// by 1.6 effective validation pixels: ..." says so.
 std::string QualityLine(const QualityReport& report, const EngineFlags& flags);
 
-/// "this result is closer, by X dB" or "the full render is closer, by X dB"
-/// from the two finite PSNRs against the converged image.
-std::string WhichIsCloser(double resultPsnr, double renderPsnr);
+/// "this result is closer, by X dB" (toolkit::CloserThanRender), "the full
+/// render is closer, by X dB" (the result's point estimate below the
+/// render's), or, between the two, that the result's estimate lies above the
+/// render's within its uncertainty; from the result's estimate and the
+/// render's finite PSNR against the converged image.
+std::string WhichIsCloser(const PsnrEstimate& result, double renderPsnr);
 
 /// The warning of a --target-psnr that was not reached, empty when it was.
 std::string QualityWarning(const QualityReport& report, const EngineFlags& flags);
