@@ -62,7 +62,8 @@ void AddEstimateMetadata(const PsnrEstimate& estimate, Metadata* metadata);
 /// and quality.target_render true. With samples of known variance
 /// (QualityReport::againstConverged) also estimated_psnr_against "converged"
 /// and estimated_render_psnr, _low, _high (the full render's own PSNR
-/// against the converged image), and closer_than_render (CloserThanRender) where both are known.
+/// against the converged image), and closer_than_render (CloserThanRender)
+/// where both are known.
 void AddQualityJson(const QualityReport& report, double targetPsnr, double budget, nlohmann::json* j);
 
 /// Whether the result is shown to be at least as close to the converged
