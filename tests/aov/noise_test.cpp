@@ -240,15 +240,19 @@ struct MirrorScene {
     if (lr)
       for (const char* c : {"Lr.R", "Lr.G", "Lr.B"})
         ch.push_back(Fill(c, width, height, [&](int x, int y) { return Mirror(x) ? at(x, y) - glow : 0.f; }));
+    AddIds(&ch);
+    return ch;
+  }
+  /// The wall and the mirror as objects (and shaders) 1 and 2.
+  void AddIds(std::vector<TestChannel>* ch) const {
     TestChannel id{"id", {}, {}}, shader{"shader", {}, {}};
     for (int y = 0; y < height; ++y)
       for (int x = 0; x < width; ++x) {
         id.ids.push_back(Mirror(x) ? 2u : 1u);
         shader.ids.push_back(Mirror(x) ? 2u : 1u);
       }
-    ch.push_back(id);
-    ch.push_back(shader);
-    return ch;
+    ch->push_back(id);
+    ch->push_back(shader);
   }
 };
 
@@ -367,14 +371,7 @@ TEST(AovAlbedo, WithoutABeautyTheMirrorsLKeepsItsDiffuseLight) {
     ch.push_back(Fill(c, sc.width, sc.height, [&](int x, int) { return tau(x); }));
   for (const char* c : {"albedo.R", "albedo.G", "albedo.B"})
     ch.push_back(Fill(c, sc.width, sc.height, [&](int x, int y) { return sc.Albedo(x, y); }));
-  TestChannel id{"id", {}, {}}, shader{"shader", {}, {}};
-  for (int y = 0; y < sc.height; ++y)
-    for (int x = 0; x < sc.width; ++x) {
-      id.ids.push_back(sc.Mirror(x) ? 2u : 1u);
-      shader.ids.push_back(sc.Mirror(x) ? 2u : 1u);
-    }
-  ch.push_back(id);
-  ch.push_back(shader);
+  sc.AddIds(&ch);
   WriteExr(dir / "nobeauty.exr", sc.width, sc.height, ch);
   auto p = Open({dir / "nobeauty.exr"}, AovOptions{});
   ASSERT_TRUE(p);
