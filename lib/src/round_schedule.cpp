@@ -86,6 +86,9 @@ Status ReconstructWithPreview(SampleProvider& exact, SampleProvider& preview,
   try {
     PlanningProvider planning(exact, preview);
     DCM_RETURN_IF_ERROR(PlanRenderAndFinish(planning, preview, options, schedule, 0, out, &stats));
+    // Every pixel rendered was paid for, also those a final run on noisy
+    // samples interpolated and denoised over (kept nowhere in the sample map).
+    out->stats.exactPixels = planning.KnownCount();
   } catch (const std::bad_alloc&) {
     return Status::Error("out of memory while planning rounds on the preview");
   }

@@ -141,6 +141,8 @@ def variance(dcm, blender, src, tmp):
         assert b["variance"] == ("halves" if used else "halves, not used"), b
         # The variance reached the engine: it runs its noise regime.
         assert j["settings"]["noisy"] == used, j["settings"]
+        # Every pixel a round rendered is paid for, also where the noise regime's final run interpolated it.
+        assert j["exact_pixels"] == sum(r["pixels"] for r in b["rounds"]) + b["extra_pixels"], (j["exact_pixels"], b)
         # The first round (256 pixels or more) measures the exact pixels' variance against
         # the preview's, used or not: 16 samples against 8 assume half, and leave less
         # noise than the preview's (1) but some (0). A preview of 16 samples (seeds of its

@@ -163,7 +163,10 @@ struct PreviewScheduleStats {
 /// (RoundSchedule::kPreview). `exact` gives the guides (asked once) and the
 /// exact samples; `preview` gives stand-in samples for any pixel, cheaply
 /// (its guides are not used). The samples the engine sees in the final run
-/// are exact except the reported stand-ins; `out->stats` are that run's. With
+/// are exact except the reported stand-ins; `out->stats` are that run's, but
+/// for `exactPixels`: every pixel the exact provider evaluated (with noisy
+/// samples also those the final run did not ask for, which it denoises over
+/// and the sample map does not show). With
 /// a preview that carries its variance the interpolated pixels are then
 /// corrected toward it (PreviewScheduleOptions::correctionRadius).
 Status ReconstructWithPreview(SampleProvider& exact, SampleProvider& preview,
