@@ -24,8 +24,10 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import blender_support as bs  # noqa: E402
 
 
-def run(dcm, args, env=None):
-    p = subprocess.run([dcm, "blender", "-q"] + args, capture_output=True, text=True, env=env, timeout=120)
+def run(dcm, args, env=None, quiet=False):
+    # Progress goes to a terminal only: captured, stderr has warnings and errors alone either way.
+    p = subprocess.run([dcm, "blender"] + (["-q"] if quiet else []) + args, capture_output=True, text=True, env=env,
+                       timeout=120)
     return p.returncode, p.stdout, p.stderr
 
 
@@ -38,8 +40,10 @@ def exact(dcm, blender, src, tmp):
         out, stats, smap = (os.path.join(tmp, schedule + e) for e in (".exr", ".json", ".png"))
         code, so, se = run(dcm, [blend, "-o", out, "--stats", stats, "--sample-map", smap, "--schedule", schedule,
                                  "--blender", blender, "--max-rounds", "8", "--min-round-share", "0", "--variance", "off",
-                                 "--pool-preview", "off", "--preview-samples", "8"])
+                                 "--pool-preview", "off", "--preview-samples", "8"], quiet=schedule == "levels")
         assert code == 0, se
+        # -q as in every command: no summary on stdout.
+        assert ("exact pixels" in so) == (schedule == "preview") and (schedule == "preview" or so == ""), so
         img, spec = bs.read_exr(out)
         assert spec.channelnames == ("ViewLayer.Combined.R", "ViewLayer.Combined.G", "ViewLayer.Combined.B",
                                      "ViewLayer.Combined.A") or sorted(spec.channelnames) == sorted(

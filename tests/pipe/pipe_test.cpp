@@ -573,7 +573,7 @@ TEST(DcmPipe, ReconstructsTheAnalyticScene) {
                     truth = dir / "truth.raw", map = dir / "map.png";
   std::string log;
   ASSERT_EQ(RunShell(Analytic("--width 192 --height 144 --truth " + truth), &log), 0) << log;
-  const int rc = RunShell(std::string(DCM_BINARY) + " pipe --quiet --provider-cmd " +
+  const int rc = RunShell(std::string(DCM_BINARY) + " pipe --provider-cmd " +
                          Quoted(Analytic("--width 192 --height 144 --count-file " + count)) + " -o " + out +
                          " --stats " + stats + " --sample-map " + map,
                      &log);
@@ -624,6 +624,12 @@ TEST(DcmPipe, FullEvaluationAsksForEveryPixel) {
   int64_t evaluated = -1;
   cf >> evaluated;
   EXPECT_EQ(evaluated, 32 * 32);
+  EXPECT_FALSE(Contains(log, "exact pixels")) << "--quiet: no summary (the provider child still speaks on stderr)\n" << log;
+  ASSERT_EQ(RunShell(std::string(DCM_BINARY) + " pipe --full --provider-cmd " +
+                         Quoted(Analytic("--width 32 --height 32")) + " -o " + (dir / "out.exr"),
+                     &log),
+            0)
+      << log;
   EXPECT_TRUE(Contains(log, "100.00 %")) << log;
 }
 

@@ -420,6 +420,20 @@ TEST(HostileFlags, HelpGroupsQuietAndSummaryOnStdout) {
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_NE(r.out.find("2 parts -> "), std::string::npos) << r.out;
   EXPECT_EQ(r.err, "");
+  // -q means the same in every command: no summary on stdout, no progress on stderr.
+  for (const bool quiet : {false, true}) {
+    for (const std::string tile : {"", "0/2"}) {
+      std::vector<std::string> a = {"render", kRoom, "--size", "48x32", "-o", dir / "r.exr"};
+      if (!tile.empty()) a.insert(a.end(), {"--tile", tile});
+      if (quiet) a.push_back("-q");
+      r = RunDcm(a, dir);
+      ASSERT_EQ(r.exitCode, 0) << r.err;
+      EXPECT_EQ(r.out.find("exact pixels") == std::string::npos, quiet) << "render " << tile << ": " << r.out;
+      if (quiet) {
+        EXPECT_EQ(r.out + r.err, "") << "render -q " << tile;
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -42,6 +42,7 @@
 #include "common/progress.h"
 #include "common/sample_map.h"
 #include "common/stats_json.h"
+#include "common/summary.h"
 #include "dcm/exact_noise_meter.h"
 #include "dcm/noise_estimate.h"
 #include "dcm/pipe/pipe_provider.h"
@@ -673,9 +674,10 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   }
   if (Status w = outputs.Commit(); !w.ok()) return Fail(w.message());
 
-  std::printf("%s: %dx%d, %s, schedule %s, %zu render calls for exact pixels\n", output.c_str(), rec.width,
+  const toolkit::Summary say(!f.pipe.engine.quiet);
+  say("%s: %dx%d, %s, schedule %s, %zu render calls for exact pixels\n", output.c_str(), rec.width,
               rec.height, method.c_str(), std::string(ToString(schedule)).c_str(), timed.rounds.size());
-  std::printf("  exact pixels   %.2f %% (%lld of %lld)%s%s\n", 100.0 * stats_.exactFraction(),
+  say("  exact pixels   %.2f %% (%lld of %lld)%s%s\n", 100.0 * stats_.exactFraction(),
               static_cast<long long>(stats_.exactPixels), static_cast<long long>(stats_.totalPixels),
               sched.previewStandIns ? (", " + std::to_string(sched.previewStandIns) + " preview stand-ins" +
                                        (sched.stoppedAtTarget ? " (their round not rendered: the target was met "
@@ -687,21 +689,21 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
                                    " rendered without being asked for (the pixel filter's reach inside the mask)")
                                       .c_str()
                                 : "");
-  std::printf("  time           Blender start %.2f s, guides %.2f s, preview %.2f s, rounds %.2f s, DCM %.2f s, "
+  say("  time           Blender start %.2f s, guides %.2f s, preview %.2f s, rounds %.2f s, DCM %.2f s, "
               "total %.2f s\n",
               handshakeS - guidesRenderS, guidesRenderS + timed.guidesS, previewS, roundsS, engineS, wallS);
   if (sched.correction.pixels > 0)
-    std::printf("  correction     %lld interpolated pixels moved toward the preview (mean weight %.3f)%s\n",
+    say("  correction     %lld interpolated pixels moved toward the preview (mean weight %.3f)%s\n",
                 static_cast<long long>(sched.correction.pixels), sched.correction.meanWeight,
                 sched.correction.filtered > 0
                     ? (", " + std::to_string(sched.correction.filtered) + " halfway to its filtered value").c_str()
                     : "");
   if (sched.errorRoundPixels > 0)
-    std::printf("  error round    %lld interpolated pixels rendered where the preview said the interpolation "
+    say("  error round    %lld interpolated pixels rendered where the preview said the interpolation "
                 "missed (--error-round)\n",
                 static_cast<long long>(sched.errorRoundPixels));
   if (sched.pooledPixels > 0)
-    std::printf("  pooled         %lld exact pixels took their preview's samples in (--pool-preview)\n",
+    say("  pooled         %lld exact pixels took their preview's samples in (--pool-preview)\n",
                 static_cast<long long>(sched.pooledPixels));
   if (!quality && !previewEstimate && std::isfinite(sched.correction.previewPsnr) && f.pipe.engine.verbose)
     std::fprintf(stderr, "dcm %s: no estimate of the PSNR: the preview's own is %.2f dB, too noisy to tell\n",
@@ -710,13 +712,13 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     char render[64] = "";
     if (std::isfinite(renderFromPreview))
       std::snprintf(render, sizeof render, "; the full render's own %.2f dB: ", renderFromPreview);
-    std::printf("  estimate       PSNR %.2f dB against the converged image, from the preview (90 %% interval %.2f to "
+    say("  estimate       PSNR %.2f dB against the converged image, from the preview (90 %% interval %.2f to "
                 "%.2f; the preview's own %.2f dB%s%s)\n",
                 fromPreview.psnr, fromPreview.low, fromPreview.high, sched.correction.previewPsnr, render,
                 *render ? WhichIsCloser(fromPreview, renderFromPreview).c_str() : "");
   }
   if (quality) {
-    std::printf("  quality        %s%s\n", QualityLine(*quality, engine).c_str(), defaultGoal ? " (the default goal)" : "");
+    say("  quality        %s%s\n", QualityLine(*quality, engine).c_str(), defaultGoal ? " (the default goal)" : "");
     if (f.pipe.engine.verbose) std::cerr << QualityLine(*quality, engine) << "\n";
     // Where the render's own noise stops the default goal, -v has said so: no warning for what was not asked.
     if (const std::string w = QualityWarning(*quality, engine); !w.empty() && !(defaultGoal && ptarget.beyondRender))

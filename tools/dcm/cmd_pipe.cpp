@@ -21,6 +21,7 @@
 #include "common/progress.h"
 #include "common/sample_map.h"
 #include "common/stats_json.h"
+#include "common/summary.h"
 #include "common/tiles.h"
 #include "dcm/pipe/pipe_provider.h"
 #include "dcm/reconstructor.h"
@@ -157,19 +158,20 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
   }
   if (Status w = outputs.Commit(); !w.ok()) return Fail(w.message());
 
+  const toolkit::Summary say(!f.engine.quiet);
   if (partial)
-    std::printf("%s: %s %s of %dx%d (window %dx%d working pixels), %s, provider '%s'\n", f.output.c_str(),
+    say("%s: %s %s of %dx%d (window %dx%d working pixels), %s, provider '%s'\n", f.output.c_str(),
                 tile.empty() ? "region" : "tile", tile.empty() ? toolkit::RegionText(region).c_str() : tile.c_str(),
                 frame.x, frame.y, info.window.width(), info.window.height(), method.c_str(), caps.name.c_str());
   else
-    std::printf("%s: %dx%d (working %dx%d), %s, provider '%s'\n", f.output.c_str(), rec.width, rec.height,
+    say("%s: %dx%d (working %dx%d), %s, provider '%s'\n", f.output.c_str(), rec.width, rec.height,
                 rec.workWidth, rec.workHeight, method.c_str(), caps.name.c_str());
-  std::printf("  exact pixels   %.2f %% (%lld of %lld)\n", 100.0 * stats.exactFraction(),
+  say("  exact pixels   %.2f %% (%lld of %lld)\n", 100.0 * stats.exactFraction(),
               static_cast<long long>(stats.exactPixels), static_cast<long long>(stats.totalPixels));
-  std::printf("  time           provider %.2f s, DCM %.2f s, guides %.2f s, total %.2f s\n", stats.timeProviderS,
+  say("  time           provider %.2f s, DCM %.2f s, guides %.2f s, total %.2f s\n", stats.timeProviderS,
               stats.timeEngineS, stats.timeGuidesS, wallS);
-  std::printf("  provider calls %lld\n", static_cast<long long>(stats.providerCalls));
-  if (quality) std::printf("  quality        %s\n", QualityLine(*quality, f.engine).c_str());
+  say("  provider calls %lld\n", static_cast<long long>(stats.providerCalls));
+  if (quality) say("  quality        %s\n", QualityLine(*quality, f.engine).c_str());
   if (quality)
     if (const std::string w = QualityWarning(*quality, f.engine); !w.empty())
       std::cerr << "dcm " << cmd << ": warning: " << w << "\n";

@@ -310,8 +310,8 @@ int RunReconstruct(const ReconstructFlags& f) {
     if (run.quality) s << ", estimated PSNR " << PsnrText(run.quality->estimate.psnr);
     s << ", engine " << std::setprecision(3) << r.stats.timeEngineS << " s -> " << f.output;
     std::cout << s.str() << "\n";
-    for (const auto& w : toolkit::SampleWarnings(r.stats)) std::cerr << "dcm " << cmd << ": warning: " << w << "\n";
   }
+  for (const auto& w : toolkit::SampleWarnings(r.stats)) std::cerr << "dcm " << cmd << ": warning: " << w << "\n";
   return kExitOk;
 }
 
@@ -350,7 +350,6 @@ Registration reg("reconstruct", "Reconstruct an image from a renderer's EXR AOVs
 #endif
                    app->option_defaults()->group(kGroupGeneral);
                    AddEngineFlags(app, &f->engine);
-                   app->get_option("--quiet")->description("no progress or warnings on stderr, no summary on stdout");
                    AddTileFlags(app, &f->tiles);
                    return [f] { return RunReconstructFrames(*f); };
                  });

@@ -199,7 +199,7 @@ void AddEngineFlags(CLI::App* app, EngineFlags* f) {
                   "checkerboard first and the other only where its exact neighbours disagree");
   }
   app->add_flag("-v,--verbose", f->verbose, "say more");
-  app->add_flag("-q,--quiet", f->quiet, "no progress on stderr");
+  app->add_flag("-q,--quiet", f->quiet, "no progress on stderr, no summary on stdout (warnings and errors stay)");
 }
 
 void AddRoundFlags(CLI::App* app, RoundFlags* f) {
