@@ -63,6 +63,8 @@ Status CheckPreviewSchedule(SampleProvider& exact, SampleProvider& preview, cons
   if (schedule.correctionRadius < 0)
     return Status::Error("preview schedule: correctionRadius must not be negative");
   if (schedule.filterRadius < 0) return Status::Error("preview schedule: filterRadius must not be negative");
+  if (!(schedule.planSignificance >= 0) || !std::isfinite(schedule.planSignificance))
+    return Status::Error("preview schedule: planSignificance must be a finite number >= 0");
   if (!(schedule.minRoundShare >= 0 && schedule.minRoundShare <= 1))
     return Status::Error("preview schedule: minRoundShare must be in [0, 1]");
   const ProviderCapabilities exactCaps = exact.Capabilities();
@@ -201,9 +203,12 @@ Status PlanRenderAndFinish(PlanningProvider& planning, SampleProvider& preview, 
   const bool canStop = schedule.stopAtPsnr > 0 && schedule.correctionRadius > 0 && preview.Capabilities().variance;
   const double allowed = Mse(schedule.stopAtPsnr);  // the target's squared error
   bool finished = false;  ///< the run ended with a result already finished without its round
+  ReconstructionOptions firstPlan = options;
+  if (schedule.maxRounds > 1 && options.noiseSignificance > 0)
+    firstPlan.noiseSignificance = std::max(options.noiseSignificance, schedule.planSignificance);
   for (int rounds = 0;;) {
     const auto engineStart = std::chrono::steady_clock::now();
-    Status s = Reconstruct(planning, options, out);
+    Status s = Reconstruct(planning, rounds == 0 ? firstPlan : options, out);
     stats->timeEngineS += detail::SecondsSince(engineStart) - out->stats.timeGuidesS;
     ++stats->engineRuns;
     if (!s.ok()) return s;

@@ -414,6 +414,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     so.correctionRadius = f.rounds.previewCorrection;
     so.filterRadius = f.rounds.previewFilter;
     so.errorRound = f.rounds.errorRound;
+    so.planSignificance = f.rounds.planSignificance;
     so.minRoundShare = f.rounds.minRoundShare;
     // A target in dB or a budget is judged by the preview's estimate where the preview can tell.
     const double target = f.pipe.engine.targetPsnr.value_or(defaultGoal ? kDefaultTargetPsnr : 0);

@@ -214,6 +214,7 @@ int RunPovray(const PovrayFlags& f) {
       so.correctionRadius = f.rounds.previewCorrection;
       so.filterRadius = f.rounds.previewFilter;
       so.errorRound = f.rounds.errorRound;
+      so.planSignificance = f.rounds.planSignificance;
       so.minRoundShare = haveGoal ? 0 : f.rounds.minRoundShare;  // the search validates what each run asks for
       if (haveGoal) {
         // Each run of the search in two rounds at most: its validation pixels go

@@ -240,6 +240,12 @@ void AddRoundFlags(CLI::App* app, RoundFlags* f) {
                   "variance there, most first (lib/include/dcm/round_schedule.h); 0: off")
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
+  app->add_option("--plan-significance", f->planSignificance,
+                  "with noisy samples and the preview schedule: the plan of a run's first round counts a "
+                  "difference only above K standard deviations (--noise-significance where that is larger; the "
+                  "later rounds keep that); 0: --noise-significance")
+      ->check(CLI::Range(0.0, 1e3))
+      ->capture_default_str();
 }
 
 Status ScheduleFor(const RoundFlags& flags, const RoundCost& cost, bool previewAvailable, RoundSchedule* out) {

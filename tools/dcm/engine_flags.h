@@ -70,9 +70,12 @@ struct RoundFlags {
   int previewFilter = 3;
   /// PreviewScheduleOptions::errorRound (off there); 8 chose on the tuning set (docs/TUNING.md).
   double errorRound = 8;
+  /// PreviewScheduleOptions::planSignificance.
+  float planSignificance = PreviewScheduleOptions{}.planSignificance;
 };
 
-/// Adds --schedule, --max-rounds, --min-round-share and --preview-correction (help group "Rounds").
+/// Adds --schedule, --max-rounds, --min-round-share, --preview-correction, --preview-filter, --error-round
+/// and --plan-significance (help group "Rounds").
 void AddRoundFlags(CLI::App* app, RoundFlags* flags);
 
 /// The schedule the flags select for a renderer whose rounds cost `cost`:

@@ -65,6 +65,15 @@ struct PreviewScheduleOptions {
   /// share of the working pixels; those keep their preview value. 0: only
   /// `maxRounds` stops.
   double minRoundShare = 0;
+  /// With noisy samples (the engine's noise regime) and more than one round:
+  /// the engine run that plans a run's first round, on samples that are
+  /// mostly the preview's, counts a difference only above this many standard
+  /// deviations of it (ReconstructionOptions::noiseSignificance where that is
+  /// larger; the later runs keep that one). A difference the plan misses
+  /// costs a pixel in the next round, which the exact samples call for; one
+  /// that noise passed for costs a pixel rendered for nothing. 1 chose on the
+  /// tuning set (docs/TUNING.md); 0: the engine's.
+  float planSignificance = 1.f;
   /// After the last round, where the preview carries its variance: the
   /// interpolated pixels move toward it by CorrectTowardPreview() in windows
   /// of this radius (0: off). 5 chose on the tuning set (docs/TUNING.md).
