@@ -677,35 +677,35 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
 
   const toolkit::Summary say(!f.pipe.engine.quiet);
   say("%s: %dx%d, %s, schedule %s, %zu render calls for exact pixels\n", output.c_str(), rec.width,
-              rec.height, method.c_str(), std::string(ToString(schedule)).c_str(), timed.rounds.size());
+      rec.height, method.c_str(), std::string(ToString(schedule)).c_str(), timed.rounds.size());
   say("  exact pixels   %.2f %% (%lld of %lld)%s%s\n", 100.0 * stats_.exactFraction(),
-              static_cast<long long>(stats_.exactPixels), static_cast<long long>(stats_.totalPixels),
-              sched.previewStandIns ? (", " + std::to_string(sched.previewStandIns) + " preview stand-ins" +
-                                       (sched.stoppedAtTarget ? " (their round not rendered: the target was met "
-                                                                "without it)"
-                                                              : ""))
-                                          .c_str()
-                                    : "",
-              timed.extraPixels ? (", " + std::to_string(timed.extraPixels) +
-                                   " rendered without being asked for (the pixel filter's reach inside the mask)")
-                                      .c_str()
-                                : "");
+      static_cast<long long>(stats_.exactPixels), static_cast<long long>(stats_.totalPixels),
+      sched.previewStandIns ? (", " + std::to_string(sched.previewStandIns) + " preview stand-ins" +
+                               (sched.stoppedAtTarget ? " (their round not rendered: the target was met "
+                                                        "without it)"
+                                                      : ""))
+                                  .c_str()
+                            : "",
+      timed.extraPixels ? (", " + std::to_string(timed.extraPixels) +
+                           " rendered without being asked for (the pixel filter's reach inside the mask)")
+                              .c_str()
+                        : "");
   say("  time           Blender start %.2f s, guides %.2f s, preview %.2f s, rounds %.2f s, DCM %.2f s, "
-              "total %.2f s\n",
-              handshakeS - guidesRenderS, guidesRenderS + timed.guidesS, previewS, roundsS, engineS, wallS);
+      "total %.2f s\n",
+      handshakeS - guidesRenderS, guidesRenderS + timed.guidesS, previewS, roundsS, engineS, wallS);
   if (sched.correction.pixels > 0)
     say("  correction     %lld interpolated pixels moved toward the preview (mean weight %.3f)%s\n",
-                static_cast<long long>(sched.correction.pixels), sched.correction.meanWeight,
-                sched.correction.filtered > 0
-                    ? (", " + std::to_string(sched.correction.filtered) + " halfway to its filtered value").c_str()
-                    : "");
+        static_cast<long long>(sched.correction.pixels), sched.correction.meanWeight,
+        sched.correction.filtered > 0
+            ? (", " + std::to_string(sched.correction.filtered) + " halfway to its filtered value").c_str()
+            : "");
   if (sched.errorRoundPixels > 0)
     say("  error round    %lld interpolated pixels rendered where the preview said the interpolation "
-                "missed (--error-round)\n",
-                static_cast<long long>(sched.errorRoundPixels));
+        "missed (--error-round)\n",
+        static_cast<long long>(sched.errorRoundPixels));
   if (sched.pooledPixels > 0)
     say("  pooled         %lld exact pixels took their preview's samples in (--pool-preview)\n",
-                static_cast<long long>(sched.pooledPixels));
+        static_cast<long long>(sched.pooledPixels));
   if (!quality && !previewEstimate && std::isfinite(sched.correction.previewPsnr) && f.pipe.engine.verbose)
     std::fprintf(stderr, "dcm %s: no estimate of the PSNR: the preview's own is %.2f dB, too noisy to tell\n",
                  cmd.c_str(), sched.correction.previewPsnr);
@@ -714,9 +714,9 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     if (std::isfinite(renderFromPreview))
       std::snprintf(render, sizeof render, "; the full render's own %.2f dB: ", renderFromPreview);
     say("  estimate       PSNR %.2f dB against the converged image, from the preview (90 %% interval %.2f to "
-                "%.2f; the preview's own %.2f dB%s%s)\n",
-                fromPreview.psnr, fromPreview.low, fromPreview.high, sched.correction.previewPsnr, render,
-                *render ? WhichIsCloser(fromPreview, renderFromPreview).c_str() : "");
+        "%.2f; the preview's own %.2f dB%s%s)\n",
+        fromPreview.psnr, fromPreview.low, fromPreview.high, sched.correction.previewPsnr, render,
+        *render ? WhichIsCloser(fromPreview, renderFromPreview).c_str() : "");
   }
   if (quality) {
     say("  quality        %s%s\n", QualityLine(*quality, engine).c_str(), defaultGoal ? " (the default goal)" : "");

@@ -161,15 +161,15 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
   const toolkit::Summary say(!f.engine.quiet);
   if (partial)
     say("%s: %s %s of %dx%d (window %dx%d working pixels), %s, provider '%s'\n", f.output.c_str(),
-                tile.empty() ? "region" : "tile", tile.empty() ? toolkit::RegionText(region).c_str() : tile.c_str(),
-                frame.x, frame.y, info.window.width(), info.window.height(), method.c_str(), caps.name.c_str());
+        tile.empty() ? "region" : "tile", tile.empty() ? toolkit::RegionText(region).c_str() : tile.c_str(),
+        frame.x, frame.y, info.window.width(), info.window.height(), method.c_str(), caps.name.c_str());
   else
     say("%s: %dx%d (working %dx%d), %s, provider '%s'\n", f.output.c_str(), rec.width, rec.height,
-                rec.workWidth, rec.workHeight, method.c_str(), caps.name.c_str());
+        rec.workWidth, rec.workHeight, method.c_str(), caps.name.c_str());
   say("  exact pixels   %.2f %% (%lld of %lld)\n", 100.0 * stats.exactFraction(),
-              static_cast<long long>(stats.exactPixels), static_cast<long long>(stats.totalPixels));
+      static_cast<long long>(stats.exactPixels), static_cast<long long>(stats.totalPixels));
   say("  time           provider %.2f s, DCM %.2f s, guides %.2f s, total %.2f s\n", stats.timeProviderS,
-              stats.timeEngineS, stats.timeGuidesS, wallS);
+      stats.timeEngineS, stats.timeGuidesS, wallS);
   say("  provider calls %lld\n", static_cast<long long>(stats.providerCalls));
   if (quality) say("  quality        %s\n", QualityLine(*quality, f.engine).c_str());
   if (quality)

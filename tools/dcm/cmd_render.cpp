@@ -180,13 +180,13 @@ int RunRenderPart(const RenderFlags& f, const embree::Scene& scene, Reconstructi
   if (Status st = outputs.Commit(); !st.ok()) return Fail(st);
   const toolkit::Summary say(!f.engine.quiet);
   say("%s: %s %s of %dx%d (window %dx%d working pixels), %s\n", f.scene.c_str(),
-              tile.empty() ? "region" : "tile", tile.empty() ? toolkit::RegionText(region).c_str() : tile.c_str(),
-              frame.x, frame.y, info.window.width(), info.window.height(), method.c_str());
+      tile.empty() ? "region" : "tile", tile.empty() ? toolkit::RegionText(region).c_str() : tile.c_str(),
+      frame.x, frame.y, info.window.width(), info.window.height(), method.c_str());
   say("  region         %s -> %s\n", toolkit::RegionText(region).c_str(), f.output.c_str());
   say("  exact pixels   %.2f %% of the region, %.2f %% of the window\n", 100.0 * rec.stats.exactFraction(),
-              100.0 * info.windowStats.exactFraction());
+      100.0 * info.windowStats.exactFraction());
   say("  time           illumination %.2f s, DCM %.2f s, guides %.2f s, total %.2f s\n",
-              info.windowStats.timeProviderS, info.windowStats.timeEngineS, info.windowStats.timeGuidesS, wallS);
+      info.windowStats.timeProviderS, info.windowStats.timeEngineS, info.windowStats.timeGuidesS, wallS);
   say("  rays           %llu\n", static_cast<unsigned long long>(rays.total()));
   return kExitOk;
 }
@@ -375,16 +375,16 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
 
   const toolkit::Summary say(!f.engine.quiet);
   say("%s: %dx%d (working %dx%d), %s\n", f.scene.c_str(), rec.width, rec.height, rec.workWidth,
-              rec.workHeight, method.c_str());
+      rec.workHeight, method.c_str());
   say("  effects        %s\n", Join(effects).c_str());
   say("  exact pixels   %.2f %% (%lld of %lld)\n", 100.0 * stats.exactFraction(),
-              static_cast<long long>(stats.exactPixels), static_cast<long long>(stats.totalPixels));
+      static_cast<long long>(stats.exactPixels), static_cast<long long>(stats.totalPixels));
   say("  time           illumination %.2f s, DCM %.2f s, guides %.2f s, total %.2f s\n",
-              stats.timeProviderS, stats.timeEngineS, stats.timeGuidesS, run.wallS);
+      stats.timeProviderS, stats.timeEngineS, stats.timeGuidesS, run.wallS);
   say("  rays           %llu (shadow %llu, glossy %llu, mirror %llu, indirect %llu)\n",
-              static_cast<unsigned long long>(run.rays.total()), static_cast<unsigned long long>(run.rays.shadow),
-              static_cast<unsigned long long>(run.rays.glossy), static_cast<unsigned long long>(run.rays.mirror),
-              static_cast<unsigned long long>(run.rays.indirect));
+      static_cast<unsigned long long>(run.rays.total()), static_cast<unsigned long long>(run.rays.shadow),
+      static_cast<unsigned long long>(run.rays.glossy), static_cast<unsigned long long>(run.rays.mirror),
+      static_cast<unsigned long long>(run.rays.indirect));
   if (run.quality) say("  quality        %s\n", QualityLine(*run.quality, f.engine).c_str());
   for (const auto& w : toolkit::SampleWarnings(stats)) std::cerr << "dcm render: warning: " << w << "\n";
   if (run.quality)
@@ -392,16 +392,16 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
       std::cerr << "dcm render: warning: " << w << "\n";
   if (full) {
     say("  full render    illumination %.2f s, total %.2f s, %llu rays\n", full->rec.stats.timeProviderS,
-                full->wallS, static_cast<unsigned long long>(full->rays.total()));
+        full->wallS, static_cast<unsigned long long>(full->rays.total()));
     say("  speed-up       %.2fx (wall clock), %.2fx (rays)\n", run.wallS > 0 ? full->wallS / run.wallS : 0.0,
-                run.rays.total() ? double(full->rays.total()) / double(run.rays.total()) : 0.0);
+        run.rays.total() ? double(full->rays.total()) / double(run.rays.total()) : 0.0);
     if (e2e)
       say("  end to end     dcm %.2f s, full render %.2f s: %.2fx (each as its own process: start-up %.2f s, "
-                  "scene, outputs)\n", e2e->dcmS, e2e->fullS, e2e->fullS / e2e->dcmS, e2e->startupS);
+          "scene, outputs)\n", e2e->dcmS, e2e->fullS, e2e->fullS / e2e->dcmS, e2e->startupS);
   }
   if (error) {
     say("  error          PSNR %.2f dB, RMSE %.5f, relMSE %.6f, SSIM %.4f (against %s)\n", error->psnr,
-                error->rmse, error->relmse, error->ssim, f.compare.empty() ? "the full render" : f.compare.c_str());
+        error->rmse, error->relmse, error->ssim, f.compare.empty() ? "the full render" : f.compare.c_str());
   }
   return kExitOk;
 }
