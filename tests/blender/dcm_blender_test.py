@@ -527,6 +527,10 @@ def errors(dcm, blender, src, tmp):
             "--target-psnr: not with --full", code=2)
     refused([blend, "-o", out, "--blender", blender, "--target-psnr", "render", "--variance", "off"],
             "--target-psnr render", "--variance off", code=2)
+    # The rounds' numbers are refused before Blender starts, NaN too, the flag named.
+    for flag in ("--plan-significance", "--error-round", "--min-round-share"):
+        for value in ("nan", "-1"):
+            refused([blend, "-o", out, "--blender", blender, flag, value], flag, code=2)
     # A scene set to Eevee: the child says why it cannot render it.
     eevee = os.path.join(tmp, "eevee.blend")
     subprocess.run([blender, "-b", blend, "--python-expr",

@@ -220,7 +220,7 @@ void AddRoundFlags(CLI::App* app, RoundFlags* f) {
                   "with the preview schedule and no --target-psnr or --budget: a round after the first that would "
                   "render fewer than this share of the pixels is not made; they keep their preview value (a "
                   "render call costs its latency however few pixels it has)")
-      ->check(CLI::Range(0.0, 1.0))
+      ->check(FiniteNumber(0.0, 1.0))
       ->capture_default_str();
   app->add_option("--preview-correction", f->previewCorrection,
                   "with the preview schedule and a preview that carries its variance: interpolated pixels move "
@@ -238,13 +238,13 @@ void AddRoundFlags(CLI::App* app, RoundFlags* f) {
                   "with the preview correction: one more round renders the interpolated pixels whose estimated "
                   "error exceeds what they would carry rendered by more than Z times the preview's display "
                   "variance there, most first (lib/include/dcm/round_schedule.h); 0: off")
-      ->check(CLI::Range(0.0, 1e6))
+      ->check(FiniteNumber(0.0, 1e6))
       ->capture_default_str();
   app->add_option("--plan-significance", f->planSignificance,
                   "with noisy samples and the preview schedule: the plan of a run's first round counts a "
                   "difference only above K standard deviations (--noise-significance where that is larger; the "
                   "later rounds keep that); 0: --noise-significance")
-      ->check(CLI::Range(0.0, 1e3))
+      ->check(FiniteNumber(0.0, 1e3))
       ->capture_default_str();
 }
 
