@@ -37,6 +37,7 @@
 #include "common/output_transaction.h"
 #include "common/sample_map.h"
 #include "common/stats_json.h"
+#include "common/summary.h"
 #include "dcm/downsample.h"
 #include "dcm/povray/povray_preview.h"
 #include "dcm/povray/povray_provider.h"
@@ -301,21 +302,20 @@ int RunPovray(const PovrayFlags& f) {
   if (Status w = outputs.Commit(); !w.ok()) return Fail(w.message());
   provider.reset();  // the scratch folder goes before the summary
 
-  if (!f.engine.quiet) {
-    std::printf("%s: %dx%d, %s, %d POV-Ray processes (%d lit), %.2f s\n", f.output.c_str(), rec.width, rec.height,
-                full ? "full render" : "dcm", runs.invocations, runs.litInvocations, toolkit::SecondsSince(t0));
-    if (!full) {
-      std::printf("  exact pixels   %.2f %% (%lld of %lld) in %zu rounds", 100.0 * rec.stats.exactFraction(),
-                  static_cast<long long>(rec.stats.exactPixels), static_cast<long long>(rec.stats.totalPixels),
-                  runs.roundS.size());
-      if (sched.previewStandIns) std::printf(", %lld preview stand-ins", static_cast<long long>(sched.previewStandIns));
-      std::printf("\n  time           guides+preview %.2f s, rounds", denseS);
-      for (double s : runs.roundS) std::printf(" %.2f", s);
-      std::printf(" s, engine %.2f s\n", engineS);
-    }
-    if (quality) std::printf("  quality        %s\n", QualityLine(*quality, f.engine).c_str());
-    if (haveRef) std::printf("  PSNR           %.2f dB against %s\n", error.psnr, f.reference.c_str());
+  const toolkit::Summary say(!f.engine.quiet);
+  say("%s: %dx%d, %s, %d POV-Ray processes (%d lit), %.2f s\n", f.output.c_str(), rec.width, rec.height,
+      full ? "full render" : "dcm", runs.invocations, runs.litInvocations, toolkit::SecondsSince(t0));
+  if (!full) {
+    say("  exact pixels   %.2f %% (%lld of %lld) in %zu rounds", 100.0 * rec.stats.exactFraction(),
+        static_cast<long long>(rec.stats.exactPixels), static_cast<long long>(rec.stats.totalPixels),
+        runs.roundS.size());
+    if (sched.previewStandIns) say(", %lld preview stand-ins", static_cast<long long>(sched.previewStandIns));
+    say("\n  time           guides+preview %.2f s, rounds", denseS);
+    for (double s : runs.roundS) say(" %.2f", s);
+    say(" s, engine %.2f s\n", engineS);
   }
+  if (quality) say("  quality        %s\n", QualityLine(*quality, f.engine).c_str());
+  if (haveRef) say("  PSNR           %.2f dB against %s\n", error.psnr, f.reference.c_str());
   if (quality) {
     if (f.engine.verbose) std::cerr << QualityLine(*quality, f.engine) << "\n";
     if (const std::string w = QualityWarning(*quality, f.engine); !w.empty())
