@@ -1,6 +1,8 @@
 """Inside Blender: Session._stopped_early, the rule that picks the exact pixels
 of a round that Cycles' adaptive sampling stopped early and that must be
-rendered again with every sample (plugins/blender/dcm_blender/scene.py).
+rendered again with every sample; how long careful renders keep their masked
+pixels (_masked_stop); and where those pixels are rendered again
+(_render_all_samples through _cheapest) (plugins/blender/dcm_blender/scene.py).
 
     blender -b --factory-startup --python-exit-code 1 --python early_stop_in_blender.py -- SRC"""
 import os
@@ -37,5 +39,41 @@ again = S._stopped_early(fake, planes, n, xs, ys, np.ones(w, bool))
 wrong = [c[0] for c, a in zip(cases, again) if bool(a) != c[5]]
 if wrong:
     print("rendered again or not, wrongly: %s" % wrong, file=sys.stderr)
+    sys.exit(1)
+
+# Session._careful's protection, and where _render_all_samples renders again:
+# a Session without a Blender scene, its cost model's inputs set by hand.
+sess = S.__new__(S)
+sess.args = types.SimpleNamespace(call_seconds=0.3, max_calls=64, masked_min_samples=0, border_tile=0)
+sess.width = sess.height = 256
+sess.samples = 64
+sess.pixel_seconds = lambda: 1e-4  # a pixel at every sample; a masked one a seventh of it per sample
+failures = []
+# Careful must keep every pixel past Cycles' first check (16 samples): in a
+# render of 32 samples or fewer none may stop early, in a longer one none
+# before 32 (an eighth of 32 or 64 samples is no protection: it stops at 16).
+for n in (16, 32, 64, 256, 1024):
+    plain, careful = S._masked_stop(sess, n), S._masked_stop(sess, n, careful=True)
+    if careful < min(n, 32) or (n > 16 and careful <= plain):
+        failures.append("careful at %d samples stops at %d (plain %d)" % (n, careful, plain))
+# 41 stopped pixels scattered over the frame: a border per 16-px tile costs
+# about 41 calls (12 s by the model), the whole frame one call and 32 masked
+# samples per pixel (0.76 s).
+ys_far = np.arange(41) * 6
+xs_far = (np.arange(41) * 37) % 256
+borders = []
+sess._masked_pixels_stop = lambda n, careful=False: None
+sess._set_border = borders.append
+sess._render = lambda n, label, seed: {}
+list(S._render_all_samples(sess, 32, "again", 0, xs_far, ys_far))
+if borders != [None]:
+    failures.append("41 scattered pixels rendered again in %d borders, not the whole frame" % len(borders))
+# Two pixels in one 16-px tile: one border over that tile.
+borders.clear()
+list(S._render_all_samples(sess, 32, "again", 0, np.array([3, 5]), np.array([4, 9])))
+if borders != [(0, 0, 16, 16)]:
+    failures.append("two pixels of one tile rendered again in %s" % borders)
+if failures:
+    print("\n".join(failures), file=sys.stderr)
     sys.exit(1)
 print("ok")

@@ -200,7 +200,7 @@ def main(argv):
         for label, s, sync, render in session.render_seconds:
             print("dcm-blender: render %s %.2f s (Cycles: sync %.2f s, render %.2f s)" % (label, s, sync, render),
                   file=sys.stderr)
-        print("dcm-blender: %d renders kept masked pixels for an eighth of the samples (an exact pixel might "
+        print("dcm-blender: %d renders kept masked pixels longer (an exact pixel might "
               "have stopped early); %d exact pixels stopped early and were rendered again; %d pixels rendered "
               "exactly besides those asked for (their pixel filter's reach inside the mask)"
               % (session.careful_renders, session.rendered_again, session.extra_pixels), file=sys.stderr)
