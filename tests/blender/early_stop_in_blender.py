@@ -2,7 +2,7 @@
 of a round that Cycles' adaptive sampling stopped early and that must be
 rendered again with every sample; how long careful renders keep their masked
 pixels (_masked_stop); and where those pixels are rendered again
-(_render_all_samples through _cheapest) (plugins/blender/dcm_blender/scene.py).
+(_render_all_samples through _again) (plugins/blender/dcm_blender/scene.py).
 
     blender -b --factory-startup --python-exit-code 1 --python early_stop_in_blender.py -- SRC"""
 import os

@@ -564,8 +564,8 @@ class Session:
     def _careful(self, xs, ys, n):
         """Whether a render of exact pixels (xs, ys) at n samples should keep
         its masked pixels longer (_masked_min_samples): where exact pixels
-        might stop early and rendering them again (_render_all_samples) would
-        cost more than the masked samples. A pixel
+        might stop early and rendering them again (_again) would cost more
+        than the masked samples. A pixel
         might stop where a few samples can all be 0: where one half of the
         preview is 0 and the other is not (a dark pixel that rare paths
         light); without halves a black preview counts too. (The preview has
@@ -577,7 +577,7 @@ class Session:
             zero &= ~(g["L"][ys, xs] == 0).all(axis=1)
         if not zero.any():
             return False
-        again = self._cheapest(xs[zero], ys[zero], 1, self._masked_seconds(n), (16,))[1]  # as _render_all_samples
+        again = self._again(xs[zero], ys[zero], n)[1]
         longer = self._masked_stop(n, careful=True) - self._masked_stop(n)
         return again > self._masked_seconds(longer) * self.width * self.height
 
@@ -645,15 +645,20 @@ class Session:
         Li[mirror] = self._reflected(pl)[ys, xs][mirror] / texture[ys, xs][mirror]
         return L, Li
 
+    def _again(self, xs, ys, n):
+        """Where pixels (xs, ys) are rendered again with every one of n samples
+        (adaptive sampling off: every pixel inside a border takes them all), and
+        what that costs: borders over their 16-px tiles or the whole frame,
+        whichever _cheapest() finds cheaper. (Larger tiles save calls for area
+        that, with adaptive sampling off, costs more than the model's masked
+        pixel: docs/BLENDER.md.)"""
+        return self._cheapest(xs, ys, 1, self._masked_seconds(n), (16,))
+
     def _render_all_samples(self, n, label, seed, xs, ys):
-        """Renders pixels (xs, ys) with every one of the n samples (adaptive
-        sampling off: every pixel inside a border takes them all), within
-        borders over their 16-px tiles or the whole frame, whichever _cheapest()
-        finds cheaper: the planes of each render and where it holds. (Larger
-        tiles save calls for area that, with adaptive sampling off, costs more
-        than the model's masked pixel: docs/BLENDER.md.)"""
+        """Renders pixels (xs, ys) with every one of the n samples, where _again()
+        says: the planes of each render and where it holds."""
         self._masked_pixels_stop(0)
-        for rect in self._cheapest(xs, ys, 1, self._masked_seconds(n), (16,))[0]:
+        for rect in self._again(xs, ys, n)[0]:
             self._set_border(rect)
             yield self._render(n, label, seed), self._inside(rect, xs, ys)
 
