@@ -8,6 +8,7 @@ Exit 77 (skipped) when Blender is missing."""
 import hashlib
 import os
 import shutil
+import subprocess
 import sys
 import tempfile
 
@@ -175,7 +176,7 @@ def main():
         # (the tolerance of the rounds above).
         keep1 = os.path.join(tmp, "renders-threshold")
         child = bs.Child(blender, src, blend, ["--keep-renders", keep1, "--samples", "64",
-                                               "--adaptive-threshold", "0.05"])
+                                               "--adaptive-threshold", "0.05", "--keep-alive", "off"])
         child.guides()
         sel = order[: w * h // 10]
         L, _, _ = child.eval(sel % w, sel // w)
@@ -190,6 +191,34 @@ def main():
         want = ref64.reshape(-1, ref64.shape[-1])[sel][:, :3]
         err = np.abs(L - want)
         assert (err <= 1e-5 * np.maximum(np.abs(want), 1) + 1e-7).all(), "max |L - full render| = %g" % err.max()
+
+        # The keep-alive: with it on, exact pixels whose samples are all 0 (the cube,
+        # made black: its diffuse colour, no other closure) take every sample
+        # instead of stopping at Cycles' first check, and every exact pixel still
+        # equals the full render.
+        dtmp = os.path.join(tmp, "dark")
+        os.mkdir(dtmp)
+        dblend = os.path.join(dtmp, "dark.blend")
+        subprocess.run([blender, "-b", blend, "--python-expr",
+                        "import bpy; bpy.data.materials['NoNodes'].diffuse_color = (0, 0, 0, 1); "
+                        "bpy.ops.wm.save_as_mainfile(filepath=%r)" % dblend], check=True, stdout=subprocess.DEVNULL)
+        dref = bs.render_full(blender, src, dblend, dtmp, samples=64, seed=0)
+        black = np.flatnonzero((dref[..., :3] == 0).all(axis=-1))
+        assert len(black) >= 20, "the black cube covers %d pixels" % len(black)
+        dsel = np.union1d(black, order[: w * h // 10])
+        keepd = os.path.join(tmp, "renders-dark")
+        child = bs.Child(blender, src, dblend, ["--keep-renders", keepd, "--samples", "64", "--keep-alive", "on"])
+        child.guides()
+        L, _, _ = child.eval(dsel % w, dsel // w)
+        assert child.quit() == 0, "the child did not exit cleanly"
+        count = np.load(sorted(glob.glob(os.path.join(keepd, "*_eval1.npz")))[0])["Debug Sample Count.X"]
+        assert (count.flat[black] == 1).all(), "black exact pixels stopped early: %s" % np.unique(count.flat[black])
+        assert not glob.glob(os.path.join(keepd, "*_again.npz")), "exact pixels were rendered again"
+        want = dref.reshape(-1, dref.shape[-1])[dsel][:, :3]
+        err = np.abs(L - want)
+        assert (err <= 1e-5 * np.maximum(np.abs(want), 1) + 1e-7).all(), "keep-alive: max |L - full render| = %g" % err.max()
+        # The keep-alive adds at most 1e-20 to a pixel (lost in any float sum above 1e-13).
+        assert (np.abs(L[np.isin(dsel, black)]) <= 1e-20).all(), "black exact pixels: %g" % np.abs(L).max()
 
         # A Gaussian's rays leave up to 1.5 widths from the pixel's centre, 2.25 px at 1.5 px.
         # A mask over half its width missed some of them: the child's check refused the round,

@@ -1,8 +1,9 @@
 """Inside Blender: Session._stopped_early, the rule that picks the exact pixels
 of a round that Cycles' adaptive sampling stopped early and that must be
-rendered again with every sample; how long careful renders keep their masked
-pixels (_masked_stop); and where those pixels are rendered again
-(_render_all_samples through _again) (plugins/blender/dcm_blender/scene.py).
+rendered again with every sample; where they are rendered again
+(_render_all_samples through _again); and when a round switches the
+keep-alive on instead (_keep_alive_pays, _keep_alive)
+(plugins/blender/dcm_blender/scene.py).
 
     blender -b --factory-startup --python-exit-code 1 --python early_stop_in_blender.py -- SRC"""
 import os
@@ -41,7 +42,7 @@ if wrong:
     print("rendered again or not, wrongly: %s" % wrong, file=sys.stderr)
     sys.exit(1)
 
-# Session._careful's protection, and where _render_all_samples renders again:
+# Where _render_all_samples renders again:
 # a Session without a Blender scene, its cost model's inputs set by hand.
 sess = S.__new__(S)
 sess.args = types.SimpleNamespace(call_seconds=0.3, max_calls=64, masked_min_samples=0, border_tile=0)
@@ -49,30 +50,92 @@ sess.width = sess.height = 256
 sess.samples = 64
 sess.pixel_seconds = lambda: 1e-4  # a pixel at every sample; a masked one a seventh of it per sample
 failures = []
-# Careful must keep every pixel past Cycles' first check (16 samples): in a
-# render of 32 samples or fewer none may stop early, in a longer one none
-# before 32 (an eighth of 32 or 64 samples is no protection: it stops at 16).
-for n in (16, 32, 64, 256, 1024):
-    plain, careful = S._masked_stop(sess, n), S._masked_stop(sess, n, careful=True)
-    if careful < min(n, 32) or (n > 16 and careful <= plain):
-        failures.append("careful at %d samples stops at %d (plain %d)" % (n, careful, plain))
 # 41 stopped pixels scattered over the frame: a border per 16-px tile costs
 # about 41 calls (12 s by the model), the whole frame one call and 32 masked
 # samples per pixel (0.76 s).
 ys_far = np.arange(41) * 6
 xs_far = (np.arange(41) * 37) % 256
 borders = []
-sess._masked_pixels_stop = lambda n, careful=False: None
+switched = []
+sess._masked_pixels_stop = lambda n: None
+sess._keep_alive = switched.append
 sess._set_border = borders.append
 sess._render = lambda n, label, seed: {}
 list(S._render_all_samples(sess, 32, "again", 0, xs_far, ys_far))
 if borders != [None]:
     failures.append("41 scattered pixels rendered again in %d borders, not the whole frame" % len(borders))
+if switched != [False]:
+    failures.append("a render again with every sample switched the keep-alive %s" % switched)
 # Two pixels in one 16-px tile: one border over that tile.
 borders.clear()
 list(S._render_all_samples(sess, 32, "again", 0, np.array([3, 5]), np.array([4, 9])))
 if borders != [(0, 0, 16, 16)]:
     failures.append("two pixels of one tile rendered again in %s" % borders)
+
+# The keep-alive: on where pixels that might stop early (one preview half 0,
+# the other not) would cost more to render again than it costs the round
+# (KEEP_ALIVE_COST of its pixels' time). 4000 exact pixels at 64 samples cost
+# 0.4 s, the keep-alive 0.048 s; rendering the 41 scattered ones again costs
+# the whole frame (1.2 s by the model): on. Two such pixels in one 16-px tile
+# among 30000 exact pixels: one border (0.3 s) against 0.36 s: off.
+sess._keep_alive_scales = [types.SimpleNamespace(default_value=0.0) for _ in range(3)]
+sess._keep_alive_on = False
+half_a = np.full((256, 256, 3), 0.2, np.float32)
+half_b = half_a.copy()
+sess.guides = lambda: {"L": (half_a + half_b) / 2, "L_of_half": [half_a, half_b]}
+exact = np.random.default_rng(1).choice(256 * 256, 30000, replace=False)
+ex, ey = exact % 256, exact // 256
+if S._keep_alive_pays(sess, ex[:4000], ey[:4000], 64):
+    failures.append("the keep-alive on without a pixel that might stop early")
+half_a[ys_far, xs_far] = 0.0
+few = np.concatenate([exact[:4000 - 41], ys_far * 256 + xs_far])
+if not S._keep_alive_pays(sess, few % 256, few // 256, 64):
+    failures.append("the keep-alive off with 41 scattered pixels that might stop early among 4000")
+scales, sess._keep_alive_scales = sess._keep_alive_scales, []
+if S._keep_alive_pays(sess, few % 256, few // 256, 64):
+    failures.append("the keep-alive on where no surface carries it")
+sess._keep_alive_scales = scales
+half_a[ys_far, xs_far] = 0.2
+half_a[[4, 9], [3, 5]] = 0.0
+two = np.concatenate([exact[np.isin(exact, [4 * 256 + 3, 9 * 256 + 5], invert=True)], [4 * 256 + 3, 9 * 256 + 5]])
+if S._keep_alive_pays(sess, two % 256, two // 256, 64):
+    failures.append("the keep-alive on for two pixels of one tile among 30000")
+# Switched by the scale of its emission, only where it changes.
+for on, want in ((True, S.KEEP_ALIVE), (True, S.KEEP_ALIVE), (False, 0.0)):
+    S._keep_alive(sess, on)
+    if [k.default_value for k in sess._keep_alive_scales] != [want] * 3:
+        failures.append("the keep-alive switched %s: scales %s" % (on, [k.default_value for k in sess._keep_alive_scales]))
+# Which materials may carry it: those Cycles cannot take for a light.
+import bpy  # noqa: E402
+
+
+def material(kind, **inputs):
+    m = bpy.data.materials.new(kind)
+    m.use_nodes = True
+    nt = m.node_tree
+    if kind != "ShaderNodeBsdfPrincipled":
+        node = nt.nodes.new(kind)
+        if kind == "ShaderNodeGroup":  # an Emission inside a group
+            node.node_tree = bpy.data.node_groups.new("glow", "ShaderNodeTree")
+            node.node_tree.nodes.new("ShaderNodeEmission")
+    for name, value in inputs.items():
+        nt.nodes["Principled BSDF"].inputs[name].default_value = value
+    return m
+
+
+emits = {
+    "a Principled BSDF as Blender makes it": (material("ShaderNodeBsdfPrincipled"), False),
+    "a Principled BSDF with an emission strength and black colour": (
+        material("ShaderNodeBsdfPrincipled", **{"Emission Strength": 5.0}), False),
+    "a Principled BSDF with an emission colour": (
+        material("ShaderNodeBsdfPrincipled", Emission=(1, 0.5, 0.2, 1)), True),
+    "an Emission node": (material("ShaderNodeEmission"), True),
+    "an Emission node in a node group": (material("ShaderNodeGroup"), True),
+    "a script node": (material("ShaderNodeScript"), True),
+}
+for what, (m, want) in emits.items():
+    if scene._may_emit(m.node_tree) != want:
+        failures.append("%s: may emit %s" % (what, not want))
 if failures:
     print("\n".join(failures), file=sys.stderr)
     sys.exit(1)

@@ -43,8 +43,11 @@ def parse_args(argv):
                     help="samples after which a masked pixel may stop in a round of exact pixels "
                          "(0: 8, which stops at 16; the samples: never)")
     ap.add_argument("--adaptive-threshold", type=float, default=1e-8,
-                    help="tests: Cycles' noise threshold in rounds of exact pixels (exact pixels that "
-                         "stop before every sample are rendered again)")
+                    help="tests: Cycles' noise threshold in rounds of exact pixels without the keep-alive (exact "
+                         "pixels that stop before every sample are rendered again)")
+    ap.add_argument("--keep-alive", choices=("auto", "on", "off"), default="auto",
+                    help="the keep-alive emission in rounds of exact pixels: where the preview expects pixels "
+                         "to stop early (auto), always (on: tests), never (off)")
     ap.add_argument("--workdir", default="",
                     help="scratch folder for masks and renders, made and removed by dcm (default: one of its own)")
     ap.add_argument("--verbose", action="store_true", help="the time of each render call on stderr")
@@ -200,9 +203,10 @@ def main(argv):
         for label, s, sync, render in session.render_seconds:
             print("dcm-blender: render %s %.2f s (Cycles: sync %.2f s, render %.2f s)" % (label, s, sync, render),
                   file=sys.stderr)
-        print("dcm-blender: %d renders kept masked pixels longer (an exact pixel might "
-              "have stopped early); %d exact pixels stopped early and were rendered again; %d pixels rendered "
+        print("dcm-blender: %d renders kept their exact pixels sampling (the keep-alive on %d of %d materials, "
+              "the others may emit); %d exact pixels stopped early and were rendered again; %d pixels rendered "
               "exactly besides those asked for (their pixel filter's reach inside the mask)"
-              % (session.careful_renders, session.rendered_again, session.extra_pixels), file=sys.stderr)
+              % (session.kept_alive_renders, len(session.kept_alive), session.masked_materials,
+                 session.rendered_again, session.extra_pixels), file=sys.stderr)
         print("dcm-blender: %.2f s in the child" % (time.monotonic() - t0), file=sys.stderr, flush=True)
     return status

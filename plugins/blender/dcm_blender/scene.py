@@ -5,7 +5,13 @@ How Cycles renders only some pixels: before every Material Output the surface
 is mixed with a zero-strength Emission, Fac = 1 - IsCameraRay * (1 - mask),
 where mask is an Image Texture in Window coordinates (Closest, Extend) that is
 1 on the pixels asked for. Only camera rays see the mask, so indirect light is
-the full render's. The mask has `mask_scale` texels per pixel and side and
+the full render's. Masked pixels' samples are all 0, and a round's adaptive
+sampling stops them after a few. A pixel asked for whose samples all agree so
+far (all 0: a dark pixel that rare paths light) would stop too: where the
+preview says that may happen, the round switches on an emission of white
+noise in the sample's window position times 1e-20 (KEEP_ALIVE) on the pixels
+asked for, so that their samples never all agree: it adds at most 1e-20 to
+a pixel, which a float sum with any value above 1e-13 loses. The mask has `mask_scale` texels per pixel and side and
 covers, around each pixel asked for, the footprint of the pixel filter (where
 the pixel's camera rays leave). With persistent data a mask changed in memory,
 or saved and reloaded under the same name, does not reach the next render; a
@@ -111,6 +117,37 @@ def _clock_seconds(text):
         return float("nan")
 
 
+def _value(socket):
+    """A socket's constant as a tuple of floats, or None where it is linked."""
+    if socket.is_linked:
+        return None
+    v = socket.default_value
+    return tuple(v) if hasattr(v, "__len__") else (v,)
+
+
+def _may_emit(tree, seen=None):
+    """Whether Cycles may take a surface of this node tree (node groups
+    included) for a light: an Emission or Background node, a Principled BSDF
+    with an emission colour and strength that are not constant 0 (Cycles adds
+    its emission node only then), or a node Cycles cannot see into (a script)."""
+    seen = set() if seen is None else seen
+    if tree is None or tree.name in seen:
+        return False
+    seen.add(tree.name)
+    for n in tree.nodes:
+        kind = n.bl_idname
+        if kind in {"ShaderNodeEmission", "ShaderNodeBackground", "ShaderNodeScript"}:
+            return True
+        if kind == "ShaderNodeBsdfPrincipled":
+            colour = _value(n.inputs["Emission"])
+            strength = _value(n.inputs["Emission Strength"])
+            if (colour is None or any(colour[:3])) and (strength is None or any(strength)):
+                return True
+        if kind == "ShaderNodeGroup" and _may_emit(n.node_tree, seen):
+            return True
+    return False
+
+
 def _log(msg):
     print("dcm-blender: " + msg, file=os.sys.stderr, flush=True)
 
@@ -131,7 +168,11 @@ class Session:
         self.rendered_again = 0  # exact pixels that stopped early (_stopped_early)
         self.extra_pixels = 0  # pixels rendered exactly without being asked for (evaluate)
         self._known = None  # [height, width]: pixels asked for or given as extra so far
-        self.careful_renders = 0  # renders of exact pixels whose masked pixels stopped late (_careful)
+        self.kept_alive = []  # materials that carry the keep-alive emission (_insert_masks)
+        self.kept_alive_renders = 0  # renders of exact pixels with the keep-alive on (evaluate)
+        self._keep_alive_scales = []  # the sockets that switch it (_keep_alive)
+        self._keep_alive_on = False
+        self.masked_materials = 0  # materials whose surface the mask decides
 
     # ------------------------------------------------------------- setup --
     def setup(self):
@@ -275,7 +316,18 @@ class Session:
             self._give_material(ob, default)
         for m in bpy.data.materials:
             if m.use_nodes and m.node_tree and m.users:
-                self._mask_tree(m.node_tree)
+                # The keep-alive emission would make a surface that emits nothing a
+                # light Cycles samples (other paths, other values): only on those
+                # that cannot emit, with their light sampling off.
+                keep_alive = not _may_emit(m.node_tree)
+                if keep_alive:
+                    self.kept_alive.append(m.name)
+                    if hasattr(m.cycles, "emission_sampling"):  # Blender 3.5 and later
+                        self.changes.set(m.cycles, "emission_sampling", "NONE")
+                    else:
+                        self.changes.set(m.cycles, "sample_as_light", False)
+                self._mask_tree(m.node_tree, keep_alive)
+                self.masked_materials += 1
 
     def _nodes_for_plain(self, m, colour=None, created=False):
         """Cycles renders a material without nodes as a Diffuse BSDF of its colour."""
@@ -312,7 +364,7 @@ class Session:
             data.materials.append(mat)
             self.changes.on_restore(lambda: data.materials.clear())  # it had none
 
-    def _mask_tree(self, nt):
+    def _mask_tree(self, nt, keep_alive):
         for out in [n for n in nt.nodes if n.bl_idname == "ShaderNodeOutputMaterial"]:
             if out.target not in {"ALL", "CYCLES"}:
                 continue
@@ -350,7 +402,16 @@ class Session:
             mix = new("ShaderNodeMixShader")
             nt.links.new(fac.outputs[0], mix.inputs["Fac"])
             nt.links.new(emit.outputs["Emission"], mix.inputs[1])
-            nt.links.new(src, mix.inputs[2])
+            shader = src
+            if keep_alive:
+                strength = self._keep_alive_strength(new, nt, coord, path, tex)
+                keep = new("ShaderNodeEmission")
+                nt.links.new(strength, keep.inputs["Strength"])
+                add = new("ShaderNodeAddShader")
+                nt.links.new(src, add.inputs[0])
+                nt.links.new(keep.outputs["Emission"], add.inputs[1])
+                shader = add.outputs["Shader"]
+            nt.links.new(shader, mix.inputs[2])
             nt.links.new(mix.outputs["Shader"], surf)
 
             def undo(nt=nt, made=made, src=src, surf=surf):
@@ -358,6 +419,42 @@ class Session:
                     nt.nodes.remove(n)
                 nt.links.new(src, surf)
             self.changes.on_restore(undo)
+
+    # The keep-alive's scale: far below any value a render holds (a float sum of
+    # 1 and 1e-20 is 1), far above the float minimum.
+    KEEP_ALIVE = 1e-20
+
+    def _keep_alive_strength(self, new, nt, coord, path, tex):
+        """The keep-alive's strength, KEEP_ALIVE * white noise of the Window
+        position * IsCameraRay * mask: a camera sample's position is jittered
+        over the pixel filter, so each sample of a pixel draws another value."""
+        noise = new("ShaderNodeTexWhiteNoise")
+        noise.noise_dimensions = "3D"
+        nt.links.new(coord.outputs["Window"], noise.inputs["Vector"])
+        seen = new("ShaderNodeMath")
+        seen.operation = "MULTIPLY"
+        nt.links.new(path.outputs["Is Camera Ray"], seen.inputs[0])
+        nt.links.new(tex.outputs["Color"], seen.inputs[1])
+        scaled = new("ShaderNodeMath")
+        scaled.operation = "MULTIPLY"
+        nt.links.new(noise.outputs["Value"], scaled.inputs[0])
+        scaled.inputs[1].default_value = 0.0  # off: Cycles folds it away (_keep_alive)
+        self._keep_alive_scales.append(scaled.inputs[1])
+        strength = new("ShaderNodeMath")
+        strength.operation = "MULTIPLY"
+        nt.links.new(seen.outputs[0], strength.inputs[0])
+        nt.links.new(scaled.outputs[0], strength.inputs[1])
+        return strength.outputs[0]
+
+    def _keep_alive(self, on):
+        """Switches the keep-alive emission on or off for the next renders. On,
+        Cycles takes every surface that carries it for an emitter and shades the
+        last hit of paths it would end: more time for the pixels rendered
+        (KEEP_ALIVE_COST); off, its nodes fold to nothing."""
+        if on != self._keep_alive_on:
+            for socket in self._keep_alive_scales:
+                socket.default_value = self.KEEP_ALIVE if on else 0.0
+            self._keep_alive_on = on
 
     def _write_mask(self, texels):
         """texels: [rows top-down, columns] of 0/1. Written to its file and reloaded:
@@ -475,7 +572,7 @@ class Session:
             self._through_mirror = mirror
             g["normal"] = self._rgb(pl, "Normal", "XYZ")
             g["L"] = mean("Combined")
-            # Each half's render alone (_careful, _stopped_early).
+            # Each half's render alone (_may_stop_early, _stopped_early).
             g["L_of_half"] = [self._rgb(p, "Combined") for p in pls]
             g["Li"] = mean("DiffDir") + mean("DiffInd")
             reflected = sum(n * self._reflected(p) for n, p in zip(counts, pls)) / float(ps)
@@ -548,52 +645,61 @@ class Session:
         rendered pixel's per sample (docs/BLENDER.md)."""
         return 0.14 * self.pixel_seconds() * samples / self.samples
 
-    def _masked_stop(self, n, careful=False):
+    def _masked_stop(self, n):
         """Samples a masked pixel of a render of n samples takes: it stops at Cycles'
         first check past the minimum."""
-        return min(n, self.CHECK * (self._masked_min_samples(n, careful) // self.CHECK + 1))
+        return min(n, self.CHECK * (self._masked_min_samples(n) // self.CHECK + 1))
 
-    def _masked_min_samples(self, n, careful=False):
-        """Samples after which a masked pixel of a render of n samples may stop:
-        8 by default (it stops at the first check, 16), where an exact pixel might
-        stop (careful) an eighth of them and past the first check, so that no
-        pixel stops before 32 (none at all in a render of 32 samples or fewer)."""
-        return max(4, min(n, self.args.masked_min_samples or
-                          (max(n // 8, self.CHECK) if careful else 8)))
+    def _masked_min_samples(self, n):
+        """Samples after which a masked pixel of a render of n samples may stop: 8
+        (it stops at the first check, 16)."""
+        return max(4, min(n, self.args.masked_min_samples or 8))
 
-    def _careful(self, xs, ys, n):
-        """Whether a render of exact pixels (xs, ys) at n samples should keep
-        its masked pixels longer (_masked_min_samples): where exact pixels
-        might stop early and rendering them again (_again) would cost more
-        than the masked samples. A pixel
-        might stop where a few samples can all be 0: where one half of the
-        preview is 0 and the other is not (a dark pixel that rare paths
-        light); without halves a black preview counts too. (The preview has
-        seeds of its own: it tells the odds, not a seed's first samples.)"""
+    def _may_stop_early(self, xs, ys):
+        """Which pixels (xs, ys) might stop early: where a few samples can all be
+        0, where one half of the preview is 0 and the other is not (a dark pixel
+        that rare paths light); without halves a black preview counts too. (The
+        preview has seeds of its own: it tells the odds, not a seed's first
+        samples.)"""
         g = self.guides()
         halves = [(p[ys, xs] == 0).all(axis=1) for p in g["L_of_half"]]
         zero = np.logical_or.reduce(halves)
         if len(halves) > 1:
             zero &= ~(g["L"][ys, xs] == 0).all(axis=1)
-        if not zero.any():
+        return zero
+
+    # What the keep-alive adds to the time of the pixels a render renders.
+    KEEP_ALIVE_COST = 0.12
+
+    def _keep_alive_pays(self, xs, ys, n):
+        """Whether a render of exact pixels (xs, ys) at n samples should switch
+        the keep-alive on (_keep_alive): where pixels might stop early
+        (_may_stop_early) and rendering them again (_again) would cost more."""
+        zero = self._may_stop_early(xs, ys)
+        if not zero.any() or not self._keep_alive_scales:  # no surface carries it
             return False
         again = self._again(xs[zero], ys[zero], n)[1]
-        longer = self._masked_stop(n, careful=True) - self._masked_stop(n)
-        return again > self._masked_seconds(longer) * self.width * self.height
+        return again > self.KEEP_ALIVE_COST * len(xs) * self.pixel_seconds() * n / self.samples
 
-    def _masked_pixels_stop(self, n, careful=False):
+    # Cycles' noise threshold with the keep-alive on: below the error it gives a
+    # pixel whose other samples are all 0 (about 1e-16).
+    KEEP_ALIVE_THRESHOLD = 1e-30
+
+    def _masked_pixels_stop(self, n, keep_alive=False):
         """Lets a masked pixel stop after a few of the n samples (n = 0: off). A
         masked camera ray costs Cycles about a seventh of a rendered one per sample;
         with adaptive sampling a pixel whose samples agree stops, and a masked
         pixel's are all 0. The threshold is so low that a rendered pixel stops only
-        when its samples are all equal (0, in practice: float rounding keeps other
-        constant sums from agreeing); _stopped_early() finds those that did
-        (docs/BLENDER.md, "Masked pixels")."""
+        when its samples (nearly) agree; _stopped_early() finds those that did.
+        With the keep-alive on (_keep_alive_pays) none of its pixels' samples
+        agree, and the threshold is lower still: only samples that agree
+        exactly stop a pixel, so no exact pixel stops (the world's pixels,
+        whose samples may differ only a little, then take longer)."""
         cy = self.scene.cycles
         cy.use_adaptive_sampling = n > 0
         if n > 0:
-            cy.adaptive_threshold = self.args.adaptive_threshold
-            cy.adaptive_min_samples = self._masked_min_samples(n, careful)
+            cy.adaptive_threshold = self.KEEP_ALIVE_THRESHOLD if keep_alive else self.args.adaptive_threshold
+            cy.adaptive_min_samples = self._masked_min_samples(n)
 
     # Values that differ by less than this, relative, are equal but for the
     # order of float additions (a few float ulps; the tests' exactness bound).
@@ -658,6 +764,7 @@ class Session:
         """Renders pixels (xs, ys) with every one of the n samples, where _again()
         says: the planes of each render and where it holds."""
         self._masked_pixels_stop(0)
+        self._keep_alive(False)  # every pixel takes every sample
         for rect in self._again(xs, ys, n)[0]:
             self._set_border(rect)
             yield self._render(n, label, seed), self._inside(rect, xs, ys)
@@ -710,9 +817,11 @@ class Session:
             inside = self._inside(rect, xs, ys)
             finside = self._inside(rect, fx, fy)
             for h, (n, seed) in enumerate(zip(counts, self.seeds)):
-                careful = self._careful(xs[inside], ys[inside], n)
-                self.careful_renders += careful
-                self._masked_pixels_stop(n, careful)
+                keep_alive = (self.args.keep_alive == "on" or self.args.keep_alive == "auto"
+                              and self._keep_alive_pays(xs[inside], ys[inside], n))
+                self._masked_pixels_stop(n, keep_alive)
+                self._keep_alive(keep_alive)
+                self.kept_alive_renders += keep_alive
                 pl = self._render(n, "eval%d" % self._evals, seed)
                 diffcol = self._rgb(pl, "DiffCol")
                 # The mask rendered must be the mask asked for: outside it no surface
@@ -789,6 +898,8 @@ class Session:
                 lines += sorted("  link %s.%s>%s.%s" % (l.from_node.name, l.from_socket.identifier, l.to_node.name,
                                                          l.to_socket.identifier) for l in m.node_tree.links)
         lines += ["image " + i.name for i in bpy.data.images if i.type != "RENDER_RESULT"]
+        lines += ["material %s light sampling %s" % (m.name, getattr(m.cycles, "emission_sampling", None)
+                                                     or m.cycles.sample_as_light) for m in bpy.data.materials]
         for ob in sc.objects:
             lines.append("object %s %s" % (ob.name, [s.material and s.material.name for s in ob.material_slots]))
         for vl in sc.view_layers:
