@@ -139,7 +139,7 @@ def _may_emit(tree, seen=None):
         if kind in {"ShaderNodeEmission", "ShaderNodeBackground", "ShaderNodeScript"}:
             return True
         if kind == "ShaderNodeBsdfPrincipled":
-            colour = _value(n.inputs["Emission"])
+            colour = _value(n.inputs.get("Emission Color") or n.inputs["Emission"])  # the name since Blender 4.0
             strength = _value(n.inputs["Emission Strength"])
             if (colour is None or any(colour[:3])) and (strength is None or any(strength)):
                 return True
