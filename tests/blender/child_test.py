@@ -216,7 +216,8 @@ def main():
         assert not glob.glob(os.path.join(keepd, "*_again.npz")), "exact pixels were rendered again"
         want = dref.reshape(-1, dref.shape[-1])[dsel][:, :3]
         err = np.abs(L - want)
-        assert (err <= 1e-5 * np.maximum(np.abs(want), 1) + 1e-7).all(), "keep-alive: max |L - full render| = %g" % err.max()
+        assert (err <= 1e-5 * np.maximum(np.abs(want), 1) + 1e-7).all(), \
+            "keep-alive: max |L - full render| = %g" % err.max()
         # The keep-alive adds at most 1e-20 to a pixel (lost in any float sum above 1e-13).
         dark = np.abs(L[np.isin(dsel, black)])
         assert (dark <= 1e-20).all(), "black exact pixels: up to %g" % dark.max()

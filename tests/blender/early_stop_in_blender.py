@@ -103,8 +103,9 @@ if S._keep_alive_pays(sess, two % 256, two // 256, 64):
 # Switched by the scale of its emission, only where it changes.
 for on, want in ((True, S.KEEP_ALIVE), (True, S.KEEP_ALIVE), (False, 0.0)):
     S._keep_alive(sess, on)
-    if [k.default_value for k in sess._keep_alive_scales] != [want] * 3:
-        failures.append("the keep-alive switched %s: scales %s" % (on, [k.default_value for k in sess._keep_alive_scales]))
+    values = [k.default_value for k in sess._keep_alive_scales]
+    if values != [want] * 3:
+        failures.append("the keep-alive switched %s: scales %s" % (on, values))
 # Which materials may carry it: those Cycles cannot take for a light.
 import bpy  # noqa: E402
 

@@ -11,9 +11,10 @@ far (all 0: a dark pixel that rare paths light) would stop too: where the
 preview says that may happen, the round switches on an emission of white
 noise in the sample's window position times 1e-20 (KEEP_ALIVE) on the pixels
 asked for, so that their samples never all agree: it adds at most 1e-20 to
-a pixel, which a float sum with any value above 1e-13 loses. The mask has `mask_scale` texels per pixel and side and
-covers, around each pixel asked for, the footprint of the pixel filter (where
-the pixel's camera rays leave). With persistent data a mask changed in memory,
+a pixel, which a float sum with any value above 1e-13 loses. The mask has
+`mask_scale` texels per pixel and side and covers, around each pixel asked
+for, the footprint of the pixel filter (where the pixel's camera rays
+leave). With persistent data a mask changed in memory,
 or saved and reloaded under the same name, does not reach the next render; a
 new file per render does.
 
