@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace dcm {
 
@@ -22,6 +23,14 @@ Status ExactNoiseMeter::Evaluate(std::span<const Point2i> pixels, const SampleRe
   const bool measure =
       pixels_ == 0 && caps.variance && own_ && own_->size() == n && n > 0 && pixels.size() >= kMinPixels;
   zeroExtraVariance_ = measure && !what.variance;
+  scaledExtraVariance_ = !measure && what.variance && fromPreview_ && pixels_ > 0 && own_ && own_->size() == n;
+  if (scaledExtraVariance_) {
+    SampleRequest once = what;
+    once.variance = false;
+    DCM_RETURN_IF_ERROR(exact_.Evaluate(pixels, once, out));
+    ScaledPreviewVariance(pixels, out);
+    return Status::Ok();
+  }
   if (!measure) return exact_.Evaluate(pixels, what, out);
   SampleRequest halves = what;
   halves.variance = true;
@@ -56,6 +65,18 @@ void ExactNoiseMeter::TakeExtraSamples(std::vector<Point2i>* pixels, std::vector
   exact_.TakeExtraSamples(pixels, samples);
   if (zeroExtraVariance_)
     for (ExactSample& s : *samples) s.variance = RGB{};
+  if (scaledExtraVariance_) ScaledPreviewVariance(*pixels, *samples);
+}
+
+void ExactNoiseMeter::ScaledPreviewVariance(std::span<const Point2i> pixels, std::span<ExactSample> out) const {
+  const ProviderCapabilities caps = exact_.Capabilities();
+  const float share = float(share_);
+  for (size_t i = 0; i < pixels.size() && i < out.size(); ++i) {
+    const Point2i& p = pixels[i];
+    const bool inside = p.x >= 0 && p.y >= 0 && p.x < caps.width && p.y < caps.height;
+    out[i].variance = inside ? (*own_)[size_t(p.y) * size_t(caps.width) + size_t(p.x)] * share
+                             : RGB::Gray(std::numeric_limits<float>::quiet_NaN());
+  }
 }
 
 }  // namespace dcm

@@ -113,12 +113,16 @@ def exact_mask(smap, h, w):
 
 
 def variance(dcm, blender, src, tmp):
-    """By default the exact pixels are two renders of half the samples with the
-    file's seed and the next; the engine weighs their variance where the
-    preview's halves say their noise matters (always with --variance on)."""
+    """By default the exact pixels of the first round are two renders of half
+    the samples with the file's seed and the next; the engine weighs their
+    variance where the preview's halves say their noise matters (always with
+    --variance on). Later rounds are one render of all the samples, their
+    variance the preview's times the share the first round measured
+    (--variance-from preview), or two halves as the first (halves)."""
     blend = bs.make_scene(blender, src, tmp)  # 16 spp, seed 0
     half_a = bs.render_full(blender, src, blend, tmp, 8, 0)
     half_b = bs.render_full(blender, src, blend, tmp, 8, 1)
+    whole = bs.render_full(blender, src, blend, tmp, 16, 0)
     h, w = half_a.shape[:2]
     runs = {}
     # "on" and the runs compared with it have no error round (it depends on the correction's estimate);
@@ -127,6 +131,8 @@ def variance(dcm, blender, src, tmp):
     no_error_round = ["--error-round", "0"]
     for name, flags in (("auto", []), ("on", ["--variance", "on"] + no_error_round),
                         ("raw", ["--variance", "on", "--no-denoise-samples", "--pool-preview", "off"] + no_error_round),
+                        ("raw halves", ["--variance", "on", "--no-denoise-samples", "--pool-preview", "off",
+                                        "--variance-from", "halves"] + no_error_round),
                         ("exact preview", ["--variance", "on", "--preview-samples", "16"] + no_error_round),
                         ("uncorrected", ["--variance", "on", "--preview-correction", "0"]),
                         ("unfiltered", ["--variance", "on", "--preview-filter", "0"] + no_error_round),
@@ -143,6 +149,7 @@ def variance(dcm, blender, src, tmp):
         # auto: the variance goes to the engine when the noise costs less than 42 dB.
         used = name != "auto" or b["noise_psnr"] < 42
         assert b["variance"] == ("halves" if used else "halves, not used"), b
+        assert b.get("later_rounds_variance") == (None if not used else "halves" if "halves" in name else "preview"), b
         # The variance reached the engine: it runs its noise regime.
         assert j["settings"]["noisy"] == used, j["settings"]
         # Every pixel a round rendered is paid for, also where the noise regime's final run interpolated it.
@@ -169,15 +176,26 @@ def variance(dcm, blender, src, tmp):
     # The engine denoises exact samples with their neighbours on the same surface.
     assert runs["on"][2]["denoised_samples"] > 0, runs["on"][2]
     assert runs["raw"][2]["denoised_samples"] == 0, runs["raw"][2]
-    # Without the denoising an exact pixel is the mean of the two seeds' renders
-    # (relative 1e-5: the order of float additions in Cycles' film, far below the
+    # Without the denoising an exact pixel rendered in halves is the mean of the two seeds'
+    # renders (relative 1e-5: the order of float additions in Cycles' film, far below the
     # 8-spp noise), which differ: two seeds, each seen by Cycles' persistent session.
-    img, is_exact = runs["raw"][0], runs["raw"][1]
+    def same(a, b, where):
+        return (np.abs(a - b)[where][:, :3] <= 1e-5 * np.maximum(np.abs(b[where][:, :3]), 1) + 1e-7).all(axis=1)
+    img, is_exact = runs["raw halves"][0], runs["raw halves"][1]
     mean = (half_a + half_b) / 2
-    err = np.abs(img - mean)[is_exact][:, :3]
-    assert (err <= 1e-5 * np.maximum(np.abs(mean[is_exact][:, :3]), 1) + 1e-7).all(), err.max()
+    assert same(img, mean, is_exact).all(), np.abs(img - mean)[is_exact].max()
     differ = (np.abs(half_a - half_b)[is_exact][:, :3] > 1e-4).any(axis=1).mean()
     assert differ > 0.5, differ
+    # By default only the first round is in halves: every later pixel is the file's own render
+    # at all 16 samples (seed 0), and no more pixels are the halves' mean than the first round
+    # and its extra pixels hold. Constant pixels equal both (58 of the exact ones here, 17 of
+    # the 94 later): at least half the later ones must be the whole render's alone.
+    img, is_exact, b = runs["raw"][0], runs["raw"][1], runs["raw"][2]["blender"]
+    as_halves, as_whole = same(img, mean, is_exact), same(img, whole, is_exact)
+    assert (as_halves | as_whole).all(), "an exact pixel is neither the halves' mean nor the whole render"
+    later = sum(r["pixels"] for r in b["rounds"][1:])
+    assert later > 0 and (as_whole & ~as_halves).sum() >= 0.5 * later, ((as_whole & ~as_halves).sum(), b["rounds"])
+    assert (as_halves & ~as_whole).sum() <= b["rounds"][0]["pixels"] + b["extra_pixels"], b
     # The preview correction (the preview carries its halves' variance) moves
     # interpolated pixels only: the same exact pixels, the same values there,
     # and the pixels that differ are among those it says it moved (a move
@@ -198,15 +216,18 @@ def variance(dcm, blender, src, tmp):
     assert unf[2]["blender"]["preview_filtered"] == 0, unf[2]["blender"]
     assert 0 < changed.sum() <= filtered <= (~on[1]).sum(), (changed.sum(), filtered, on[2]["blender"])
     # The error round renders, after the same rounds, the interpolated pixels the preview says the
-    # interpolation missed most, and keeps them exact as the mean of the two seeds' renders
-    # (not denoised, though the samples are noisy).
+    # interpolation missed most, and keeps them exact as rendered (not denoised, though the samples
+    # are noisy).
     er = runs["error round"]
     n_error = er[2]["blender"]["error_round_pixels"]
     added = er[1] & ~on[1]
     assert (er[1] | ~on[1]).all() and added.sum() == n_error > 0, (added.sum(), er[2]["blender"])
     assert len(er[2]["blender"]["rounds"]) == len(on[2]["blender"]["rounds"]) + 1, (er[2]["blender"], on[2]["blender"])
-    err = np.abs(er[0] - mean)[added][:, :3]
-    assert (err <= 1e-5 * np.maximum(np.abs(mean[added][:, :3]), 1) + 1e-7).all(), err.max()
+    # (Some were extra pixels of the first round, its halves' mean; those its own call rendered
+    # are whole.)
+    as_halves, as_whole = same(er[0], mean, added), same(er[0], whole, added)
+    assert (as_halves | as_whole).all() and as_whole.sum() >= er[2]["blender"]["rounds"][-1]["pixels"], (
+        as_halves.sum(), as_whole.sum(), er[2]["blender"]["rounds"])
     # The corrected run estimates its PSNR against the converged image from the
     # preview where the preview's own noise costs less than 25 dB; without the
     # correction there is no estimate.

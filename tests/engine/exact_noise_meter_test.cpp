@@ -76,6 +76,37 @@ TEST(ExactNoiseMeter, APreviewFourTimesAsNoisyMeasuresAQuarter) {
   EXPECT_EQ(meter.pixels(), 1000);
 }
 
+TEST(ExactNoiseMeter, LaterRoundsTakeThePreviewsVarianceTimesTheShare) {
+  // The preview four times as noisy: after the first round measured a quarter,
+  // a round that asks for the variance is rendered without it (one render
+  // call) and gets the preview's own variance times the quarter, which is the
+  // exact variance here; without SetVarianceFromPreview it is rendered in halves.
+  Fixture f;
+  const std::vector<RGB> exact = f.ExactVariance();
+  std::vector<RGB> own = exact;
+  for (RGB& c : own) c = c * 4.f;
+  for (const bool fromPreview : {true, false}) {
+    f.log.askedVariance.clear();
+    ExactNoiseMeter meter(f.log);
+    meter.SetPreviewVariance(&own);
+    meter.SetVarianceFromPreview(fromPreview);
+    std::vector<ExactSample> out(1000);
+    ASSERT_TRUE(meter.Evaluate(Pixels(0, 1000), SampleRequest{false, true}, out).ok());
+    ASSERT_NEAR(meter.share(), 0.25, 1e-6);
+    const std::vector<Point2i> later = Pixels(1000, 1000);
+    ASSERT_TRUE(meter.Evaluate(later, SampleRequest{false, true}, out).ok());
+    EXPECT_EQ(f.log.askedVariance, (std::vector<bool>{true, !fromPreview}));
+    for (size_t i = 0; i < later.size(); ++i) {
+      const RGB& want = exact[size_t(later[i].y) * M + size_t(later[i].x)];
+      // 4 x and x 0.25: float rounding only.
+      for (int c = 0; c < 3; ++c) ASSERT_NEAR(out[i].variance[c], want[c], 1e-6f * want[c]) << i;
+    }
+    // Not asked for: none, from the preview or not.
+    ASSERT_TRUE(meter.Evaluate(later, SampleRequest{}, out).ok());
+    for (const ExactSample& s : out) EXPECT_EQ(s.variance, RGB{});
+  }
+}
+
 TEST(ExactNoiseMeter, DarkPixelsWeighAsTheDisplaysSlopeSays) {
   // The preview four times as noisy where the truth is dark, sixteen times
   // where it is bright: the share is the ratio of the display-weighted sums.

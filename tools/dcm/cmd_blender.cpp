@@ -95,6 +95,10 @@ struct BlenderFlags {
   /// auto where the preview's halves say the noise matters (kNoisyPsnr), on, off
   /// (one render per pixel).
   std::string variance = "auto";
+  /// The exact pixels' variance after the round that measured their noise:
+  /// preview (its own times the measured share, one render call per round) or
+  /// halves (their own, two calls).
+  std::string varianceFrom = "preview";
   /// What judges --target-psnr: auto (the preview where it can tell), preview, validation.
   std::string estimateFrom = "auto";
   PipeFlags pipe;  ///< --provider-timeout, --provider-startup-timeout; engine; EXR format
@@ -460,6 +464,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     measureNoise =
         !(st.ok() && targetFromPreview && !useVariance && target > 0 && ratioRenderPsnr >= target + kMeasureNoiseMarginDb);
     if (measureNoise) meter.SetPreviewVariance(&so.previewOwnVariance);
+    meter.SetVarianceFromPreview(f.varianceFrom == "preview");
     if (targetFromPreview) {
       QualityReport report;
       const auto tq = Clock::now();
@@ -632,6 +637,8 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       b["exact_samples"] = all >> ptarget.exactSampleHalvings;
     }
     b["variance"] = useVariance ? "halves" : provider->Capabilities().variance ? "halves, not used" : "none";
+    // After the round that measured the share (ExactNoiseMeter::SetVarianceFromPreview).
+    if (useVariance && meter.pixels() > 0) b["later_rounds_variance"] = f.varianceFrom;
     if (!std::isnan(noisePsnr)) b["noise_psnr"] = noisePsnr;
     if (std::isfinite(assumedShare))
       b["exact_noise_share"] = {{"assumed", assumedShare},
@@ -794,6 +801,12 @@ Registration reg("blender", "Render a .blend with Cycles at the pixels DCM asks 
                                    "noise costs less than 42 dB PSNR, and always with --target-psnr render), on, "
                                    "or off (one render each, no variance)")
                        ->check(CLI::IsMember({"auto", "on", "off"}))
+                       ->capture_default_str();
+                   app->add_option("--variance-from", f->varianceFrom,
+                                   "the exact pixels' variance after the first round, which measures it against the "
+                                   "preview's: preview (the preview's own times that share: one render call per "
+                                   "round) or halves (each round in two renders, as the first)")
+                       ->check(CLI::IsMember({"preview", "halves"}))
                        ->capture_default_str();
                    app->add_option("--estimate-from", f->estimateFrom,
                                    "what judges --target-psnr and --budget: the preview's estimate at every pixel "

@@ -38,6 +38,12 @@ class ExactNoiseMeter final : public SampleProvider {
   /// pointer: set it before the rounds. Unset, empty or of another size:
   /// nothing is measured.
   void SetPreviewVariance(const std::vector<RGB>* own) { own_ = own; }
+  /// Once the share is measured, a call that asks for the variance takes it
+  /// from the preview instead: the preview's own at that pixel times the
+  /// share, and the renderer renders without halves (one render call per round
+  /// instead of two). The exact variance of a pixel from its own halves has one
+  /// degree of freedom, as the preview's: per pixel neither is better.
+  void SetVarianceFromPreview(bool on) { fromPreview_ = on; }
   /// The measured share; NaN until a round measured it.
   double share() const { return share_; }
   /// The pixels it was measured on (0: not measured).
@@ -52,8 +58,13 @@ class ExactNoiseMeter final : public SampleProvider {
   void TakeExtraSamples(std::vector<Point2i>* pixels, std::vector<ExactSample>* samples) override;
 
  private:
+  /// out[i].variance = the preview's own at pixels[i] times the share (NaN outside the image).
+  void ScaledPreviewVariance(std::span<const Point2i> pixels, std::span<ExactSample> out) const;
+
   SampleProvider& exact_;
   bool zeroExtraVariance_ = false;  ///< the last call asked for the variance its caller did not
+  bool scaledExtraVariance_ = false;  ///< the last call took the variance from the preview
+  bool fromPreview_ = false;
   const std::vector<RGB>* own_ = nullptr;
   double share_ = std::numeric_limits<double>::quiet_NaN();
   int64_t pixels_ = 0;

@@ -225,13 +225,11 @@ class Session:
             c.set(vl, "use", vl == self.layer)
         vl = self.layer
         for attr in ("use_pass_combined", "use_pass_diffuse_color", "use_pass_diffuse_direct",
-                     "use_pass_diffuse_indirect", "use_pass_normal", "use_pass_cryptomatte_object",
-                     "use_pass_cryptomatte_material"):
+                     "use_pass_diffuse_indirect"):
             c.set(vl, attr, True)
         c.set(vl, "pass_cryptomatte_depth", 2)
-        # The Denoising Albedo: the texture seen in mirrors, and what it modulates
-        # there, the light they reflect (GlossCol * GlossInd).
-        c.set(vl.cycles, "denoising_store_passes", True)
+        self._guides_only_passes(True)
+        # What a mirror reflects, GlossCol * GlossInd (_reflected).
         for attr in ("use_pass_glossy_color", "use_pass_glossy_indirect"):
             c.set(vl, attr, True)
         # How many samples each pixel took: an exact pixel that stopped early is rendered again.
@@ -534,6 +532,16 @@ class Session:
         p = self.layer.name + "."
         return {k[len(p):]: v for k, v in planes.items() if k.startswith(p)}
 
+    def _guides_only_passes(self, on):
+        """The passes only the guides read: the IDs (Cryptomatte), the normal and
+        the Denoising Albedo (the texture seen in mirrors). Off in the rounds:
+        Cycles writes them for every sample of every pixel, masked ones too
+        (about 4 % of a round; docs/BLENDER.md)."""
+        vl = self.layer
+        for attr in ("use_pass_normal", "use_pass_cryptomatte_object", "use_pass_cryptomatte_material"):
+            self.changes.set(vl, attr, on)
+        self.changes.set(vl.cycles, "denoising_store_passes", on)
+
     def _rgb(self, planes, name, comps="RGB"):
         return np.stack([planes[name + "." + c] for c in comps], axis=-1)
 
@@ -554,6 +562,7 @@ class Session:
             def mean(name, comps="RGB"):
                 return sum(n * self._rgb(p, name, comps) for n, p in zip(counts, pls)) / float(ps)
             pl = pls[0]
+            self._guides_only_passes(False)
             g = {}
             g["texture"] = mean("DiffCol")
             g["object_id"] = pl["CryptoObject00.r"].view(np.uint32).copy()
