@@ -536,7 +536,7 @@ class Session:
         """The passes only the guides read: the IDs (Cryptomatte), the normal and
         the Denoising Albedo (the texture seen in mirrors). Off in the rounds:
         Cycles writes them for every sample of every pixel, masked ones too
-        (about 4 % of a round; docs/BLENDER.md)."""
+        (docs/BLENDER.md)."""
         vl = self.layer
         for attr in ("use_pass_normal", "use_pass_cryptomatte_object", "use_pass_cryptomatte_material"):
             self.changes.set(vl, attr, on)
