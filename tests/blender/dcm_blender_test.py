@@ -250,6 +250,8 @@ def variance(dcm, blender, src, tmp):
     assert code == 0, se
     j = json.load(open(stats))
     assert j["blender"]["variance"] == "halves" and j["settings"]["noisy"], (j["blender"], j["settings"])
+    # Validation pixels judge it, by each one's own variance: every round in halves.
+    assert j["blender"]["later_rounds_variance"] == "halves", j["blender"]
     assert j["quality"]["target_render"] and j["estimated_render_psnr"] > 0, j
     # Two judges, the validation and the preview's estimate: the lower is reported (JSON null: +inf),
     # the summary names the other.

@@ -377,6 +377,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   double previewS = 0, goalS = 0;
   double assumedShare = std::numeric_limits<double>::quiet_NaN();  ///< the ratio of samples
   bool measureNoise = true;  ///< the first round in halves (ExactNoiseMeter)
+  bool laterFromPreview = false;  ///< later rounds' variance the preview's times the share
   double ratioRenderPsnr = std::numeric_limits<double>::quiet_NaN();  ///< the render's own, from the ratio
   Status st;
   if (schedule == RoundSchedule::kPreview) {
@@ -464,7 +465,10 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     measureNoise =
         !(st.ok() && targetFromPreview && !useVariance && target > 0 && ratioRenderPsnr >= target + kMeasureNoiseMarginDb);
     if (measureNoise) meter.SetPreviewVariance(&so.previewOwnVariance);
-    meter.SetVarianceFromPreview(f.varianceFrom == "preview");
+    // Validation pixels judge a goal by each one's own variance, which the
+    // preview's times a share measured on other pixels (edges) would bias.
+    laterFromPreview = f.varianceFrom == "preview" && !(haveGoal && !targetFromPreview);
+    meter.SetVarianceFromPreview(laterFromPreview);
     if (targetFromPreview) {
       QualityReport report;
       const auto tq = Clock::now();
@@ -638,7 +642,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     }
     b["variance"] = useVariance ? "halves" : provider->Capabilities().variance ? "halves, not used" : "none";
     // After the round that measured the share (ExactNoiseMeter::SetVarianceFromPreview).
-    if (useVariance && meter.pixels() > 0) b["later_rounds_variance"] = f.varianceFrom;
+    if (useVariance && meter.pixels() > 0) b["later_rounds_variance"] = laterFromPreview ? "preview" : "halves";
     if (!std::isnan(noisePsnr)) b["noise_psnr"] = noisePsnr;
     if (std::isfinite(assumedShare))
       b["exact_noise_share"] = {{"assumed", assumedShare},
@@ -805,7 +809,8 @@ Registration reg("blender", "Render a .blend with Cycles at the pixels DCM asks 
                    app->add_option("--variance-from", f->varianceFrom,
                                    "the exact pixels' variance after the first round, which measures it against the "
                                    "preview's: preview (the preview's own times that share: one render call per "
-                                   "round) or halves (each round in two renders, as the first)")
+                                   "round; halves where validation pixels judge a goal) or halves (each round in "
+                                   "two renders, as the first)")
                        ->check(CLI::IsMember({"preview", "halves"}))
                        ->capture_default_str();
                    app->add_option("--estimate-from", f->estimateFrom,
