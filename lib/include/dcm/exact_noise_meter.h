@@ -42,7 +42,9 @@ class ExactNoiseMeter final : public SampleProvider {
   /// from the preview instead: the preview's own at that pixel times the
   /// share, and the renderer renders without halves (one render call per round
   /// instead of two). The exact variance of a pixel from its own halves has one
-  /// degree of freedom, as the preview's: per pixel neither is better.
+  /// degree of freedom, as the preview's: per pixel neither is less noisy. But
+  /// the share, measured on one round's pixels, is biased for others: a judge
+  /// that weighs each pixel's own variance (validation pixels) needs halves.
   void SetVarianceFromPreview(bool on) { fromPreview_ = on; }
   /// The measured share; NaN until a round measured it.
   double share() const { return share_; }
