@@ -20,10 +20,10 @@ Status ExactNoiseMeter::Evaluate(std::span<const Point2i> pixels, const SampleRe
                                  std::span<ExactSample> out) {
   const ProviderCapabilities caps = exact_.Capabilities();
   const size_t n = size_t(std::max(caps.width, 0)) * size_t(std::max(caps.height, 0));
-  const bool measure =
-      pixels_ == 0 && caps.variance && own_ && own_->size() == n && n > 0 && pixels.size() >= kMinPixels;
+  const bool haveOwn = own_ && own_->size() == n && n > 0;
+  const bool measure = pixels_ == 0 && caps.variance && haveOwn && pixels.size() >= kMinPixels;
   zeroExtraVariance_ = measure && !what.variance;
-  scaledExtraVariance_ = !measure && what.variance && fromPreview_ && pixels_ > 0 && own_ && own_->size() == n;
+  scaledExtraVariance_ = pixels_ > 0 && haveOwn && fromPreview_ && what.variance;
   if (scaledExtraVariance_) {
     SampleRequest once = what;
     once.variance = false;

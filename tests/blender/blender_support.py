@@ -15,6 +15,12 @@ def make_scene(blender, src, tmp, res="64x48", samples=16, pixel_filter="BLACKMA
     return out
 
 
+def as_rendered(a, want):
+    """Where a equals want but for the order of float additions in Cycles' film:
+    relative 1e-5, far below any test scene's noise and far above float rounding."""
+    return np.abs(a - want) <= 1e-5 * np.maximum(np.abs(want), 1) + 1e-7
+
+
 def display_mse(a, b):
     """Mean squared difference of a and b [..., 3+] on sRGB-encoded values clipped to [0, 1], as the
     stats' PSNR measures it (tools/common/metrics.h)."""
