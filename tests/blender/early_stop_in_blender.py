@@ -45,14 +45,14 @@ if wrong:
 # Where _render_all_samples renders again:
 # a Session without a Blender scene, its cost model's inputs set by hand.
 sess = S.__new__(S)
-sess.args = types.SimpleNamespace(call_seconds=0.3, max_calls=64, masked_min_samples=0, border_tile=0)
+sess.args = types.SimpleNamespace(call_seconds=0.05, max_calls=64, masked_min_samples=0, border_tile=0)
 sess.width = sess.height = 256
 sess.samples = 64
 sess.pixel_seconds = lambda: 1e-4  # a pixel at every sample; a masked one a seventh of it per sample
 failures = []
 # 41 stopped pixels scattered over the frame: a border per 16-px tile costs
-# about 41 calls (12 s by the model), the whole frame one call and 32 masked
-# samples per pixel (0.76 s).
+# 41 calls (2.1 s by the model), the whole frame one call and 32 masked
+# samples per pixel (0.53 s).
 ys_far = np.arange(41) * 6
 xs_far = (np.arange(41) * 37) % 256
 borders = []
@@ -76,8 +76,8 @@ if borders != [(0, 0, 16, 16)]:
 # the other not) would cost more to render again than it costs the round
 # (KEEP_ALIVE_COST of its pixels' time). 4000 exact pixels at 64 samples cost
 # 0.4 s, the keep-alive 0.048 s; rendering the 41 scattered ones again costs
-# the whole frame (1.2 s by the model): on. Two such pixels in one 16-px tile
-# among 30000 exact pixels: one border (0.3 s) against 0.36 s: off.
+# the whole frame (1.0 s by the model): on. Two such pixels in one 16-px tile
+# among 30000 exact pixels: one border (0.054 s) against 0.36 s: off.
 sess._keep_alive_scales = [types.SimpleNamespace(default_value=0.0) for _ in range(3)]
 sess._keep_alive_on = False
 half_a = np.full((256, 256, 3), 0.2, np.float32)

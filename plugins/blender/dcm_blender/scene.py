@@ -173,6 +173,7 @@ class Session:
         self.kept_alive_renders = 0  # renders of exact pixels with the keep-alive on (evaluate)
         self._keep_alive_scales = []  # the sockets that switch it (_keep_alive)
         self._keep_alive_on = False
+        self._crop = None  # the render border's rectangle, cropped to (_set_border)
         self.masked_materials = 0  # materials whose surface the mask decides
 
     # ------------------------------------------------------------- setup --
@@ -520,12 +521,23 @@ class Session:
         cycles = [_clock_seconds(meta.get("cycles.%s.%s" % (self.layer.name, k), "")) for k in
                   ("synchronization_time", "render_time")]
         self.render_seconds.append((label, time.monotonic() - t0, *cycles))
+        crop = self._crop
+        if crop is not None:
+            # A cropped render: its planes in the frame, 0 outside as an uncropped border's.
+            x0, y0, x1, y1 = crop
+            if (w, h) != (x1 - x0, y1 - y0):
+                raise SceneError("Cycles rendered %dx%d for the render border %s, expected %dx%d" %
+                                 (w, h, crop, x1 - x0, y1 - y0))
+            for k, v in planes.items():
+                frame = np.zeros((self.height, self.width), v.dtype)
+                frame[y0:y1, x0:x1] = v
+                planes[k] = frame
+        elif (w, h) != (self.width, self.height):
+            raise SceneError("Cycles rendered %dx%d, expected %dx%d" % (w, h, self.width, self.height))
         if self.args.keep_renders:
             os.makedirs(self.args.keep_renders, exist_ok=True)
             dst = os.path.join(self.args.keep_renders, "%02d_%s.npz" % (self._round, label))
             np.savez(dst, **{k.split(".", 1)[-1]: v for k, v in planes.items()})
-        if (w, h) != (self.width, self.height):
-            raise SceneError("Cycles rendered %dx%d, expected %dx%d" % (w, h, self.width, self.height))
         done = meta.get("cycles.%s.samples" % self.layer.name)
         if done is not None and done != str(samples):
             raise SceneError("Cycles rendered %s samples per pixel, asked for %d (%s)" % (done, samples, label))
@@ -626,29 +638,36 @@ class Session:
         """Where to render pixels (xs, ys) in a round: a list of (x0, y0, x1, y1), or
         [None] for the whole frame. A masked pixel costs Cycles a camera ray and a
         shader per sample (about a seventh of a rendered one) until it stops
-        (_masked_pixels_stop): _cheapest() with `calls` renders per rectangle."""
+        (_masked_pixels_stop), and a visit per sample after that:
+        _cheapest() with `calls` renders per rectangle."""
         if self.args.border_tile > 0:
             return self._runs(xs, ys, self.args.border_tile)
         n = self.samples // calls
-        return self._cheapest(xs, ys, calls, self._masked_seconds(self._masked_stop(n)))[0]
+        return self._cheapest(xs, ys, calls, self._masked_seconds(self._masked_stop(n)) + n * self.VISIT_SECONDS)[0]
 
     def _cheapest(self, xs, ys, calls, masked, tiles=(16, 32, 64)):
         """Of the `tiles` (sides in px) that hold the pixels (xs, ys) (each tile
         row's runs one render border, at most max_calls of them) and the whole
         frame ([None]), the cheapest to render: `calls` renders per rectangle,
-        each its fixed time (call_seconds), every pixel inside a border `masked`
-        seconds. Returns the rectangles and their cost in seconds."""
-        best, best_cost = [None], calls * self.args.call_seconds + self.width * self.height * masked
+        each its fixed time (call_seconds) and `masked` seconds for every pixel
+        inside its border. Returns the rectangles and their cost in seconds."""
+        best, best_cost = [None], calls * (self.args.call_seconds + self.width * self.height * masked)
         for t in tiles:
             rects = self._runs(xs, ys, t)
             area = sum((x1 - x0) * (y1 - y0) for x0, y0, x1, y1 in rects)
-            cost = len(rects) * calls * self.args.call_seconds + area * masked
+            cost = calls * (len(rects) * self.args.call_seconds + area * masked)
             if len(rects) <= self.args.max_calls and cost < best_cost:
                 best, best_cost = rects, cost
         return best, best_cost
 
     # Cycles judges a pixel's convergence every this many samples past the minimum.
     CHECK = 16
+
+    # What Cycles spends on a pixel of the render (border) per sample after the
+    # pixel stopped: it visits every pixel each sample. A round of no pixel at
+    # 256² took 0.58 s at 512 samples, 0.29 s at 64, on this project's machine
+    # (examples/blender/round_call_cost.py; docs/BLENDER.md, *Render borders*).
+    VISIT_SECONDS = 1e-8
 
     def _masked_seconds(self, samples):
         """What a masked pixel costs for `samples` samples: about a seventh of a
@@ -768,7 +787,7 @@ class Session:
         whichever _cheapest() finds cheaper. (Larger tiles save calls for area
         that, with adaptive sampling off, costs more than the model's masked
         pixel: docs/BLENDER.md.)"""
-        return self._cheapest(xs, ys, 1, self._masked_seconds(n), (16,))
+        return self._cheapest(xs, ys, 1, self._masked_seconds(n) + n * self.VISIT_SECONDS, (16,))
 
     def _render_all_samples(self, n, label, seed, xs, ys):
         """Renders pixels (xs, ys) with every one of the n samples, where _again()
@@ -780,16 +799,22 @@ class Session:
             yield self._render(n, label, seed), self._inside(rect, xs, ys)
 
     def _set_border(self, rect):
+        """Renders from now on within rect (x0, y0, x1, y1) and a pixel more on each
+        side, cropped to it (_render() places it in the frame); None: the frame."""
         r = self.scene.render
         if rect is None:
             r.use_border = False
+            self._crop = None
             return
-        # One pixel more on each side: Blender truncates the border to whole pixels.
         x0, y0 = max(rect[0] - 1, 0), max(rect[1] - 1, 0)
         x1, y1 = min(rect[2] + 1, self.width), min(rect[3] + 1, self.height)
-        r.use_border = True
-        r.border_min_x, r.border_max_x = x0 / self.width, x1 / self.width
-        r.border_min_y, r.border_max_y = 1 - y1 / self.height, 1 - y0 / self.height
+        # A quarter pixel in: Blender takes the border to whole pixels, by
+        # truncation or rounding alike; y counts from the bottom.
+        W, H = self.width, self.height
+        r.use_border = r.use_crop_to_border = True
+        r.border_min_x, r.border_max_x = (x0 + 0.25) / W, min((x1 + 0.25) / W, 1.0)
+        r.border_min_y, r.border_max_y = (H - y1 + 0.25) / H, min((H - y0 + 0.25) / H, 1.0)
+        self._crop = (x0, y0, x1, y1)
 
     def evaluate(self, xs, ys, variance=True):
         """L, L_i, L_c, var [n, 3] of pixels (xs, ys) at full samples: one mask, and one
@@ -893,8 +918,9 @@ class Session:
         pixel at full samples costs samples / preview_samples times a preview pixel
         (pixel_seconds); a round is a render call per seed, each its fixed time
         (call_seconds) and the masked pixels of the whole frame until they stop
-        (_masked_stop; docs/BLENDER.md)."""
-        masked = self._masked_seconds(self._masked_stop(self.samples // len(self.seeds)))
+        (_masked_stop) and after (VISIT_SECONDS; docs/BLENDER.md)."""
+        n = self.samples // len(self.seeds)
+        masked = self._masked_seconds(self._masked_stop(n)) + n * self.VISIT_SECONDS
         return len(self.seeds) * (self.args.call_seconds + self.width * self.height * masked), self.pixel_seconds()
 
     def fingerprint(self):
