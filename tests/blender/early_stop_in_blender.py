@@ -14,7 +14,7 @@ import numpy as np
 
 src = sys.argv[sys.argv.index("--") + 1]
 sys.path.insert(0, os.path.join(src, "plugins", "blender"))
-from dcm_blender import scene  # noqa: E402
+from dcm_blender import child, scene  # noqa: E402
 
 S = scene.Session
 n = 64
@@ -45,14 +45,16 @@ if wrong:
 # Where _render_all_samples renders again:
 # a Session without a Blender scene, its cost model's inputs set by hand.
 sess = S.__new__(S)
-sess.args = types.SimpleNamespace(call_seconds=0.05, max_calls=64, masked_min_samples=0, border_tile=0)
+defaults = child.parse_args([])  # the child's call_seconds (0.03 s) and max_calls
+sess.args = types.SimpleNamespace(call_seconds=defaults.call_seconds, max_calls=defaults.max_calls,
+                                  masked_min_samples=0, border_tile=0)
 sess.width = sess.height = 256
 sess.samples = 64
 sess.pixel_seconds = lambda: 1e-4  # a pixel at every sample; a masked one a seventh of it per sample
 failures = []
 # 41 stopped pixels scattered over the frame: a border per 16-px tile costs
-# 41 calls (2.1 s by the model), the whole frame one call and 32 masked
-# samples per pixel (0.53 s).
+# 41 calls (1.3 s by the model), the whole frame one call and 32 masked
+# samples per pixel (0.51 s).
 ys_far = np.arange(41) * 6
 xs_far = (np.arange(41) * 37) % 256
 borders = []
@@ -72,12 +74,50 @@ list(S._render_all_samples(sess, 32, "again", 0, np.array([3, 5]), np.array([4, 
 if borders != [(0, 0, 16, 16)]:
     failures.append("two pixels of one tile rendered again in %s" % borders)
 
+# A late round at 512 samples, a pixel's cost the room's (6e-4 s): Cycles
+# visits every pixel of a frame or border each sample (VISIT_SECONDS), so the
+# whole frame costs 0.55 s by the model however few pixels it has. 132
+# pixels in 12 clusters of 11 (12 16-px tiles, 0.44 s): borders; as many
+# scattered over 132 tiles: the whole frame.
+sess.samples = 512
+sess.pixel_seconds = lambda: 6e-4
+cx, cy = np.arange(12) * 21 + 5, (np.arange(12) * 77) % 240 + 5
+clustered = (np.repeat(cx, 11) + np.tile(np.arange(11) % 4, 12), np.repeat(cy, 11) + np.tile(np.arange(11) // 4, 12))
+rects = S.rectangles(sess, *clustered)
+if rects == [None] or not all(S._inside(r, *clustered).any() for r in rects):
+    failures.append("132 pixels in 12 clusters at 512 samples rendered in %s, not in their borders" % rects)
+scattered = (np.arange(132) * 37 % 256, np.arange(132) * 2 % 256 // 16 * 16 + np.arange(132) // 16)
+if S.rectangles(sess, *scattered) != [None]:
+    failures.append("132 scattered pixels at 512 samples rendered within borders, not the whole frame")
+
+# A border is cropped to its rectangle and a pixel more on each side, by
+# fractions a quarter pixel inside Blender's whole pixels (y from the bottom).
+fake_render = types.SimpleNamespace()
+sess.scene = types.SimpleNamespace(render=fake_render)
+S._set_border(sess, (16, 32, 48, 40))
+r = fake_render
+got = [int(r.border_min_x * 256), int(r.border_max_x * 256), int(r.border_min_y * 256), int(r.border_max_y * 256)]
+got_rounded = [round(r.border_min_x * 256), round(r.border_max_x * 256), round(r.border_min_y * 256),
+               round(r.border_max_y * 256)]
+if not (r.use_border and r.use_crop_to_border) or sess._crop != (15, 31, 49, 41) \
+        or got != [15, 49, 256 - 41, 256 - 31] or got_rounded != got:
+    failures.append("a render border (16, 32, 48, 40) cropped to %s, Blender's pixels %s / %s"
+                    % (sess._crop, got, got_rounded))
+S._set_border(sess, (0, 0, 256, 256))
+if sess._crop != (0, 0, 256, 256) or r.border_max_x > 1 or r.border_max_y > 1:
+    failures.append("a border over the frame: %s, maxima %s %s" % (sess._crop, r.border_max_x, r.border_max_y))
+S._set_border(sess, None)
+if r.use_border or sess._crop is not None:
+    failures.append("no border: use_border %s, crop %s" % (r.use_border, sess._crop))
+sess.samples = 64
+sess.pixel_seconds = lambda: 1e-4
+
 # The keep-alive: on where pixels that might stop early (one preview half 0,
 # the other not) would cost more to render again than it costs the round
 # (KEEP_ALIVE_COST of its pixels' time). 4000 exact pixels at 64 samples cost
 # 0.4 s, the keep-alive 0.048 s; rendering the 41 scattered ones again costs
 # the whole frame (1.0 s by the model): on. Two such pixels in one 16-px tile
-# among 30000 exact pixels: one border (0.054 s) against 0.36 s: off.
+# among 30000 exact pixels: one border (0.034 s) against 0.36 s: off.
 sess._keep_alive_scales = [types.SimpleNamespace(default_value=0.0) for _ in range(3)]
 sess._keep_alive_on = False
 half_a = np.full((256, 256, 3), 0.2, np.float32)

@@ -33,7 +33,7 @@ def parse_args(argv):
     ap.add_argument("--threads", type=int, default=0, help="render threads (0: Blender's choice)")
     ap.add_argument("--variance-halves", action="store_true",
                     help="render exact pixels as two halves of the samples with two seeds; report their variance")
-    ap.add_argument("--call-seconds", type=float, default=0.05,
+    ap.add_argument("--call-seconds", type=float, default=0.03,
                     help="fixed time of a render call in the running Blender, its render cropped to its "
                          "border (sets how many borders pay off)")
     ap.add_argument("--max-calls", type=int, default=64, help="render calls per round at most")
