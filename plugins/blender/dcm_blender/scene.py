@@ -643,19 +643,20 @@ class Session:
         if self.args.border_tile > 0:
             return self._runs(xs, ys, self.args.border_tile)
         n = self.samples // calls
-        return self._cheapest(xs, ys, calls, self._masked_seconds(self._masked_stop(n)) + n * self.VISIT_SECONDS)[0]
+        return self._cheapest(xs, ys, calls, self._border_pixel_seconds(n, self._masked_stop(n)))[0]
 
-    def _cheapest(self, xs, ys, calls, masked, tiles=(16, 32, 64)):
+    def _cheapest(self, xs, ys, calls, per_pixel, tiles=(16, 32, 64)):
         """Of the `tiles` (sides in px) that hold the pixels (xs, ys) (each tile
         row's runs one render border, at most max_calls of them) and the whole
         frame ([None]), the cheapest to render: `calls` renders per rectangle,
-        each its fixed time (call_seconds) and `masked` seconds for every pixel
-        inside its border. Returns the rectangles and their cost in seconds."""
-        best, best_cost = [None], calls * (self.args.call_seconds + self.width * self.height * masked)
+        each its fixed time (call_seconds) and `per_pixel` seconds for every
+        pixel inside its border (_border_pixel_seconds). Returns the rectangles
+        and their cost in seconds."""
+        best, best_cost = [None], calls * (self.args.call_seconds + self.width * self.height * per_pixel)
         for t in tiles:
             rects = self._runs(xs, ys, t)
             area = sum((x1 - x0) * (y1 - y0) for x0, y0, x1, y1 in rects)
-            cost = calls * (len(rects) * self.args.call_seconds + area * masked)
+            cost = calls * (len(rects) * self.args.call_seconds + area * per_pixel)
             if len(rects) <= self.args.max_calls and cost < best_cost:
                 best, best_cost = rects, cost
         return best, best_cost
@@ -668,6 +669,11 @@ class Session:
     # 256² took 0.58 s at 512 samples, 0.29 s at 64, on this project's machine
     # (examples/blender/round_call_cost.py; docs/BLENDER.md, *Render borders*).
     VISIT_SECONDS = 1e-8
+
+    def _border_pixel_seconds(self, n, masked_samples):
+        """What a masked pixel inside a render border costs a call of n samples: the
+        masked_samples it takes before it stops, and Cycles' visit each sample."""
+        return self._masked_seconds(masked_samples) + n * self.VISIT_SECONDS
 
     def _masked_seconds(self, samples):
         """What a masked pixel costs for `samples` samples: about a seventh of a
@@ -787,7 +793,7 @@ class Session:
         whichever _cheapest() finds cheaper. (Larger tiles save calls for area
         that, with adaptive sampling off, costs more than the model's masked
         pixel: docs/BLENDER.md.)"""
-        return self._cheapest(xs, ys, 1, self._masked_seconds(n) + n * self.VISIT_SECONDS, (16,))
+        return self._cheapest(xs, ys, 1, self._border_pixel_seconds(n, n), (16,))
 
     def _render_all_samples(self, n, label, seed, xs, ys):
         """Renders pixels (xs, ys) with every one of the n samples, where _again()
@@ -920,8 +926,8 @@ class Session:
         (call_seconds) and the masked pixels of the whole frame until they stop
         (_masked_stop) and after (VISIT_SECONDS; docs/BLENDER.md)."""
         n = self.samples // len(self.seeds)
-        masked = self._masked_seconds(self._masked_stop(n)) + n * self.VISIT_SECONDS
-        return len(self.seeds) * (self.args.call_seconds + self.width * self.height * masked), self.pixel_seconds()
+        per_pixel = self._border_pixel_seconds(n, self._masked_stop(n))
+        return len(self.seeds) * (self.args.call_seconds + self.width * self.height * per_pixel), self.pixel_seconds()
 
     def fingerprint(self):
         """What setup() may change, as text: restore() must bring it back."""
