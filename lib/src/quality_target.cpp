@@ -594,32 +594,39 @@ Status EvaluateValidation(CachingProvider& cache, const ReconstructionOptions& o
   return Status::Ok();
 }
 
-/// Gives the result's interpolated working pixels in the boxes of the
-/// validation pixels their exact samples, which were paid for, and their
-/// output pixels the box mean again. Without variance only: a noisy exact
-/// value need not be closer to the converged image than the engine's
-/// denoised interpolation. The estimate stays that of the result without
-/// them, which the search judged: conservative by the error they remove.
-void KeepValidationPixels(const Validation& v, const CachingProvider& cache, int s, Reconstruction* rec) {
-  if (!v.variance.empty()) return;
+/// Gives the result's interpolated working pixels among `pixels` (row-major
+/// working indices) that `cache` holds their exact samples, which were paid
+/// for, as `why`, and their output pixels the box mean again. Returns how
+/// many it gave. For noise-free samples only: a noisy exact value need not be
+/// closer to the converged image than the engine's denoised interpolation.
+int64_t KeepSamples(std::span<const size_t> pixels, const CachingProvider& cache, int s, SampleReason why,
+                    Reconstruction* rec) {
   const int W = rec->workWidth, H = rec->workHeight;
-  for (const Point2i& p : v.pixels) {
-    for (int wy = p.y * s; wy < std::min(H, (p.y + 1) * s); ++wy)
-      for (int wx = p.x * s; wx < std::min(W, (p.x + 1) * s); ++wx) {
-        const size_t k = size_t(wy) * size_t(W) + size_t(wx);
-        SampleReason& why = rec->sampleMap[k];
-        if (why == SampleReason::kInterpolated || why == SampleReason::kPreviewStandIn) {
-          if (const ExactSample* e = cache.SampleAt({wx, wy})) {
-            --rec->stats.byReason[size_t(why)];
-            ++rec->stats.byReason[size_t(SampleReason::kValidation)];
-            why = SampleReason::kValidation;
-            rec->workImage[k] = e->L;
-            if (rec->interpolation) rec->interpolation->MarkExact(int64_t(k));
-          }
-        }
-      }
-    rec->image[size_t(p.y) * size_t(rec->width) + size_t(p.x)] = BoxMean(rec->workImage, W, H, s, p.x, p.y);
+  int64_t kept = 0;
+  for (size_t k : pixels) {
+    SampleReason& was = rec->sampleMap[k];
+    if (HoldsExactSample(was)) continue;
+    const ExactSample* e = cache.SampleAt({int(k % size_t(W)), int(k / size_t(W))});
+    if (!e) continue;
+    --rec->stats.byReason[size_t(was)];
+    ++rec->stats.byReason[size_t(why)];
+    was = why;
+    rec->workImage[k] = e->L;
+    if (rec->interpolation) rec->interpolation->MarkExact(int64_t(k));
+    const int ox = int(k % size_t(W)) / s, oy = int(k / size_t(W)) / s;
+    rec->image[size_t(oy) * size_t(rec->width) + size_t(ox)] = BoxMean(rec->workImage, W, H, s, ox, oy);
+    ++kept;
   }
+  return kept;
+}
+
+/// The working pixels (row-major indices) of the validation's output pixels.
+std::vector<size_t> WorkingPixelsOf(const Validation& v, int s, int W, int H) {
+  std::vector<size_t> out;
+  for (const Point2i& p : v.pixels)
+    for (int wy = p.y * s; wy < std::min(H, (p.y + 1) * s); ++wy)
+      for (int wx = p.x * s; wx < std::min(W, (p.x + 1) * s); ++wx) out.push_back(size_t(wy) * size_t(W) + size_t(wx));
+  return out;
 }
 
 /// One finished run.
@@ -989,7 +996,23 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   report->threshold = best->threshold;
   report->targetReached = target <= 0 || meets(*best);
   report->exactPixels = cache.Distinct();
-  KeepValidationPixels(v, cache, s, &best->rec);
+  // Noise-free, every pixel the search paid for holds the full render's value
+  // and is kept where the result interpolated it: those of runs the result did
+  // not come from (one the budget refused, a coarser one), then the
+  // validation's. The estimate stays that of the result the search judged
+  // (it reads the validation pixels alone): conservative by the error they
+  // remove.
+  if (v.variance.empty()) {
+    const int W = best->rec.workWidth, H = best->rec.workHeight;
+    const std::vector<size_t> validation = WorkingPixelsOf(v, s, W, H);
+    std::vector<uint8_t> isValidation(size_t(W) * size_t(H), 0);
+    for (size_t k : validation) isValidation[k] = 1;
+    std::vector<size_t> others;
+    for (size_t k = 0; k < isValidation.size(); ++k)
+      if (!isValidation[k]) others.push_back(k);
+    KeepSamples(others, cache, s, SampleReason::kRendered, &best->rec);
+    KeepSamples(validation, cache, s, SampleReason::kValidation, &best->rec);
+  }
   *out = std::move(best->rec);
   // The cost of the whole search: every pixel evaluated, every run's time.
   out->stats.exactPixels = report->exactPixels;

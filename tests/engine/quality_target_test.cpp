@@ -173,21 +173,25 @@ TEST(QualityTarget, BudgetIsNeverExceeded) {
   }
 }
 
-// What a budget buys against what a user who knew the right global threshold
-// would get for the same exact fraction: a sweep of thresholds, interpolated
-// in log fraction between its points.
+// What a budget buys against what a user who knew the best global threshold
+// for the same exact fraction would get: the best run of a sweep of
+// thresholds within that fraction, and the sweep interpolated in log fraction
+// between its points (which credits a fraction between two runs with a
+// quality no threshold may deliver).
 TEST(QualityTarget, BudgetBuysWhatTheThresholdSweepBuysAtTheSameFraction) {
   const int N = 256;
-  // The issue asks for 0.5 dB. The validation alone takes a twentieth of the
-  // budget, about 0.4 dB here (the sweep gains 5.3 dB per doubling of the
-  // pixels from 3 % to 5 %); 0.75 leaves the search 0.35 dB for the pixels it
-  // leaves unused or spends on runs it abandons (a search that stopped short
-  // of the budget or wasted a tenth of it lost 1.7 to 3.7 dB).
-  constexpr double kTolerance = 0.75;
+  // The issue asks for 0.5 dB of the sweep at the same fraction. The
+  // validation takes a twentieth of the budget, placed at random rather than
+  // where the lattice needs it: about 0.4 dB where the sweep gains 5.3 dB per
+  // doubling of the pixels (3 % to 5 %). A search that stopped short of the
+  // budget, or left the pixels of the runs it abandoned out of the result,
+  // lost 1.7 to 3.7 dB. Interpolated, 0.75 dB (0.25 for where the sweep's
+  // steps of x0.9 straddle a jump).
+  constexpr double kTolerance = 0.5, kInterpolatedTolerance = 0.75;
   AnalyticProvider sweepProvider(N, N, FurnishedScene(N, N));
   const std::vector<RGB> full = sweepProvider.FullRender();
   std::vector<std::pair<double, double>> sweep;  // (exact fraction, true PSNR)
-  for (double t = 1.0; t > 0.004; t *= 0.8) {
+  for (double t = 1.0; t > 0.004; t *= 0.9) {
     ReconstructionOptions o;
     o.contrastThreshold = float(t);
     Reconstruction rec;
@@ -201,8 +205,10 @@ TEST(QualityTarget, BudgetBuysWhatTheThresholdSweepBuysAtTheSameFraction) {
     goal.budget = budget;
     const Outcome r = RunGoal(provider, ReconstructionOptions{}, goal);
     const double frontier = SweepPsnrAt(sweep, r.report.exactFraction());
-    std::printf("  the sweep at %.2f %%: %.2f dB\n", 100 * r.report.exactFraction(), frontier);
-    EXPECT_GE(r.truePsnr, frontier - kTolerance) << "budget " << budget;
+    std::printf("  the sweep at %.2f %%: %.2f dB interpolated, %.2f dB by the best threshold within it\n",
+                100 * r.report.exactFraction(), frontier, SweepBestWithin(sweep, r.report.exactFraction()));
+    EXPECT_GE(r.truePsnr, SweepBestWithin(sweep, r.report.exactFraction()) - kTolerance) << "budget " << budget;
+    EXPECT_GE(r.truePsnr, frontier - kInterpolatedTolerance) << "budget " << budget;
     // Spent: what is left buys less than the smallest step of the threshold.
     EXPECT_GT(r.report.exactFraction(), 0.9 * budget) << "budget " << budget;
   }
@@ -491,6 +497,41 @@ TEST(QualityTarget, ValidationPixelsKeepTheirExactValues) {
   QualityReport report;
   ASSERT_TRUE(ReconstructToQuality(noisy, ReconstructionOptions{}, goal, &rec, &report).ok());
   EXPECT_EQ(rec.stats.byReason[size_t(SampleReason::kValidation)], 0);
+}
+
+// A budget's search makes several runs, some refused part way; every pixel
+// any of them evaluated counts in the budget, so each is in the result with
+// its exact value, not only those of the run the result came from.
+TEST(QualityTarget, EveryPixelTheSearchPaidForIsKept) {
+  const int N = 256;
+  for (int s : {1, 2}) {
+    AnalyticProvider provider(N, N, FurnishedScene(N, N));
+    ReconstructionOptions o;
+    o.downsample = s;
+    QualityGoal goal;
+    goal.budget = 0.05;
+    const Outcome r = RunGoal(provider, o, goal);
+    ASSERT_GT(r.report.runs, 1);
+    const std::vector<RGB> full = provider.FullRender();
+    int64_t evaluated = 0;
+    for (int y = 0; y < N; ++y)
+      for (int x = 0; x < N; ++x) {
+        if (provider.EvaluationsOf(x, y) == 0) continue;
+        ++evaluated;
+        const size_t k = size_t(y) * size_t(N) + size_t(x);
+        ASSERT_TRUE(HoldsExactSample(r.rec.sampleMap[k])) << x << "," << y << " s " << s;
+        ASSERT_EQ(r.rec.workImage[k], full[k]) << x << "," << y;
+      }
+    EXPECT_EQ(evaluated, r.report.exactPixels);
+    // Runs the result did not come from left pixels of their own.
+    EXPECT_GT(r.rec.stats.byReason[size_t(SampleReason::kRendered)], 0) << "s " << s;
+    int64_t exact = 0;
+    for (int k = 0; k < kSampleReasonCount; ++k)
+      if (HoldsExactSample(SampleReason(k))) exact += r.rec.stats.byReason[size_t(k)];
+    EXPECT_EQ(exact, evaluated);
+    int w = 0, h = 0;
+    EXPECT_EQ(BoxDownsample(r.rec.workImage, N, N, s, &w, &h), r.rec.image);
+  }
 }
 
 TEST(QualityTarget, ProgressiveLevelsCarryAnEstimate) {

@@ -23,4 +23,16 @@ inline double SweepPsnrAt(const std::vector<std::pair<double, double>>& sweep, d
   return sweep.back().second;
 }
 
+/// The best PSNR of the sweep's runs whose exact fraction is at most `f`:
+/// what a user who knew the best single threshold for a budget of `f` gets.
+/// Where the PSNR jumps between two thresholds (a feature's block refined or
+/// not), SweepPsnrAt credits the fractions between them with a quality no
+/// threshold delivers; this does not. NaN where no run is within `f`.
+inline double SweepBestWithin(const std::vector<std::pair<double, double>>& sweep, double f) {
+  double best = NAN;
+  for (const auto& [fraction, psnr] : sweep)
+    if (fraction <= f && (std::isnan(best) || psnr > best)) best = psnr;
+  return best;
+}
+
 }  // namespace dcm::testing

@@ -100,7 +100,7 @@ enum {
   DCM_REASON_FALLBACK = 7,
   DCM_REASON_FULL = 8,
   DCM_REASON_PREVIEW_STAND_IN = 9, /**< left at its preview value (dcmSetRoundCost); since API version 3 */
-  DCM_REASON_RENDERED = 10, /**< rendered in a round that the final plan did not need; since API version 6 */
+  DCM_REASON_RENDERED = 10, /**< rendered in a round or a run of a quality search that the final plan did not need; since API version 6 */
   DCM_REASON_VALIDATION = 11, /**< a validation pixel of "target_psnr" or "budget", kept exact; since API version 11 */
   DCM_REASON_COUNT = 12
 };

@@ -30,8 +30,9 @@ enum class SampleReason : uint8_t {
   /// wanted exact, left at a preview's stand-in value after the last round
   /// (RoundSchedule::kPreview); not counted as exact
   kPreviewStandIn,
-  /// evaluated in a round planned on the preview that the final run did not
-  /// ask for: keeps its exact value (RoundSchedule::kPreview)
+  /// evaluated in a round planned on the preview (RoundSchedule::kPreview)
+  /// or by a run of a quality search (dcm/quality_target.h) that the final
+  /// run did not ask for: keeps its exact value
   kRendered,
   /// a validation pixel of a quality target or budget (dcm/quality_target.h)
   /// the final run interpolated: keeps the exact value it was evaluated for
