@@ -272,8 +272,10 @@ def variance(dcm, blender, src, tmp):
 
 
 def display_psnr(a, b):
-    """PSNR of a against b as the stats' (blender_support.display_mse)."""
-    return 10 * np.log10(1 / bs.display_mse(a, b))
+    """PSNR of a against b as the stats' (blender_support.display_mse); +inf where they are equal (a
+    search whose runs and the pixels their render calls computed besides cover the frame keeps them all)."""
+    mse = bs.display_mse(a, b)
+    return 10 * np.log10(1 / mse) if mse > 0 else float("inf")
 
 
 def quality(dcm, blender, src, tmp):
@@ -304,6 +306,10 @@ def quality(dcm, blender, src, tmp):
     assert sum(r["pixels"] for r in b["rounds"]) + b["extra_pixels"] == j["exact_pixels"] == q["exact_pixels"], \
         (b["rounds"], b["extra_pixels"], q)
     assert "quality" in so, so
+    # Noise-free, every pixel the search paid for is in the result with its exact value (on this
+    # small frame the rounds and what their calls computed besides cover it all: the truth is +inf).
+    held = sum(n for why, n in j["by_reason"].items() if why not in ("interpolated", "preview_stand_in"))
+    assert held == j["exact_pixels"], (j["by_reason"], j["exact_pixels"])
     print("--target-psnr %g: estimated %.2f dB (low %.2f), true %.2f dB, %.1f %% exact, %d runs, %d render calls"
           % (target, j["estimated_psnr"], j["estimated_psnr_low"], true, 100 * j["exact_fraction"], q["runs"],
              len(b["rounds"])))
