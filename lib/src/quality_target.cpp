@@ -225,6 +225,15 @@ class CachingProvider : public SampleProvider {
     const int32_t i = index_[Index(p)];
     return i < 0 ? nullptr : &samples_[size_t(i)];
   }
+  /// The working pixels (row-major indices) that hold a sample.
+  std::vector<size_t> Evaluated() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<size_t> out;
+    out.reserve(samples_.size());
+    for (size_t i = 0; i < index_.size(); ++i)
+      if (index_[i] >= 0) out.push_back(i);
+    return out;
+  }
   bool BudgetHit() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return budgetHit_;
@@ -1007,9 +1016,8 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
     const std::vector<size_t> validation = WorkingPixelsOf(v, s, W, H);
     std::vector<uint8_t> isValidation(size_t(W) * size_t(H), 0);
     for (size_t k : validation) isValidation[k] = 1;
-    std::vector<size_t> others;
-    for (size_t k = 0; k < isValidation.size(); ++k)
-      if (!isValidation[k]) others.push_back(k);
+    std::vector<size_t> others = cache.Evaluated();
+    std::erase_if(others, [&](size_t k) { return isValidation[k] != 0; });
     KeepSamples(others, cache, s, SampleReason::kRendered, &best->rec);
     KeepSamples(validation, cache, s, SampleReason::kValidation, &best->rec);
   }
