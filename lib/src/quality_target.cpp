@@ -605,13 +605,12 @@ Status EvaluateValidation(CachingProvider& cache, const ReconstructionOptions& o
 
 /// Gives the result's interpolated working pixels among `pixels` (row-major
 /// working indices) that `cache` holds their exact samples, which were paid
-/// for, as `why`, and their output pixels the box mean again. Returns how
-/// many it gave. For noise-free samples only: a noisy exact value need not be
-/// closer to the converged image than the engine's denoised interpolation.
-int64_t KeepSamples(std::span<const size_t> pixels, const CachingProvider& cache, int s, SampleReason why,
+/// for, as `why`, and their output pixels the box mean again. For noise-free
+/// samples only: a noisy exact value need not be closer to the converged
+/// image than the engine's denoised interpolation.
+void KeepSamples(std::span<const size_t> pixels, const CachingProvider& cache, int s, SampleReason why,
                     Reconstruction* rec) {
   const int W = rec->workWidth, H = rec->workHeight;
-  int64_t kept = 0;
   for (size_t k : pixels) {
     SampleReason& was = rec->sampleMap[k];
     if (HoldsExactSample(was)) continue;
@@ -624,9 +623,7 @@ int64_t KeepSamples(std::span<const size_t> pixels, const CachingProvider& cache
     if (rec->interpolation) rec->interpolation->MarkExact(int64_t(k));
     const int ox = int(k % size_t(W)) / s, oy = int(k / size_t(W)) / s;
     rec->image[size_t(oy) * size_t(rec->width) + size_t(ox)] = BoxMean(rec->workImage, W, H, s, ox, oy);
-    ++kept;
   }
-  return kept;
 }
 
 /// The working pixels (row-major indices) of the validation's output pixels.
