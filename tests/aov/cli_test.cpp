@@ -472,15 +472,20 @@ INSTANTIATE_TEST_SUITE_P(BeautyAndSplit, PlanRoundTrip, ::testing::Combine(::tes
                                   std::to_string(std::get<1>(p.param));
                          });
 
-// --target-psnr through `dcm plan` rounds: the validation pixels, then each
-// run of the search, are asked for as the engine's own samples are; the
-// result is the dense run's, bit for bit, with the same estimate.
-TEST(DcmPlan, RoundTripToATargetMatchesDense) {
+// --target-psnr or --budget through `dcm plan` rounds: the validation pixels,
+// then each run of the search, are asked for as the engine's own samples are;
+// the result is the dense run's, bit for bit, with the same estimate, and
+// keeps every pixel rendered (the budget's refused runs' too).
+class DcmPlanGoal : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(DcmPlanGoal, RoundTripMatchesDense) {
   ScratchDir dir;
   Scene sc{72, 56};
   WriteExr(dir / "dense.exr", sc.width, sc.height, sc.GenericChannels(false));
   WriteExr(dir / "guides.exr", sc.width, sc.height, sc.GenericChannels(false, /*guidesOnly=*/true));
-  const std::vector<std::string> engine = {"--threads", "2", "--quiet", "--target-psnr", "20"};
+  const std::string goal = GetParam();
+  const std::vector<std::string> engine = {"--threads", "2", "--quiet", goal.substr(0, goal.find(' ')),
+                                           goal.substr(goal.find(' ') + 1)};
   auto dense = engine;
   dense.insert(dense.begin(), {"reconstruct", dir / "dense.exr", "-o", dir / "dense_out.exr", "--stats", dir / "dense.json"});
   auto r = RunDcm(dense, dir);
@@ -515,7 +520,17 @@ TEST(DcmPlan, RoundTripToATargetMatchesDense) {
   EXPECT_EQ(ds["quality"]["exact_pixels"], ss["quality"]["exact_pixels"]);
   // Every pixel rendered was needed: the plan asked for no more than the dense run evaluated.
   EXPECT_EQ(int64_t(rendered.size()), int64_t(ds["quality"]["exact_pixels"]));
+  // And every one is exact in the result (noise-free samples).
+  int64_t held = 0;
+  for (const auto& [why, n] : ss["by_reason"].items())
+    if (why != "interpolated" && why != "preview_stand_in") held += n.get<int64_t>();
+  EXPECT_EQ(held, int64_t(rendered.size()));
+  // The budget's search refuses runs part way: their pixels are among those kept.
+  if (goal.rfind("--budget", 0) == 0) EXPECT_GT(ss["by_reason"]["rendered"].get<int64_t>(), 0);
 }
+
+INSTANTIATE_TEST_SUITE_P(Goals, DcmPlanGoal, ::testing::Values("--target-psnr 20", "--budget 0.3"),
+                         [](const auto& p) { return std::string(p.param[2] == 't' ? "Target" : "Budget"); });
 
 TEST(QualityLine, SaysWhereAFewValidationPixelsCarryTheEstimate) {
   using cli::EngineFlags;
