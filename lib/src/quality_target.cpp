@@ -609,7 +609,7 @@ Status EvaluateValidation(CachingProvider& cache, const ReconstructionOptions& o
 /// samples only: a noisy exact value need not be closer to the converged
 /// image than the engine's denoised interpolation.
 void KeepSamples(std::span<const size_t> pixels, const CachingProvider& cache, int s, SampleReason why,
-                    Reconstruction* rec) {
+                 Reconstruction* rec) {
   const int W = rec->workWidth, H = rec->workHeight;
   for (size_t k : pixels) {
     SampleReason& was = rec->sampleMap[k];
@@ -1003,20 +1003,15 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
   report->targetReached = target <= 0 || meets(*best);
   report->exactPixels = cache.Distinct();
   // Noise-free, every pixel the search paid for holds the full render's value
-  // and is kept where the result interpolated it: those of runs the result did
-  // not come from (one the budget refused, a coarser one), then the
-  // validation's. The estimate stays that of the result the search judged
-  // (it reads the validation pixels alone): conservative by the error they
-  // remove.
+  // and is kept where the result interpolated it: the validation's, then
+  // (exact by now, those are passed over) those of runs the result did not
+  // come from (one the budget refused, a coarser one). The estimate stays
+  // that of the result the search judged (it reads the validation pixels
+  // alone): conservative by the error they remove.
   if (v.variance.empty()) {
-    const int W = best->rec.workWidth, H = best->rec.workHeight;
-    const std::vector<size_t> validation = WorkingPixelsOf(v, s, W, H);
-    std::vector<uint8_t> isValidation(size_t(W) * size_t(H), 0);
-    for (size_t k : validation) isValidation[k] = 1;
-    std::vector<size_t> others = cache.Evaluated();
-    std::erase_if(others, [&](size_t k) { return isValidation[k] != 0; });
-    KeepSamples(others, cache, s, SampleReason::kRendered, &best->rec);
-    KeepSamples(validation, cache, s, SampleReason::kValidation, &best->rec);
+    KeepSamples(WorkingPixelsOf(v, s, best->rec.workWidth, best->rec.workHeight), cache, s,
+                SampleReason::kValidation, &best->rec);
+    KeepSamples(cache.Evaluated(), cache, s, SampleReason::kRendered, &best->rec);
   }
   *out = std::move(best->rec);
   // The cost of the whole search: every pixel evaluated, every run's time.
