@@ -6,8 +6,14 @@ thresholds (the frontier a user could reach knowing the best threshold), one
 run with --target-psnr T and one with --budget B (B: the exact fraction the
 best single threshold needs for T). Prints a Markdown table.
 
+The rays column is the cost that includes what no exact-pixel count shows
+(a goal judged by the tracer's preview traces every pixel with a few rays):
+the target run's rays and the best threshold's, as shares of the full
+render's.
+
 usage: scripts/quality_check.py DCM OUTDIR [--size 256] [--supersampling 1] [--target 40]
-                                [--scenes room,mirror,...]
+                                [--scenes room,mirror,...] [--extra=--estimate-from=validation]
+                                [--scene NAME=PATH ...] [--common=--set=render.shadow_rays=64 ...]
 """
 import argparse
 import json
@@ -77,18 +83,29 @@ def main():
     ap.add_argument("--supersampling", type=int, default=1)
     ap.add_argument("--target", type=float, default=40.0)
     ap.add_argument("--scenes", default=",".join(SCENES))
+    ap.add_argument("--extra", action="append", default=[], help="a flag for the target and budget runs")
+    ap.add_argument("--scene", action="append", default=[], help="NAME=PATH: another scene (then --scenes "
+                    "defaults to these)")
+    ap.add_argument("--common", action="append", default=[], help="a flag for every run (the sweep too)")
     a = ap.parse_args()
     os.makedirs(a.outdir, exist_ok=True)
-    common = ["--size", f"{a.size}x{a.size}", "--supersampling", str(a.supersampling)]
+    scenes = dict(SCENES)
+    for e in a.scene:
+        name, path = e.split("=", 1)
+        scenes[name] = path
+    names = a.scenes if a.scenes != ",".join(SCENES) or not a.scene else ",".join(e.split("=")[0] for e in a.scene)
+    common = ["--size", f"{a.size}x{a.size}", "--supersampling", str(a.supersampling)] + a.common
     print(f"size {a.size}², supersampling {a.supersampling}, target {a.target:g} dB\n")
     print("| scene | target | estimate [90 % interval] | true PSNR | exact | best threshold: exact (thr) | ratio "
-          "| budget | true PSNR at budget | best threshold within that fraction (sweep interpolated) | exact at budget |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
-    for name in a.scenes.split(","):
-        scene = SCENES[name]
+          "| budget | true PSNR at budget | best threshold within that fraction (sweep interpolated) | exact at budget "
+          "| rays: target, best threshold (of the full render's) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for name in names.split(","):
+        scene = scenes[name]
         base = os.path.join(a.outdir, f"{name}_{a.size}_{a.supersampling}")
         ref = base + "_full"
-        render(a.dcm, scene, ref, common, ["--full"], reuse=True)
+        full = render(a.dcm, scene, ref, common, ["--full"], reuse=True)
+        rays = lambda s: f"{100 * s['rays']['total'] / full['rays']['total']:.1f} %"
         cmp_ = ["--compare", ref + ".exr"]
         sweep = []
         for t in THRESHOLDS:
@@ -97,19 +114,19 @@ def main():
             sweep.append(s)
         meeting = [s for s in sweep if s["reference"]["psnr"] >= a.target]
         best = min(meeting, key=lambda s: s["exact_fraction"]) if meeting else None
-        q = render(a.dcm, scene, f"{base}_target", common, cmp_ + ["--target-psnr", f"{a.target:g}"])
+        q = render(a.dcm, scene, f"{base}_target", common, cmp_ + ["--target-psnr", f"{a.target:g}"] + a.extra)
         line = (f"| {name} | {a.target:g} | {db(q['estimated_psnr'])} [{db(q['estimated_psnr_low'])}, "
                 f"{db(q['estimated_psnr_high'])}] | {db(q['reference']['psnr'])} | {100 * q['exact_fraction']:.2f} % | ")
         if best:
             budget = round(best["exact_fraction"], 4)
-            b = render(a.dcm, scene, f"{base}_budget", common, cmp_ + ["--budget", f"{budget:g}"])
+            b = render(a.dcm, scene, f"{base}_budget", common, cmp_ + ["--budget", f"{budget:g}"] + a.extra)
             line += (f"{100 * best['exact_fraction']:.2f} % ({best['threshold']:g}) | "
                      f"{q['exact_fraction'] / best['exact_fraction']:.2f} | {100 * budget:.2f} % | "
                      f"{b['reference']['psnr']:.2f} | {best_within(sweep, b['exact_fraction']):.2f} "
                      f"({at_fraction(sweep, b['exact_fraction']):.2f}) | "
-                     f"{100 * b['exact_fraction']:.2f} % |")
+                     f"{100 * b['exact_fraction']:.2f} % | {rays(q)}, {rays(best)} |")
         else:
-            line += "none reaches it | | | | | |"
+            line += f"none reaches it | | | | | | {rays(q)} |"
         print(line)
         sys.stdout.flush()
 

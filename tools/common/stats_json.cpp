@@ -155,6 +155,24 @@ void AddEstimateJson(const PsnrEstimate& e, double confidence, nlohmann::json* j
 
 nlohmann::json EstimateJson(const PsnrEstimate& e) { return {{"psnr", e.psnr}, {"low", e.low}, {"high", e.high}}; }
 
+void AddLadderJson(const PreviewTargetStats& s, nlohmann::json* quality) {
+  nlohmann::json ladder = nlohmann::json::array();
+  for (size_t k = 0; k < s.thresholds.size() && k < s.estimates.size(); ++k) {
+    nlohmann::json run = EstimateJson(s.estimates[k]);
+    run["threshold"] = s.thresholds[k];
+    ladder.push_back(std::move(run));
+  }
+  (*quality)["ladder"] = std::move(ladder);
+  nlohmann::json predictions = nlohmann::json::array();
+  for (const PreviewTargetStats::Prediction& p : s.predictions) {
+    nlohmann::json prediction = EstimateJson(p.estimate);
+    prediction["threshold"] = p.threshold;
+    prediction["pixels"] = p.pixels;
+    predictions.push_back(std::move(prediction));
+  }
+  (*quality)["start_predictions"] = std::move(predictions);
+}
+
 void AddEstimateMetadata(const PsnrEstimate& e, Metadata* m) {
   for (const auto& [name, v] : {std::pair<const char*, double>{"dcm:estimated_psnr", e.psnr},
                                 {"dcm:estimated_psnr_low", e.low},

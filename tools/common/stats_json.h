@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "dcm/options.h"
+#include "dcm/preview_target.h"
 #include "dcm/quality_target.h"
 #include "dcm/reconstructor.h"
 #include "dcm/status.h"
@@ -44,6 +45,11 @@ void AddEstimateJson(const PsnrEstimate& estimate, double confidence, nlohmann::
 
 /// {psnr, low, high} of one estimate: a run's, a level's, a judge's.
 nlohmann::json EstimateJson(const PsnrEstimate& estimate);
+
+/// Adds a ladder judged by the preview (ReconstructToTargetFromPreview) to a
+/// --stats object's quality: ladder [{threshold, psnr, low, high}] per run and
+/// start_predictions [{threshold, pixels, psnr, low, high}].
+void AddLadderJson(const PreviewTargetStats& ladder, nlohmann::json* quality);
 
 /// Adds dcm:estimated_psnr, dcm:estimated_psnr_low, dcm:estimated_psnr_high
 /// (finite values only) to EXR metadata.

@@ -663,21 +663,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       toolkit::AddQualityJson(*quality, engine.targetPsnr.value_or(0), engine.budget.value_or(0), &j);
       j["quality"]["target_default"] = defaultGoal && targetFromPreview;
       if (targetFromPreview) {
-        nlohmann::json ladder = nlohmann::json::array();
-        for (size_t k = 0; k < ptarget.thresholds.size(); ++k) {
-          nlohmann::json run = toolkit::EstimateJson(ptarget.estimates[k]);
-          run["threshold"] = ptarget.thresholds[k];
-          ladder.push_back(std::move(run));
-        }
-        j["quality"]["ladder"] = ladder;
-        nlohmann::json predictions = nlohmann::json::array();
-        for (const PreviewTargetStats::Prediction& p : ptarget.predictions) {
-          nlohmann::json prediction = toolkit::EstimateJson(p.estimate);
-          prediction["threshold"] = p.threshold;
-          prediction["pixels"] = p.pixels;
-          predictions.push_back(std::move(prediction));
-        }
-        j["quality"]["start_predictions"] = predictions;
+        toolkit::AddLadderJson(ptarget, &j["quality"]);
       } else if (schedule == RoundSchedule::kPreview) {
         j["quality"]["searches"] = qrounds.passes;
       }

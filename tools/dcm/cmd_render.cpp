@@ -28,6 +28,7 @@
 #include "engine_flags.h"
 #include "flag_checks.h"
 #include "output_flags.h"
+#include "render_preview.h"
 #include "tile_flags.h"
 
 namespace dcm::cli {
@@ -47,6 +48,7 @@ struct RenderFlags {
   std::optional<int64_t> seed;
   bool withReference = false;
   std::string referenceOut;
+  std::string estimateFrom = "auto";
   EngineFlags engine;
   TileFlags tiles;
   toolkit::ExrFormat exr;  ///< -d, --compression, --ch
@@ -90,14 +92,32 @@ struct Run {
   double wallS = 0;
   embree::RayCounts rays;
   std::optional<QualityReport> quality;  ///< with --target-psnr / --budget
+  std::optional<TracerPreviewRun> preview;  ///< the goal judged by the tracer's preview
+  std::string validationWhy;             ///< a goal judged by validation pixels: why not by the preview
 };
 
-/// One reconstruction as `engine` asks (to a target or budget when given).
+/// One reconstruction as `engine` asks (to a target or budget when given,
+/// judged by the tracer's preview where `estimateFrom` and the run allow).
 Status RunOnce(embree::EmbreeProvider& provider, const ReconstructionOptions& options, const EngineFlags& engine,
-               Run* run) {
+               const std::string& estimateFrom, Run* run) {
   provider.ResetRayCounts();
   auto t0 = std::chrono::steady_clock::now();
-  Status st = ReconstructFor(provider, options, engine, &run->rec, &run->quality);
+  QualityGoal goal;
+  Status st;
+  bool judged = false;
+  if (QualityGoalOf(engine, &goal) && TracerPreviewApplies(provider, options, engine, estimateFrom, &run->validationWhy)) {
+    TracerPreviewRun preview;
+    QualityReport report;
+    st = ReconstructFromTracerPreview(provider, options, goal, estimateFrom, &run->rec, &report, &preview, &judged,
+                                      &run->validationWhy);
+    if (st.ok() && judged) {
+      run->quality = std::move(report);
+      run->preview = std::move(preview);
+    } else if (st.ok() && estimateFrom == "preview") {
+      st = Status::Error("--estimate-from preview: " + run->validationWhy);
+    }
+  }
+  if (st.ok() && !judged) st = ReconstructFor(provider, options, engine, &run->rec, &run->quality);
   run->wallS = toolkit::SecondsSince(t0);
   run->rays = provider.rayCounts();
   return st;
@@ -272,6 +292,13 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
               << "engine settings: " << SettingsSummary(options, provider->Capabilities()) << "\n";
   }
   if (IsPartial(f.tiles)) return RunRenderPart(f, scene, options, *provider, progress, outputs);
+  if (std::string why; f.estimateFrom == "preview" &&
+                       !((f.engine.targetPsnr || f.engine.budget) &&
+                         TracerPreviewApplies(*provider, options, f.engine, f.estimateFrom, &why))) {
+    std::cerr << "dcm render: --estimate-from preview: "
+              << (why.empty() ? "judges --target-psnr or --budget, and neither is given" : why) << "\n";
+    return kExitUsage;
+  }
 
   // The reference compared against, from a file or rendered in this run.
   std::optional<std::vector<RGB>> reference;
@@ -294,14 +321,27 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
     fo.fullEvaluation = true;
     fo.progress = [&](float v, std::string_view stage) { progress.Update(v, "full render: " + std::string(stage)); };
     Run r;
-    if (Status st = RunOnce(*provider, fo, EngineFlags{}, &r); !st.ok()) return Fail(st);
+    if (Status st = RunOnce(*provider, fo, EngineFlags{}, f.estimateFrom, &r); !st.ok()) return Fail(st);
     full = std::move(r);
   }
 
   options.progress = [&](float v, std::string_view stage) { progress.Update(v, stage); };
   Run run;
-  if (Status st = RunOnce(*provider, options, f.engine, &run); !st.ok()) return Fail(st);
+  if (Status st = RunOnce(*provider, options, f.engine, f.estimateFrom, &run); !st.ok()) return Fail(st);
   progress.Done();
+  if (f.engine.verbose && run.quality) {
+    const std::string goalName = f.engine.targetPsnr ? "--target-psnr" : "--budget";
+    if (run.preview) {
+      char line[200];
+      std::snprintf(line, sizeof line, "every pixel at 1/%d of the scene's rays, twice: %llu rays, %.2f s, its own "
+                    "noise %.2f dB", kTracerPreviewDivisor,
+                    static_cast<unsigned long long>(run.preview->previewRays.total()), run.preview->previewS,
+                    run.preview->previewPsnr);
+      std::cerr << "render: " << goalName << " judged by the preview's estimate (" << line << ")\n";
+    } else {
+      std::cerr << "render: " << goalName << " judged by validation pixels: " << run.validationWhy << "\n";
+    }
+  }
   const Reconstruction& rec = run.rec;
   const ReconstructionStats& stats = rec.stats;
   if (f.engine.verbose) std::cerr << toolkit::StageTimesLine(stats) << "\n";
@@ -360,6 +400,16 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
     if (error) j["reference"] = ErrorToJson(*error);
     if (run.quality)
       toolkit::AddQualityJson(*run.quality, f.engine.targetPsnr.value_or(0), f.engine.budget.value_or(0), &j);
+    if (run.preview) {
+      j["quality"]["preview"] = {{"rays", RaysToJson(run.preview->previewRays)},
+                                 {"time_s", run.preview->previewS},
+                                 {"noise_psnr", run.preview->previewPsnr},
+                                 {"cost_share", run.preview->costShare},
+                                 {"ray_divisor", kTracerPreviewDivisor}};
+      toolkit::AddLadderJson(run.preview->ladder, &j["quality"]);
+    } else if (run.quality) {
+      j["quality"]["validation_because"] = run.validationWhy;
+    }
     if (!f.preview.empty()) j["preview_transform"] = displayText;
     if (full) {
       j["full"] = {{"time_illum_s", full->rec.stats.timeProviderS},
@@ -449,6 +499,14 @@ Registration reg("render", "Ray trace a scene file (Embree) with DCM: a few perc
                    app->add_option("--supersampling", f->supersampling,
                                    "override render.supersampling (samples per output pixel per axis)")
                        ->transform(Integer(1, 16))
+                       ->group(kGroupQuality);
+                   app->add_option("--estimate-from", f->estimateFrom,
+                                   "what judges --target-psnr and --budget: a preview of every pixel at 1/32 of the "
+                                   "scene's rays (its estimate against the converged image; final resolution, "
+                                   "noise-free exact samples), validation pixels traced exactly, or auto (the "
+                                   "preview where it can tell: its own noise under 25 dB)")
+                       ->check(CLI::IsMember({"auto", "preview", "validation"}))
+                       ->capture_default_str()
                        ->group(kGroupQuality);
                    app->add_option("--spp", f->spp,
                                    "override render.samples_per_pixel (independent estimates per exact pixel; "

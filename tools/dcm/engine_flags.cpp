@@ -346,6 +346,8 @@ std::string QualityLine(const QualityReport& r, const EngineFlags& f) {
   }
   if (!r.againstConverged) return line;
   const PsnrEstimate& n = r.renderEstimate;
+  // +inf: noise-free exact samples, the full render is the converged image.
+  if (std::isinf(n.psnr)) return line + "; against the converged image (the exact samples carry no noise)";
   char noise[160];
   std::snprintf(noise, sizeof noise, "; against the converged image, the full render's own estimated PSNR %.2f dB",
                 n.psnr);

@@ -2,6 +2,9 @@
 
 #include "dcm/embree/scene_file.h"
 
+#include <algorithm>
+#include <new>
+
 #include <tbb/parallel_for.h>
 
 namespace dcm::embree {
@@ -169,6 +172,60 @@ Status EmbreeProvider::Evaluate(std::span<const Point2i> pixels, const SampleReq
     if (what.variance) s.variance = r.variance;
   }
   AddCounts(counts);
+  return Status::Ok();
+}
+
+IntegratorConfig EmbreeProvider::PreviewConfig(int divisor) const {
+  IntegratorConfig cfg = integrator_->config();
+  auto fewer = [divisor](int rays) { return rays > 0 ? std::max(1, rays / divisor) : 0; };
+  cfg.shadowRays = fewer(cfg.shadowRays);
+  cfg.secondaryShadowRays = fewer(cfg.secondaryShadowRays);
+  cfg.glossyRays = fewer(cfg.glossyRays);
+  cfg.indirectRays = fewer(cfg.indirectRays);
+  cfg.samplesPerPixel = 2;
+  // Random numbers of its own: the preview is more samples of the same pixels.
+  cfg.seed = cfg.seed ^ 0x9e3779b9u;
+  return cfg;
+}
+
+Status EmbreeProvider::PreviewCostShare(int divisor, int stride, double* share) {
+  if (divisor < 1 || stride < 1)
+    return Status::Error("embree: preview ray divisor " + std::to_string(divisor) + ", stride " +
+                         std::to_string(stride) + " (each at least 1)");
+  const Integrator preview(*integrator_, PreviewConfig(divisor));
+  RayCounts exact, cheap;
+  for (int y = std::min(stride / 2, workHeight_ - 1); y < workHeight_; y += stride)
+    for (int x = std::min(stride / 2, workWidth_ - 1); x < workWidth_; x += stride) {
+      integrator_->Evaluate(x, y, &exact);
+      preview.Evaluate(x, y, &cheap);
+    }
+  AddCounts(exact);
+  AddCounts(cheap);
+  *share = exact.total() > 0 ? double(cheap.total()) / double(exact.total()) : 1.0;
+  return Status::Ok();
+}
+
+Status EmbreeProvider::RenderPreview(int divisor, std::vector<ExactSample>* out) {
+  if (divisor < 1) return Status::Error("embree: preview ray divisor " + std::to_string(divisor) + " (at least 1)");
+  const Integrator preview(*integrator_, PreviewConfig(divisor));
+  try {
+    out->assign(size_t(workWidth_) * size_t(workHeight_), ExactSample{});
+  } catch (const std::bad_alloc&) {
+    return Status::Error("embree: no memory for a preview of " + std::to_string(workWidth_) + "x" +
+                         std::to_string(workHeight_) + " pixels");
+  }
+  tbb::parallel_for(0, workHeight_, [&](int y) {
+    RayCounts counts;
+    for (int x = 0; x < workWidth_; ++x) {
+      const PixelRadiance r = preview.Evaluate(x, y, &counts);
+      ExactSample& s = (*out)[size_t(y) * size_t(workWidth_) + size_t(x)];
+      s.L = r.L;
+      s.Li = r.Li;
+      s.Lc = r.Lc;
+      s.variance = r.variance;
+    }
+    AddCounts(counts);
+  });
   return Status::Ok();
 }
 

@@ -47,6 +47,17 @@ class EmbreeProvider final : public SampleProvider {
   Status Evaluate(std::span<const Point2i> pixels, const SampleRequest& what,
                   std::span<ExactSample> out) override;
 
+  /// A preview of every working pixel, row-major, for a goal judged by its
+  /// estimate (tools/dcm/render_preview.h): each secondary ray count of the
+  /// scene (shadow, glossy, secondary shadow, indirect) divided by `divisor`,
+  /// at least 1, and two independent estimates per pixel on random numbers of
+  /// their own (not the exact samples'): L, L_i and L_c and the variance of
+  /// their mean. Its rays count in rayCounts().
+  Status RenderPreview(int divisor, std::vector<ExactSample>* out);
+  /// What RenderPreview(divisor) costs against the full render, in rays,
+  /// measured on the pixels of a grid of `stride` (their centres) traced both
+  /// ways; those rays count in rayCounts().
+  Status PreviewCostShare(int divisor, int stride, double* share);
   /// One exact pixel with its tau (for tests and tools; same bits as Evaluate()).
   PixelRadiance EvaluatePixel(int x, int y);
   /// The guides of one pixel, its primary ray traced alone (for tests: the
@@ -68,6 +79,9 @@ class EmbreeProvider final : public SampleProvider {
  private:
   EmbreeProvider() = default;
   void AddCounts(const RayCounts& c);
+  /// The integrator's config with each secondary ray count over `divisor`
+  /// (at least 1), two estimates a pixel, a seed of its own.
+  IntegratorConfig PreviewConfig(int divisor) const;
 
   Scene scene_;
   int workWidth_ = 0, workHeight_ = 0;

@@ -31,6 +31,11 @@ struct RayCounts {
     glossy += o.glossy; mirror += o.mirror; indirect += o.indirect;
     return *this;
   }
+  /// The rays traced since `earlier`, a count of the same counters.
+  RayCounts Since(const RayCounts& earlier) const {
+    return {primary - earlier.primary, guide - earlier.guide,   shadow - earlier.shadow,
+            glossy - earlier.glossy,   mirror - earlier.mirror, indirect - earlier.indirect};
+  }
 };
 
 /// One exact pixel: L = Li * tau + Lc (exactly, in floats).
@@ -77,6 +82,11 @@ class Integrator {
              std::vector<Material> materials, std::vector<Light> lights,
              std::vector<int> objectMaterial, std::vector<uint32_t> objectId,
              std::vector<uint32_t> lightId);
+
+  /// The same scene traced with another `config` (a preview's ray counts and seed).
+  Integrator(const Integrator& base, IntegratorConfig config) : Integrator(base) { cfg_ = config; }
+
+  const IntegratorConfig& config() const { return cfg_; }
 
   /// The exact radiance of working pixel (x, y), split at the first hit.
   PixelRadiance Evaluate(int x, int y, RayCounts* counts) const;
