@@ -612,6 +612,65 @@ TEST(DcmPipe, ReconstructsTheAnalyticScene) {
   EXPECT_LT(sum / double(3 * img.size()), 0.005) << "mean absolute error against the analytic image";
 }
 
+// A provider whose calls cost a latency (a render call over the whole frame,
+// a process start) gets its exact pixels in a few large calls chosen on its
+// preview, as PROTOCOL.md promises; --schedule levels asks step by step.
+TEST(DcmPipe, ACallThatCostsALatencyIsPlannedOnThePreview) {
+  TempDir dir;
+  const std::string truth = dir / "truth.raw";
+  std::string log;
+  ASSERT_EQ(RunShell(Analytic("--width 192 --height 144 --truth " + truth), &log), 0) << log;
+  std::vector<float> ref(size_t(192 * 144 * 3));
+  std::ifstream tf(truth, std::ios::binary);
+  tf.read(reinterpret_cast<char*>(ref.data()), std::streamsize(ref.size() * 4));
+  ASSERT_TRUE(tf.good());
+  auto run = [&](const std::string& flags, nlohmann::json* j, double* meanError) {
+    const std::string out = dir / "out.exr", stats = dir / "stats.json";
+    const int rc = RunShell(std::string(DCM_BINARY) + " pipe --quiet --provider-cmd " +
+                                Quoted(Analytic("--width 192 --height 144 --round-latency 0.5")) + " -o " + out +
+                                " --stats " + stats + " " + flags,
+                            &log);
+    ASSERT_EQ(rc, 0) << log;
+    std::ifstream js(stats);
+    *j = nlohmann::json::parse(js);
+    int w = 0, h = 0;
+    std::vector<dcm::RGB> img;
+    ASSERT_TRUE(dcm::toolkit::ReadRgb(out, &w, &h, &img).ok());
+    ASSERT_EQ(size_t(w) * size_t(h), img.size());
+    double sum = 0;
+    for (size_t i = 0; i < img.size(); ++i)
+      for (int c = 0; c < 3; ++c) sum += std::fabs(double(img[i][c]) - double(ref[3 * i + size_t(c)]));
+    *meanError = sum / double(3 * img.size());
+  };
+  nlohmann::json preview, levels, goal;
+  double previewError = 0, levelsError = 0, goalError = 0;
+  run("", &preview, &previewError);
+  run("--schedule levels", &levels, &levelsError);
+  EXPECT_EQ(preview.at("schedule"), "preview");
+  EXPECT_EQ(levels.at("schedule"), "levels");
+  // At most --max-rounds (3) calls, against one per refinement step.
+  EXPECT_LE(preview.at("provider_calls").get<int>(), 3);
+  EXPECT_GT(levels.at("provider_calls").get<int>(), 3);
+  EXPECT_EQ(preview.at("preview").at("pixels_per_call").size(), preview.at("provider_calls").get<size_t>());
+  // The same accuracy as the level schedule's within what a few pixels left at
+  // their (half-resolution) preview value cost: the analytic image's mean
+  // absolute error 0.005 (DcmPipe.ReconstructsTheAnalyticScene).
+  EXPECT_LT(previewError, 0.005);
+  EXPECT_LT(levelsError, 0.005);
+  // A goal: each run of the search in two calls at most, validation pixels with its first.
+  run("--target-psnr 40", &goal, &goalError);
+  EXPECT_EQ(goal.at("schedule"), "preview");
+  EXPECT_TRUE(goal.at("quality").at("target_reached").get<bool>());
+  EXPECT_LE(goal.at("provider_calls").get<int>(), 2 * goal.at("quality").at("runs").get<int>());
+  // Parts of the frame follow the levels: a preview schedule asked for there is a usage error.
+  EXPECT_EQ(RunShell(std::string(DCM_BINARY) + " pipe --quiet --schedule preview --tile 0/2 --provider-cmd " +
+                         Quoted(Analytic("--width 64 --height 64 --round-latency 0.5")) + " -o " + (dir / "t.exr"),
+                     &log),
+            2)
+      << log;
+  EXPECT_TRUE(Contains(log, "--schedule preview")) << log;
+}
+
 TEST(DcmPipe, FullEvaluationAsksForEveryPixel) {
   TempDir dir;
   std::string log;

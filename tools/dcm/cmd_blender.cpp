@@ -89,7 +89,6 @@ struct BlenderFlags {
   std::string poolPreview = "on";
   /// Every exact pixel at `samples`, also where a goal in dB needs fewer.
   bool fixedSamples = false;
-  RoundFlags rounds;       ///< --schedule, --max-rounds
   int renderThreads = 0;
   /// Exact pixels as two halves with two seeds; their variance to the engine:
   /// auto where the preview's halves say the noise matters (kNoisyPsnr), on, off
@@ -320,7 +319,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
   PooledVarianceProvider pooled(meter, poolRadius, useVariance);
   const ProviderCapabilities caps = pooled.Capabilities();
   RoundSchedule schedule = RoundSchedule::kLevels;
-  if (Status st = ScheduleFor(f.rounds, provider->roundCost(), provider->hasPreview(), &schedule); !st.ok())
+  if (Status st = ScheduleFor(f.pipe.rounds, provider->roundCost(), provider->hasPreview(), &schedule); !st.ok())
     return Fail("'" + f.scene + "': " + st.message());
   const bool goalInDb = (f.pipe.engine.targetPsnr || f.pipe.engine.budget) && !f.pipe.engine.TargetsRender();
   if (f.estimateFrom == "preview" && (schedule != RoundSchedule::kPreview || !goalInDb))
@@ -388,7 +387,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     // preview's own variance (its halves, pooled as the exact pixels') keeps
     // the preview's noise from passing for edges. The preview correction
     // needs that variance in any case.
-    const bool previewVariance = useVariance || (f.rounds.previewCorrection > 0 && provider->Capabilities().variance);
+    const bool previewVariance = useVariance || (f.pipe.rounds.previewCorrection > 0 && provider->Capabilities().variance);
     PreviewScheduleOptions so;
     st = provider->FetchPreview({options.textureSplit && caps.splitRadiance, previewVariance}, &preview, poolRadius,
                                 &so.previewOwnVariance, &so.previewTextureCovariance);
@@ -399,7 +398,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     if (samples > 0 && previewSamples > 0) so.exactVarianceShare = std::min(1.0, previewSamples / samples);
     assumedShare = so.exactVarianceShare;
     so.measuredExactVarianceShare = [&meter] { return meter.share(); };
-    so.maxRounds = f.rounds.maxRounds;
+    so.maxRounds = f.pipe.rounds.maxRounds;
     // Fewer samples for the exact pixels where a goal does not need them all
     // (never noisier than the preview: the library's bound on the share), nor,
     // with their variance not weighed, past the noise the regime was chosen for.
@@ -416,11 +415,11 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
         return provider->SetExactSamples(int64_t(samples) >> j);
       };
     }
-    so.correctionRadius = f.rounds.previewCorrection;
-    so.filterRadius = f.rounds.previewFilter;
-    so.errorRound = f.rounds.errorRound;
-    so.planSignificance = f.rounds.planSignificance;
-    so.minRoundShare = f.rounds.minRoundShare;
+    so.correctionRadius = f.pipe.rounds.previewCorrection;
+    so.filterRadius = f.pipe.rounds.previewFilter;
+    so.errorRound = f.pipe.rounds.errorRound;
+    so.planSignificance = f.pipe.rounds.planSignificance;
+    so.minRoundShare = f.pipe.rounds.minRoundShare;
     // A target in dB or a budget is judged by the preview's estimate where the preview can tell.
     const double target = f.pipe.engine.targetPsnr.value_or(defaultGoal ? kDefaultTargetPsnr : 0);
     if (st.ok() && (target > 0 || goalInDb) && f.estimateFrom != "validation") {
@@ -516,7 +515,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       // Each run of the search in two rounds at most: its validation pixels go
       // with its first; pixels left at their preview value after one round
       // carry errors few validation pixels see (docs/QUALITY.md).
-      so.maxRounds = std::min(f.rounds.maxRounds, 2);
+      so.maxRounds = std::min(f.pipe.rounds.maxRounds, 2);
       QualityReport report;
       const auto tq = Clock::now();
       st = ReconstructToQualityWithPreview(timed, *preview, options, goal, so, &rec, &report, &qrounds);
@@ -813,7 +812,7 @@ Registration reg("blender", "Render a .blend with Cycles at the pixels DCM asks 
                    AddProviderTimeoutFlags(app, &f->pipe);
                    AddExrFormatFlags(app, &f->pipe.exr);
                    AddEngineFlags(app, &f->pipe.engine);
-                   AddRoundFlags(app, &f->rounds);
+                   AddRoundFlags(app, &f->pipe.rounds);
                    return [f] { return Run(*f); };
                  });
 

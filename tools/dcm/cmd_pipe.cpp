@@ -7,6 +7,7 @@
 // Compiles to nothing unless the dcm_pipe library is linked (DCM_HAVE_PIPE).
 #ifdef DCM_HAVE_PIPE
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <iostream>
@@ -24,7 +25,9 @@
 #include "common/summary.h"
 #include "common/tiles.h"
 #include "dcm/pipe/pipe_provider.h"
+#include "dcm/quality_preview.h"
 #include "dcm/reconstructor.h"
+#include "dcm/round_schedule.h"
 #include "dcm/window_provider.h"
 #include "engine_flags.h"
 #include "flag_checks.h"
@@ -44,6 +47,50 @@ void AddProviderTimeoutFlags(CLI::App* app, PipeFlags* f) {
       ->capture_default_str()
       ->group(kGroupIo);
 }
+
+namespace {
+
+/// What the preview schedule did.
+struct PreviewRun {
+  PreviewScheduleStats sched;  ///< without a goal
+  QualityRoundStats goal;      ///< with one
+  double previewS = 0;         ///< fetching the preview
+};
+
+/// Reconstructs on the provider's preview (RoundSchedule::kPreview): the
+/// preview fetched once, with its variance where the provider gives one (the
+/// preview correction needs it), then a few large calls for the exact pixels;
+/// with a goal, the validation search in rounds, each run in two calls at
+/// most (ReconstructToQualityWithPreview, as `dcm povray`).
+Status ReconstructOnPreview(pipe::PipeProvider& provider, const ReconstructionOptions& options, const PipeFlags& f,
+                            Reconstruction* rec, std::optional<QualityReport>* quality, PreviewRun* run) {
+  const ProviderCapabilities caps = provider.Capabilities();
+  ProviderCapabilities noisy = caps;
+  noisy.variance = true;
+  const int poolRadius = ResolveSettings(options, noisy).elementaryBlock;
+  PreviewScheduleOptions so;
+  std::unique_ptr<SampleProvider> preview;
+  const auto t0 = std::chrono::steady_clock::now();
+  DCM_RETURN_IF_ERROR(provider.FetchPreview({options.textureSplit && caps.splitRadiance, caps.variance}, &preview,
+                                            poolRadius, &so.previewOwnVariance, &so.previewTextureCovariance));
+  run->previewS = toolkit::SecondsSince(t0);
+  so.maxRounds = f.rounds.maxRounds;
+  so.minRoundShare = f.rounds.minRoundShare;
+  so.correctionRadius = f.rounds.previewCorrection;
+  so.filterRadius = f.rounds.previewFilter;
+  so.errorRound = f.rounds.errorRound;
+  so.planSignificance = f.rounds.planSignificance;
+  QualityGoal goal;
+  if (!QualityGoalOf(f.engine, &goal)) return ReconstructWithPreview(provider, *preview, options, so, rec, &run->sched);
+  so.minRoundShare = 0;  // the search validates what each run asks for
+  so.maxRounds = std::min(f.rounds.maxRounds, 2);
+  QualityReport report;
+  DCM_RETURN_IF_ERROR(ReconstructToQualityWithPreview(provider, *preview, options, goal, so, rec, &report, &run->goal));
+  *quality = std::move(report);
+  return Status::Ok();
+}
+
+}  // namespace
 
 int RunPipe(const std::string& cmd, const PipeFlags& f) {
   auto Fail = [&cmd](const std::string& message, int code = kExitFailure) {
@@ -100,13 +147,31 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
     if (Status st = ResolveRegion(f.tiles, frame.x, frame.y, TileAlignment(options), &region, &tile); !st.ok())
       return Fail(st.message(), kExitUsage);
   }
+  // A provider whose calls cost a latency: its exact pixels planned on its
+  // preview, in a few calls. A part of the frame and --progressive follow the
+  // levels, whose steps they are made of.
+  RoundSchedule schedule = RoundSchedule::kLevels;
+  if (!partial && f.engine.progressive.empty() && !options.fullEvaluation) {
+    if (Status st = ScheduleFor(f.rounds, provider->roundCost(), provider->hasPreview(), &schedule); !st.ok())
+      return Fail(st.message(), kExitUsage);
+  } else if (f.rounds.schedule == "preview") {
+    return Fail("--schedule preview: not with --tile, --region, --progressive or --full (they follow the levels)",
+                kExitUsage);
+  }
+  if (f.engine.verbose && schedule == RoundSchedule::kPreview)
+    std::cerr << "schedule preview: a call costs " << provider->roundCost().latencyS << " s besides "
+              << provider->roundCost().perSampleS << " s a pixel; the exact pixels are chosen on the preview and "
+              << "asked for in at most " << f.rounds.maxRounds << " calls\n";
   toolkit::Progress progress(!f.engine.quiet);
   options.progress = [&](float v, std::string_view stage) { progress.Update(v, stage); };
   Reconstruction rec;
   RegionInfo info;
   std::optional<QualityReport> quality;
+  PreviewRun previewRun;
   Status st = partial ? ReconstructRegion(*provider, options, region, &rec, &info)
-                      : ReconstructFor(*provider, options, f.engine, &rec, &quality);
+              : schedule == RoundSchedule::kPreview
+                  ? ReconstructOnPreview(*provider, options, f, &rec, &quality, &previewRun)
+                  : ReconstructFor(*provider, options, f.engine, &rec, &quality);
   progress.Done();
   if (!st.ok()) return Fail(st.message());
   // The child must end cleanly before anything is written.
@@ -153,6 +218,13 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
     j["provider_name"] = caps.name;
     j["provider_cmd"] = f.command;
     if (partial) j["part"] = PartJson(tile, info);
+    j["schedule"] = std::string(ToString(schedule));
+    if (schedule == RoundSchedule::kPreview) {
+      const bool goal = quality.has_value();
+      j["preview"] = {{"time_s", previewRun.previewS},
+                      {"pixels_per_call", goal ? previewRun.goal.pixelsPerRound : previewRun.sched.pixelsPerRound},
+                      {"stand_ins", goal ? previewRun.goal.previewStandIns : previewRun.sched.previewStandIns}};
+    }
     if (quality) toolkit::AddQualityJson(*quality, f.engine.targetPsnr.value_or(0), f.engine.budget.value_or(0), &j);
     if (Status w = toolkit::WriteJson(f.stats, j); !w.ok()) return Fail(w.message());
   }
@@ -195,6 +267,7 @@ Registration reg("pipe", "Reconstruct with an external renderer as a child proce
                    AddProviderTimeoutFlags(app, f.get());
                    AddExrFormatFlags(app, &f->exr);
                    AddEngineFlags(app, &f->engine);
+                   AddRoundFlags(app, &f->rounds);
                    AddTileFlags(app, &f->tiles);
                    return [f] { return RunPipe("pipe", *f); };
                  });

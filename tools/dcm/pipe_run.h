@@ -22,6 +22,7 @@ struct PipeFlags {
   double timeout = 600.0;         ///< --provider-timeout, per answer
   double startupTimeout = 600.0;  ///< --provider-startup-timeout, for the handshake
   EngineFlags engine;
+  RoundFlags rounds;  ///< --schedule and the preview schedule's flags, for a provider whose calls cost a latency
   TileFlags tiles;  ///< --tile / --region: a part of the frame for `dcm merge` (no --frames)
   toolkit::ExrFormat exr;  ///< -d, --compression, --ch (the whole frame)
 };
