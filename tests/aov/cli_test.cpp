@@ -526,7 +526,9 @@ TEST_P(DcmPlanGoal, RoundTripMatchesDense) {
     if (why != "interpolated" && why != "preview_stand_in") held += n.get<int64_t>();
   EXPECT_EQ(held, int64_t(rendered.size()));
   // The budget's search refuses runs part way: their pixels are among those kept.
-  if (goal.rfind("--budget", 0) == 0) EXPECT_GT(ss["by_reason"]["rendered"].get<int64_t>(), 0);
+  if (goal.rfind("--budget", 0) == 0) {
+    EXPECT_GT(ss["by_reason"]["rendered"].get<int64_t>(), 0);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Goals, DcmPlanGoal, ::testing::Values("--target-psnr 20", "--budget 0.3"),

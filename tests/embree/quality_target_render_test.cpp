@@ -5,6 +5,9 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -18,34 +21,19 @@ namespace {
 
 using testing::MakeProvider;
 
-// Two area lights of different colours over a checker-textured floor, a
-// glossy spheres, a thin rod and a box: soft and hard
-// shadow edges, highlights and texture at final resolution (128x128).
-const char* kHeldOut = R"({
-  "camera": {"position": [0.4, 1.6, 3.0], "look_at": [0, 0.35, 0], "fov": 45, "resolution": [128, 128]},
-  "render": {"shadow_rays": 16, "glossy_rays": 8, "supersampling": 1},
-  "materials": {
-    "floor": {"type": "diffuse", "color": 0.8, "texture": {"type": "checker", "scale": 8, "color0": 0.3, "color1": 0.9}},
-    "shiny": {"type": "plastic", "color": [0.1, 0.5, 0.2], "specular": 0.4, "exponent": 60},
-    "rod": {"type": "diffuse", "color": [0.9, 0.8, 0.2]},
-    "box": {"type": "diffuse", "color": [0.6, 0.3, 0.5]}
-  },
-  "objects": [
-    {"type": "quad", "material": "floor", "origin": [-3, 0, 3], "edge_u": [6, 0, 0], "edge_v": [0, 0, -6]},
-    {"type": "sphere", "material": "shiny", "center": [-0.7, 0.25, 0.2], "radius": 0.25},
-    {"type": "sphere", "material": "shiny", "center": [-0.2, 0.15, 0.6], "radius": 0.15},
-    {"type": "sphere", "material": "shiny", "center": [0.5, 0.3, -0.3], "radius": 0.3},
-    {"type": "cylinder", "material": "rod", "from": [0.2, 0, 0.9], "to": [-0.4, 1.0, 0.5], "radius": 0.01},
-    {"type": "box", "material": "box", "min": [0.6, 0, 0.3], "max": [1.1, 0.4, 0.8]}
-  ],
-  "lights": [
-    {"type": "rect", "origin": [-1.5, 2.5, 0], "edge_u": [0.5, 0, 0], "edge_v": [0, 0, 0.5], "radiance": [9, 7, 5]},
-    {"type": "rect", "origin": [1.5, 2.0, 1.0], "edge_u": [0.3, 0, 0], "edge_v": [0, 0, 0.3], "radiance": [3, 5, 9]}
-  ]
-})";
+// Two area lights of different colours over a checker-textured floor, glossy
+// spheres, a thin rod and a box: soft and hard shadow edges, highlights and
+// texture at final resolution (128x128). Also the scene of QT64 and QT16
+// (docs/TUNING.md) and of render_goal_cli_test.cpp.
+std::string HeldOutScene() {
+  std::ifstream in(std::string(DCM_TEST_DATA_DIR) + "/heldout_scene.json");
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
 
 TEST(QualityTargetRender, HeldOutSceneMeetsItsTargetAndNeverExceedsItsBudget) {
-  auto p = MakeProvider(kHeldOut);
+  auto p = MakeProvider(HeldOutScene());
   ASSERT_TRUE(p);
   ReconstructionOptions o;
   o.threads = 2;

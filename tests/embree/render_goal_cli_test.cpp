@@ -5,47 +5,34 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "../robustness/dcm_process.h"
 
 namespace dcm::testing {
 namespace {
 
-// Two area lights of 64 shadow rays each over a checker floor, glossy spheres,
-// a thin rod and a box (the held-out scene of quality_target_render_test.cpp
-// with more shadow rays): a preview costs about 7 % of the full render.
-const char* kAreaLights = R"({
-  "camera": {"position": [0.4, 1.6, 3.0], "look_at": [0, 0.35, 0], "fov": 45, "resolution": [96, 96]},
-  "render": {"shadow_rays": 64, "glossy_rays": 8, "supersampling": 1},
-  "materials": {
-    "floor": {"type": "diffuse", "color": 0.8, "texture": {"type": "checker", "scale": 8, "color0": 0.3, "color1": 0.9}},
-    "shiny": {"type": "plastic", "color": [0.1, 0.5, 0.2], "specular": 0.4, "exponent": 60},
-    "rod": {"type": "diffuse", "color": [0.9, 0.8, 0.2]},
-    "box": {"type": "diffuse", "color": [0.6, 0.3, 0.5]}
-  },
-  "objects": [
-    {"type": "quad", "material": "floor", "origin": [-3, 0, 3], "edge_u": [6, 0, 0], "edge_v": [0, 0, -6]},
-    {"type": "sphere", "material": "shiny", "center": [-0.7, 0.25, 0.2], "radius": 0.25},
-    {"type": "sphere", "material": "shiny", "center": [0.5, 0.3, -0.3], "radius": 0.3},
-    {"type": "cylinder", "material": "rod", "from": [0.2, 0, 0.9], "to": [-0.4, 1.0, 0.5], "radius": 0.01},
-    {"type": "box", "material": "box", "min": [0.6, 0, 0.3], "max": [1.1, 0.4, 0.8]}
-  ],
-  "lights": [
-    {"type": "rect", "origin": [-1.5, 2.5, 0], "edge_u": [0.5, 0, 0], "edge_v": [0, 0, 0.5], "radiance": [9, 7, 5]},
-    {"type": "rect", "origin": [1.5, 2.0, 1.0], "edge_u": [0.3, 0, 0], "edge_v": [0, 0, 0.3], "radiance": [3, 5, 9]}
-  ]
-})";
+// The held-out scene of quality_target_render_test.cpp at 96x96 with 64
+// shadow rays a light: a preview costs about 7 % of the full render.
+const std::vector<std::string> kAreaLights{"--size", "96x96", "--set", "render.shadow_rays=64"};
+// The same objects under two point lights: one shadow ray each, which a
+// preview cannot divide.
+const std::vector<std::string> kPointLights{
+    "--size", "64x64", "--set",
+    R"(lights=[{"type": "point", "position": [-1, 2.5, 1], "intensity": 8},
+               {"type": "point", "position": [1, 2, 0], "intensity": 4}])"};
 
-// Point lights: one shadow ray each, which a preview cannot divide.
-const char* kPointLights = R"({
-  "camera": {"position": [0.4, 1.6, 3.0], "look_at": [0, 0.35, 0], "fov": 45, "resolution": [64, 64]},
-  "materials": {"floor": {"type": "diffuse", "color": 0.8}, "box": {"type": "diffuse", "color": [0.6, 0.3, 0.5]}},
-  "objects": [
-    {"type": "quad", "material": "floor", "origin": [-3, 0, 3], "edge_u": [6, 0, 0], "edge_v": [0, 0, -6]},
-    {"type": "box", "material": "box", "min": [0.3, 0, -0.2], "max": [0.9, 0.5, 0.4]}
-  ],
-  "lights": [{"type": "point", "position": [-1, 2.5, 1], "intensity": 8}, {"type": "point", "position": [1, 2, 0], "intensity": 4}]
-})";
+/// A scratch folder holding the held-out scene as scene.json.
+void WriteScene(const TempDir& dir) {
+  dir.Write("scene.json", ReadAll(std::string(DCM_TEST_DATA_DIR) + "/heldout_scene.json"));
+}
+
+/// `dcm render scene.json` with `args` and then `scene`'s flags.
+Result Render(const TempDir& dir, std::vector<std::string> args, const std::vector<std::string>& scene) {
+  args.insert(args.begin(), {"render", "scene.json"});
+  args.insert(args.end(), scene.begin(), scene.end());
+  return RunDcm(dir.path(), args);
+}
 
 nlohmann::json Stats(const TempDir& dir, const std::string& name) {
   return nlohmann::json::parse(ReadAll(dir.path() / name));
@@ -53,11 +40,11 @@ nlohmann::json Stats(const TempDir& dir, const std::string& name) {
 
 TEST(RenderGoal, JudgedByThePreviewItMeetsTheTargetWithFewerExactPixels) {
   TempDir dir("dcm_render_goal");
-  dir.Write("scene.json", kAreaLights);
-  Result full = RunDcm(dir.path(), {"render", "scene.json", "--full", "-o", "full.exr", "--stats", "full.json", "-q"});
+  WriteScene(dir);
+  Result full = Render(dir, {"--full", "-o", "full.exr", "--stats", "full.json", "-q"}, kAreaLights);
   ASSERT_TRUE(full.exited && full.code == 0) << full.Describe();
-  Result r = RunDcm(dir.path(), {"render", "scene.json", "--target-psnr", "40", "-o", "p.exr", "--stats", "p.json",
-                                 "--compare", "full.exr", "-v"});
+  Result r = Render(dir, {"--target-psnr", "40", "-o", "p.exr", "--stats", "p.json", "--compare", "full.exr", "-v"},
+                    kAreaLights);
   ASSERT_TRUE(r.exited && r.code == 0) << r.Describe();
   EXPECT_NE(r.output.find("--target-psnr judged by the preview's estimate"), std::string::npos) << r.output;
   const nlohmann::json p = Stats(dir, "p.json");
@@ -77,15 +64,16 @@ TEST(RenderGoal, JudgedByThePreviewItMeetsTheTargetWithFewerExactPixels) {
 
   // The same goal judged by validation pixels spends more exact pixels: the
   // validation's own and a search that starts at the default threshold.
-  Result v = RunDcm(dir.path(), {"render", "scene.json", "--target-psnr", "40", "-o", "v.exr", "--stats", "v.json",
-                                 "--compare", "full.exr", "--estimate-from", "validation", "-q"});
+  Result v = Render(dir, {"--target-psnr", "40", "-o", "v.exr", "--stats", "v.json", "--compare", "full.exr",
+                         "--estimate-from", "validation", "-q"},
+                    kAreaLights);
   ASSERT_TRUE(v.exited && v.code == 0) << v.Describe();
   const nlohmann::json val = Stats(dir, "v.json");
   EXPECT_EQ(val["estimated_psnr_from"], "validation");
   EXPECT_GT(val["exact_fraction"].get<double>(), p["exact_fraction"].get<double>());
 
   // A budget judged by the preview never exceeds it.
-  Result b = RunDcm(dir.path(), {"render", "scene.json", "--budget", "0.12", "-o", "b.exr", "--stats", "b.json", "-q"});
+  Result b = Render(dir, {"--budget", "0.12", "-o", "b.exr", "--stats", "b.json", "-q"}, kAreaLights);
   ASSERT_TRUE(b.exited && b.code == 0) << b.Describe();
   const nlohmann::json bs = Stats(dir, "b.json");
   EXPECT_EQ(bs["estimated_psnr_from"], "preview");
@@ -94,30 +82,30 @@ TEST(RenderGoal, JudgedByThePreviewItMeetsTheTargetWithFewerExactPixels) {
 
 TEST(RenderGoal, WhereThePreviewCostsMoreThanItSparesValidationPixelsJudge) {
   TempDir dir("dcm_render_goal");
-  dir.Write("scene.json", kPointLights);
-  Result r = RunDcm(dir.path(), {"render", "scene.json", "--target-psnr", "40", "-o", "a.exr", "--stats", "a.json", "-v"});
+  WriteScene(dir);
+  Result r = Render(dir, {"--target-psnr", "40", "-o", "a.exr", "--stats", "a.json", "-v"}, kPointLights);
   ASSERT_TRUE(r.exited && r.code == 0) << r.Describe();
   EXPECT_NE(r.output.find("judged by validation pixels: a preview would cost"), std::string::npos) << r.output;
   const nlohmann::json a = Stats(dir, "a.json");
   EXPECT_EQ(a["estimated_psnr_from"], "validation");
   EXPECT_NE(a["quality"]["validation_because"].get<std::string>().find("would cost"), std::string::npos);
   // Asked for, the preview judges all the same.
-  Result f = RunDcm(dir.path(), {"render", "scene.json", "--target-psnr", "40", "-o", "f.exr", "--stats", "f.json",
-                                 "--estimate-from", "preview", "-q"});
+  Result f = Render(dir, {"--target-psnr", "40", "-o", "f.exr", "--stats", "f.json", "--estimate-from", "preview", "-q"},
+                    kPointLights);
   ASSERT_TRUE(f.exited && f.code == 0) << f.Describe();
   EXPECT_EQ(Stats(dir, "f.json")["estimated_psnr_from"], "preview");
 }
 
 TEST(RenderGoal, ThePreviewAskedForWhereItCannotJudgeIsAUsageError) {
   TempDir dir("dcm_render_goal");
-  dir.Write("scene.json", kAreaLights);
+  WriteScene(dir);
   for (const std::vector<std::string>& extra :
        {std::vector<std::string>{"--target-psnr", "40", "--supersampling", "2"},
         std::vector<std::string>{"--target-psnr", "40", "--spp", "4"},
         std::vector<std::string>{"--threshold", "0.1"}}) {
-    std::vector<std::string> args{"render", "scene.json", "-o", "out.exr", "--estimate-from", "preview", "-q"};
+    std::vector<std::string> args{"-o", "out.exr", "--estimate-from", "preview", "-q"};
     args.insert(args.end(), extra.begin(), extra.end());
-    Result r = RunDcm(dir.path(), args);
+    Result r = Render(dir, args, kAreaLights);
     EXPECT_TRUE(r.exited && r.code == 2) << r.Describe();
     EXPECT_NE(r.output.find("--estimate-from preview"), std::string::npos) << r.output;
     EXPECT_EQ(dir.Files(), std::set<std::string>{"scene.json"});  // nothing written
