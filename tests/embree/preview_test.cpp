@@ -39,17 +39,6 @@ const char* kAreaLights = R"({
   ]
 })";
 
-// The same objects under point lights: one shadow ray each, which no preview divides.
-const char* kPointLights = R"({
-  "camera": {"position": [0.4, 1.6, 3.0], "look_at": [0, 0.35, 0], "fov": 45, "resolution": [32, 32]},
-  "materials": {"floor": {"type": "diffuse", "color": 0.8}, "box": {"type": "diffuse", "color": [0.6, 0.3, 0.5]}},
-  "objects": [
-    {"type": "quad", "material": "floor", "origin": [-3, 0, 3], "edge_u": [6, 0, 0], "edge_v": [0, 0, -6]},
-    {"type": "box", "material": "box", "min": [0.3, 0, -0.2], "max": [0.9, 0.5, 0.4]}
-  ],
-  "lights": [{"type": "point", "position": [-1, 2.5, 1], "intensity": 8}, {"type": "point", "position": [1, 2, 0], "intensity": 4}]
-})";
-
 TEST(TracerPreview, IsUnbiasedAndItsVarianceIsItsNoise) {
   auto p = MakeProvider(kAreaLights);
   ASSERT_TRUE(p);
@@ -79,24 +68,6 @@ TEST(TracerPreview, IsUnbiasedAndItsVarianceIsItsNoise) {
   EXPECT_NEAR(squared / variance, 1.06, 0.35) << "squared " << squared << ", variance " << variance;
   // Unbiased: the summed difference within 4 of its standard deviations.
   EXPECT_LT(std::abs(difference), 4 * std::sqrt(variance)) << difference;
-}
-
-TEST(TracerPreview, CostShareIsMeasuredAndCounted) {
-  auto area = MakeProvider(kAreaLights);
-  ASSERT_TRUE(area);
-  double share = 0;
-  ASSERT_TRUE(area->PreviewCostShare(32, 16, &share).ok());
-  // 1 + 2 (2 + 2) rays a lit pixel against 1 + 128.
-  EXPECT_GT(share, 0.02);
-  EXPECT_LT(share, 0.1);
-  EXPECT_GT(area->rayCounts().shadow, 0u);  // what the measurement traced counts
-  auto point = MakeProvider(kPointLights);
-  ASSERT_TRUE(point);
-  ASSERT_TRUE(point->PreviewCostShare(32, 16, &share).ok());
-  // Two estimates of one ray a point light: 1 + 2 (1 + 1) rays a lit pixel
-  // against 1 + 2 (1.5 measured: pixels facing away from a light trace none).
-  EXPECT_GT(share, 1.2);
-  EXPECT_FALSE(area->PreviewCostShare(0, 16, &share).ok());
 }
 
 }  // namespace

@@ -48,7 +48,7 @@ struct RenderFlags {
   std::optional<int64_t> seed;
   bool withReference = false;
   std::string referenceOut;
-  std::string estimateFrom = "auto";
+  std::string estimateFrom = "validation";
   EngineFlags engine;
   TileFlags tiles;
   toolkit::ExrFormat exr;  ///< -d, --compression, --ch
@@ -93,31 +93,30 @@ struct Run {
   embree::RayCounts rays;
   std::optional<QualityReport> quality;  ///< with --target-psnr / --budget
   std::optional<TracerPreviewRun> preview;  ///< the goal judged by the tracer's preview
-  std::string validationWhy;             ///< a goal judged by validation pixels: why not by the preview
 };
 
 /// One reconstruction as `engine` asks (to a target or budget when given,
-/// judged by the tracer's preview where `estimateFrom` and the run allow).
+/// judged by the tracer's preview where `fromPreview`: RunRender checked that it can).
 Status RunOnce(embree::EmbreeProvider& provider, const ReconstructionOptions& options, const EngineFlags& engine,
-               const std::string& estimateFrom, Run* run) {
+               bool fromPreview, Run* run) {
   provider.ResetRayCounts();
   auto t0 = std::chrono::steady_clock::now();
   QualityGoal goal;
   Status st;
-  bool judged = false;
-  if (QualityGoalOf(engine, &goal) && TracerPreviewApplies(provider, options, engine, estimateFrom, &run->validationWhy)) {
+  if (fromPreview && QualityGoalOf(engine, &goal)) {
     TracerPreviewRun preview;
     QualityReport report;
-    st = ReconstructFromTracerPreview(provider, options, goal, estimateFrom, &run->rec, &report, &preview, &judged,
-                                      &run->validationWhy);
-    if (st.ok() && judged) {
+    bool judged = false;
+    std::string why;
+    st = ReconstructFromTracerPreview(provider, options, goal, &run->rec, &report, &preview, &judged, &why);
+    if (st.ok() && !judged) st = Status::Error("--estimate-from preview: " + why);
+    if (st.ok()) {
       run->quality = std::move(report);
       run->preview = std::move(preview);
-    } else if (st.ok() && estimateFrom == "preview") {
-      st = Status::Error("--estimate-from preview: " + run->validationWhy);
     }
+  } else {
+    st = ReconstructFor(provider, options, engine, &run->rec, &run->quality);
   }
-  if (st.ok() && !judged) st = ReconstructFor(provider, options, engine, &run->rec, &run->quality);
   run->wallS = toolkit::SecondsSince(t0);
   run->rays = provider.rayCounts();
   return st;
@@ -292,11 +291,9 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
               << "engine settings: " << SettingsSummary(options, provider->Capabilities()) << "\n";
   }
   if (IsPartial(f.tiles)) return RunRenderPart(f, scene, options, *provider, progress, outputs);
-  if (std::string why; f.estimateFrom == "preview" &&
-                       !((f.engine.targetPsnr || f.engine.budget) &&
-                         TracerPreviewApplies(*provider, options, f.engine, f.estimateFrom, &why))) {
-    std::cerr << "dcm render: --estimate-from preview: "
-              << (why.empty() ? "judges --target-psnr or --budget, and neither is given" : why) << "\n";
+  const bool fromPreview = f.estimateFrom == "preview";
+  if (std::string why; fromPreview && !TracerPreviewApplies(*provider, options, f.engine, &why)) {
+    std::cerr << "dcm render: --estimate-from preview: " << why << "\n";
     return kExitUsage;
   }
 
@@ -321,26 +318,22 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
     fo.fullEvaluation = true;
     fo.progress = [&](float v, std::string_view stage) { progress.Update(v, "full render: " + std::string(stage)); };
     Run r;
-    if (Status st = RunOnce(*provider, fo, EngineFlags{}, f.estimateFrom, &r); !st.ok()) return Fail(st);
+    if (Status st = RunOnce(*provider, fo, EngineFlags{}, false, &r); !st.ok()) return Fail(st);
     full = std::move(r);
   }
 
   options.progress = [&](float v, std::string_view stage) { progress.Update(v, stage); };
   Run run;
-  if (Status st = RunOnce(*provider, options, f.engine, f.estimateFrom, &run); !st.ok()) return Fail(st);
+  if (Status st = RunOnce(*provider, options, f.engine, fromPreview, &run); !st.ok()) return Fail(st);
   progress.Done();
-  if (f.engine.verbose && run.quality) {
-    const std::string goalName = f.engine.targetPsnr ? "--target-psnr" : "--budget";
-    if (run.preview) {
-      char line[200];
-      std::snprintf(line, sizeof line, "every pixel at 1/%d of the scene's rays, twice: %llu rays, %.2f s, its own "
-                    "noise %.2f dB", kTracerPreviewDivisor,
-                    static_cast<unsigned long long>(run.preview->previewRays.total()), run.preview->previewS,
-                    run.preview->previewPsnr);
-      std::cerr << "render: " << goalName << " judged by the preview's estimate (" << line << ")\n";
-    } else {
-      std::cerr << "render: " << goalName << " judged by validation pixels: " << run.validationWhy << "\n";
-    }
+  if (f.engine.verbose && run.preview) {
+    char line[240];
+    std::snprintf(line, sizeof line, "render: %s judged by the preview's estimate (every pixel at 1/%d of the scene's "
+                  "rays, twice: %llu rays, %.2f s, its own noise %.2f dB)\n",
+                  f.engine.targetPsnr ? "--target-psnr" : "--budget", kTracerPreviewDivisor,
+                  static_cast<unsigned long long>(run.preview->previewRays.total()), run.preview->previewS,
+                  run.preview->previewPsnr);
+    std::cerr << line;
   }
   const Reconstruction& rec = run.rec;
   const ReconstructionStats& stats = rec.stats;
@@ -404,11 +397,8 @@ int RunRender(const RenderFlags& f, CLI::App* app) {
       j["quality"]["preview"] = {{"rays", RaysToJson(run.preview->previewRays)},
                                  {"time_s", run.preview->previewS},
                                  {"noise_psnr", run.preview->previewPsnr},
-                                 {"cost_share", run.preview->costShare},
                                  {"ray_divisor", kTracerPreviewDivisor}};
       toolkit::AddLadderJson(run.preview->ladder, &j["quality"]);
-    } else if (run.quality) {
-      j["quality"]["validation_because"] = run.validationWhy;
     }
     if (!f.preview.empty()) j["preview_transform"] = displayText;
     if (full) {
@@ -501,11 +491,11 @@ Registration reg("render", "Ray trace a scene file (Embree) with DCM: a few perc
                        ->transform(Integer(1, 16))
                        ->group(kGroupQuality);
                    app->add_option("--estimate-from", f->estimateFrom,
-                                   "what judges --target-psnr and --budget: a preview of every pixel at 1/32 of the "
-                                   "scene's rays (its estimate against the converged image; final resolution, "
-                                   "noise-free exact samples), validation pixels traced exactly, or auto (the "
-                                   "preview where it can tell: its own noise under 25 dB)")
-                       ->check(CLI::IsMember({"auto", "preview", "validation"}))
+                                   "what judges --target-psnr and --budget: validation pixels traced exactly, or a "
+                                   "preview of every pixel at 1/32 of the scene's rays (fewer exact pixels and an "
+                                   "estimate that sees every pixel, for the preview's rays and more engine time; "
+                                   "final resolution, noise-free exact samples; docs/QUALITY.md)")
+                       ->check(CLI::IsMember({"preview", "validation"}))
                        ->capture_default_str()
                        ->group(kGroupQuality);
                    app->add_option("--spp", f->spp,

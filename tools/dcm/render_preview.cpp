@@ -1,9 +1,7 @@
 // dcm render's goal judged by a preview of the tracer (render_preview.h).
 #include "render_preview.h"
 
-#include <algorithm>
 #include <chrono>
-#include <cstdio>
 #include <utility>
 #include <vector>
 
@@ -21,21 +19,11 @@ namespace {
 /// until its plan asks for nothing new, and no pixel keeps its preview value.
 constexpr int kTracerMaxRounds = 16;
 
-/// A preview costing more than this share of the full render's rays costs
-/// more than the exact pixels it spares: chosen on the tracer's tuning scenes
-/// (docs/TUNING.md), where below it the goal took fewer rays than with
-/// validation pixels, above it about twice as many.
-constexpr double kMaxPreviewCost = 0.1;
-
-/// The grid the preview's cost is measured on: every 16th pixel each way,
-/// about 0.4 % of the full render's rays.
-constexpr int kCostStride = 16;
-
 }  // namespace
 
 bool TracerPreviewApplies(const embree::EmbreeProvider& provider, const ReconstructionOptions& options,
-                          const EngineFlags& flags, const std::string& estimateFrom, std::string* why) {
-  if (estimateFrom == "validation") *why = "--estimate-from validation";
+                          const EngineFlags& flags, std::string* why) {
+  if (!flags.targetPsnr && !flags.budget) *why = "it judges --target-psnr or --budget, and neither is given";
   else if (flags.method != "dcm") *why = "--method " + flags.method + ": the preview plans dcm's runs";
   else if (options.downsample != 1)
     *why = "supersampling " + std::to_string(options.downsample) + ": the preview estimates at final resolution only";
@@ -49,21 +37,11 @@ bool TracerPreviewApplies(const embree::EmbreeProvider& provider, const Reconstr
 }
 
 Status ReconstructFromTracerPreview(embree::EmbreeProvider& provider, const ReconstructionOptions& options,
-                                    const QualityGoal& goal, const std::string& estimateFrom, Reconstruction* out,
-                                    QualityReport* report, TracerPreviewRun* run, bool* judged, std::string* why) {
+                                    const QualityGoal& goal, Reconstruction* out, QualityReport* report,
+                                    TracerPreviewRun* run, bool* judged, std::string* why) {
   *judged = false;
   const auto t0 = std::chrono::steady_clock::now();
   const embree::RayCounts before = provider.rayCounts();
-  DCM_RETURN_IF_ERROR(provider.PreviewCostShare(kTracerPreviewDivisor, kCostStride, &run->costShare));
-  if (estimateFrom == "auto" && run->costShare > kMaxPreviewCost) {
-    char line[200];
-    std::snprintf(line, sizeof line, "a preview would cost %.1f %% of the full render's rays (measured on every "
-                  "%dth pixel; taken up to %.0f %%: the primary ray, a point light's one shadow ray and a few "
-                  "shadow rays cannot be divided)",
-                  100 * run->costShare, kCostStride, 100 * kMaxPreviewCost);
-    *why = line;
-    return Status::Ok();
-  }
   std::vector<ExactSample> s;
   DCM_RETURN_IF_ERROR(provider.RenderPreview(kTracerPreviewDivisor, &s));
 

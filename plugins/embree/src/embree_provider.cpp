@@ -188,23 +188,6 @@ IntegratorConfig EmbreeProvider::PreviewConfig(int divisor) const {
   return cfg;
 }
 
-Status EmbreeProvider::PreviewCostShare(int divisor, int stride, double* share) {
-  if (divisor < 1 || stride < 1)
-    return Status::Error("embree: preview ray divisor " + std::to_string(divisor) + ", stride " +
-                         std::to_string(stride) + " (each at least 1)");
-  const Integrator preview(*integrator_, PreviewConfig(divisor));
-  RayCounts exact, cheap;
-  for (int y = std::min(stride / 2, workHeight_ - 1); y < workHeight_; y += stride)
-    for (int x = std::min(stride / 2, workWidth_ - 1); x < workWidth_; x += stride) {
-      integrator_->Evaluate(x, y, &exact);
-      preview.Evaluate(x, y, &cheap);
-    }
-  AddCounts(exact);
-  AddCounts(cheap);
-  *share = exact.total() > 0 ? double(cheap.total()) / double(exact.total()) : 1.0;
-  return Status::Ok();
-}
-
 Status EmbreeProvider::RenderPreview(int divisor, std::vector<ExactSample>* out) {
   if (divisor < 1) return Status::Error("embree: preview ray divisor " + std::to_string(divisor) + " (at least 1)");
   const Integrator preview(*integrator_, PreviewConfig(divisor));

@@ -54,10 +54,6 @@ class EmbreeProvider final : public SampleProvider {
   /// their own (not the exact samples'): L, L_i and L_c and the variance of
   /// their mean. Its rays count in rayCounts().
   Status RenderPreview(int divisor, std::vector<ExactSample>* out);
-  /// What RenderPreview(divisor) costs against the full render, in rays,
-  /// measured on the pixels of a grid of `stride` (their centres) traced both
-  /// ways; those rays count in rayCounts().
-  Status PreviewCostShare(int divisor, int stride, double* share);
   /// One exact pixel with its tau (for tests and tools; same bits as Evaluate()).
   PixelRadiance EvaluatePixel(int x, int y);
   /// The guides of one pixel, its primary ray traced alone (for tests: the
