@@ -398,7 +398,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
     if (samples > 0 && previewSamples > 0) so.exactVarianceShare = std::min(1.0, previewSamples / samples);
     assumedShare = so.exactVarianceShare;
     so.measuredExactVarianceShare = [&meter] { return meter.share(); };
-    so.maxRounds = f.pipe.rounds.maxRounds;
+    ApplyRoundFlags(f.pipe.rounds, &so);
     // Fewer samples for the exact pixels where a goal does not need them all
     // (never noisier than the preview: the library's bound on the share), nor,
     // with their variance not weighed, past the noise the regime was chosen for.
@@ -415,11 +415,6 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
         return provider->SetExactSamples(int64_t(samples) >> j);
       };
     }
-    so.correctionRadius = f.pipe.rounds.previewCorrection;
-    so.filterRadius = f.pipe.rounds.previewFilter;
-    so.errorRound = f.pipe.rounds.errorRound;
-    so.planSignificance = f.pipe.rounds.planSignificance;
-    so.minRoundShare = f.pipe.rounds.minRoundShare;
     // A target in dB or a budget is judged by the preview's estimate where the preview can tell.
     const double target = f.pipe.engine.targetPsnr.value_or(defaultGoal ? kDefaultTargetPsnr : 0);
     if (st.ok() && (target > 0 || goalInDb) && f.estimateFrom != "validation") {

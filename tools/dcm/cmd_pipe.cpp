@@ -74,12 +74,7 @@ Status ReconstructOnPreview(pipe::PipeProvider& provider, const ReconstructionOp
   DCM_RETURN_IF_ERROR(provider.FetchPreview({options.textureSplit && caps.splitRadiance, caps.variance}, &preview,
                                             poolRadius, &so.previewOwnVariance, &so.previewTextureCovariance));
   run->previewS = toolkit::SecondsSince(t0);
-  so.maxRounds = f.rounds.maxRounds;
-  so.minRoundShare = f.rounds.minRoundShare;
-  so.correctionRadius = f.rounds.previewCorrection;
-  so.filterRadius = f.rounds.previewFilter;
-  so.errorRound = f.rounds.errorRound;
-  so.planSignificance = f.rounds.planSignificance;
+  ApplyRoundFlags(f.rounds, &so);
   QualityGoal goal;
   if (!QualityGoalOf(f.engine, &goal)) return ReconstructWithPreview(provider, *preview, options, so, rec, &run->sched);
   so.minRoundShare = 0;  // the search validates what each run asks for

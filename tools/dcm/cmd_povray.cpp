@@ -211,12 +211,8 @@ int RunPovray(const PovrayFlags& f) {
       // and the estimate would err high.
       povray::PovrayPreview previewProvider(*provider, pw, ph, std::move(Li), std::move(Lc), haveGoal ? -1 : 2);
       PreviewScheduleOptions so;
-      so.maxRounds = f.rounds.maxRounds;
-      so.correctionRadius = f.rounds.previewCorrection;
-      so.filterRadius = f.rounds.previewFilter;
-      so.errorRound = f.rounds.errorRound;
-      so.planSignificance = f.rounds.planSignificance;
-      so.minRoundShare = haveGoal ? 0 : f.rounds.minRoundShare;  // the search validates what each run asks for
+      ApplyRoundFlags(f.rounds, &so);
+      if (haveGoal) so.minRoundShare = 0;  // the search validates what each run asks for
       if (haveGoal) {
         // Each run of the search in two rounds at most: its validation pixels go
         // with its first; pixels left at their preview value after one round

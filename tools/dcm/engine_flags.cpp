@@ -248,6 +248,15 @@ void AddRoundFlags(CLI::App* app, RoundFlags* f) {
       ->capture_default_str();
 }
 
+void ApplyRoundFlags(const RoundFlags& f, PreviewScheduleOptions* so) {
+  so->maxRounds = f.maxRounds;
+  so->minRoundShare = f.minRoundShare;
+  so->correctionRadius = f.previewCorrection;
+  so->filterRadius = f.previewFilter;
+  so->errorRound = f.errorRound;
+  so->planSignificance = f.planSignificance;
+}
+
 Status ScheduleFor(const RoundFlags& flags, const RoundCost& cost, bool previewAvailable, RoundSchedule* out) {
   if (flags.schedule == "auto") {
     *out = previewAvailable ? ChooseSchedule(cost, flags.maxRounds) : RoundSchedule::kLevels;

@@ -78,6 +78,10 @@ struct RoundFlags {
 /// and --plan-significance (help group "Rounds").
 void AddRoundFlags(CLI::App* app, RoundFlags* flags);
 
+/// Sets the preview schedule's rounds, minRoundShare, correctionRadius,
+/// filterRadius, errorRound and planSignificance as the flags say.
+void ApplyRoundFlags(const RoundFlags& flags, PreviewScheduleOptions* schedule);
+
 /// The schedule the flags select for a renderer whose rounds cost `cost`:
 /// the one named, or with "auto" ChooseSchedule(cost); kPreview only where
 /// `previewAvailable` (a preview asked for without one is an error naming --schedule).

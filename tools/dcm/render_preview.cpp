@@ -72,13 +72,9 @@ Status ReconstructFromTracerPreview(embree::EmbreeProvider& provider, const Reco
   ImagePreviewProvider preview(W, H, W, H, std::move(L), std::move(Li), std::move(Lc), std::move(pooled));
 
   PreviewScheduleOptions so;
-  const RoundFlags rounds;  // the renderers' defaults (docs/TUNING.md), not chosen on the tracer
+  ApplyRoundFlags(RoundFlags{}, &so);  // the renderers' defaults (docs/TUNING.md), not chosen on the tracer
   so.maxRounds = kTracerMaxRounds;
   so.minRoundShare = 0;
-  so.correctionRadius = rounds.previewCorrection;
-  so.filterRadius = rounds.previewFilter;
-  so.errorRound = rounds.errorRound;
-  so.planSignificance = rounds.planSignificance;
   so.previewOwnVariance = std::move(own);
   run->previewPsnr = PreviewNoisePsnr(preview, so.previewOwnVariance);
   run->previewRays = provider.rayCounts().Since(before);

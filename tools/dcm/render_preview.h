@@ -1,6 +1,7 @@
 // dcm render's --target-psnr and --budget judged by a preview of the tracer:
 // every pixel traced with a few of the scene's rays, whose estimate of the
-// result's error costs no exact pixel (docs/QUALITY.md, "The tracer's preview").
+// result's error costs no exact pixel (docs/QUALITY.md, "A goal judged by the
+// tracer's preview").
 #pragma once
 
 #include <string>
