@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "dcm/downsample.h"
+#include "dcm/noise_estimate.h"
 #include "dcm/preview_pooling.h"
 #include "elapsed.h"
 #include "planning_provider.h"
@@ -375,6 +376,30 @@ Status ImagePreviewProvider::Evaluate(std::span<const Point2i> pixels, const Sam
     if (what.variance && !variance_.empty()) s.variance = at(variance_);
   }
   return Status::Ok();
+}
+
+std::unique_ptr<SampleProvider> PreviewFromSamples(std::span<const ExactSample> samples, int width, int height,
+                                                   bool split, bool variance, const GuideImage& ids,
+                                                   int varianceRadius, std::vector<RGB>* ownVariance) {
+  std::vector<RGB> L(samples.size()), Li, Lc, var;
+  if (split) {
+    Li.resize(samples.size());
+    Lc.resize(samples.size());
+  }
+  if (variance) var.resize(samples.size());
+  for (size_t i = 0; i < samples.size(); ++i) {
+    L[i] = samples[i].L;
+    if (split) {
+      Li[i] = samples[i].Li;
+      Lc[i] = samples[i].Lc;
+    }
+    if (variance) var[i] = samples[i].variance;
+  }
+  if (ownVariance) *ownVariance = var;
+  if (variance && varianceRadius > 0)
+    var = SurfaceWindowRelativeMean(var, L, width, height, ids.objectId, ids.shaderId, varianceRadius);
+  return std::make_unique<ImagePreviewProvider>(width, height, width, height, std::move(L), std::move(Li),
+                                                std::move(Lc), std::move(var));
 }
 
 }  // namespace dcm

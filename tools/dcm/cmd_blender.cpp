@@ -312,9 +312,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
       provider->Capabilities().variance &&
       (f.variance == "on" || (f.variance == "auto" && (f.pipe.engine.TargetsRender() || noisePsnr < kNoisyPsnr)));
   // The variance is pooled over the elementary block of the noisy regime.
-  ProviderCapabilities noisyCaps = provider->Capabilities();
-  noisyCaps.variance = true;
-  const int poolRadius = ResolveSettings(options, noisyCaps).elementaryBlock;
+  const int poolRadius = VariancePoolRadius(options, provider->Capabilities());
   ExactNoiseMeter meter(*provider);
   PooledVarianceProvider pooled(meter, poolRadius, useVariance);
   const ProviderCapabilities caps = pooled.Capabilities();
@@ -506,11 +504,7 @@ int RunFrame(const BlenderFlags& f, int frame, const std::string& output, const 
                   << "decibels), and no result from these samples is closer than the render: more --samples raise "
                   << "both\n";
     } else if (st.ok() && haveGoal) {
-      so.minRoundShare = 0;  // the search validates what each run asks for
-      // Each run of the search in two rounds at most: its validation pixels go
-      // with its first; pixels left at their preview value after one round
-      // carry errors few validation pixels see (docs/QUALITY.md).
-      so.maxRounds = std::min(f.pipe.rounds.maxRounds, 2);
+      LimitRoundsForValidation(&so);
       QualityReport report;
       const auto tq = Clock::now();
       st = ReconstructToQualityWithPreview(timed, *preview, options, goal, so, &rec, &report, &qrounds);

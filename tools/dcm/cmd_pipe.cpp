@@ -65,20 +65,17 @@ struct PreviewRun {
 Status ReconstructOnPreview(pipe::PipeProvider& provider, const ReconstructionOptions& options, const PipeFlags& f,
                             Reconstruction* rec, std::optional<QualityReport>* quality, PreviewRun* run) {
   const ProviderCapabilities caps = provider.Capabilities();
-  ProviderCapabilities noisy = caps;
-  noisy.variance = true;
-  const int poolRadius = ResolveSettings(options, noisy).elementaryBlock;
   PreviewScheduleOptions so;
   std::unique_ptr<SampleProvider> preview;
   const auto t0 = std::chrono::steady_clock::now();
   DCM_RETURN_IF_ERROR(provider.FetchPreview({options.textureSplit && caps.splitRadiance, caps.variance}, &preview,
-                                            poolRadius, &so.previewOwnVariance, &so.previewTextureCovariance));
+                                            VariancePoolRadius(options, caps), &so.previewOwnVariance,
+                                            &so.previewTextureCovariance));
   run->previewS = toolkit::SecondsSince(t0);
   ApplyRoundFlags(f.rounds, &so);
   QualityGoal goal;
   if (!QualityGoalOf(f.engine, &goal)) return ReconstructWithPreview(provider, *preview, options, so, rec, &run->sched);
-  so.minRoundShare = 0;  // the search validates what each run asks for
-  so.maxRounds = std::min(f.rounds.maxRounds, 2);
+  LimitRoundsForValidation(&so);
   QualityReport report;
   DCM_RETURN_IF_ERROR(ReconstructToQualityWithPreview(provider, *preview, options, goal, so, rec, &report, &run->goal));
   *quality = std::move(report);

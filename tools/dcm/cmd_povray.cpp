@@ -212,12 +212,8 @@ int RunPovray(const PovrayFlags& f) {
       povray::PovrayPreview previewProvider(*provider, pw, ph, std::move(Li), std::move(Lc), haveGoal ? -1 : 2);
       PreviewScheduleOptions so;
       ApplyRoundFlags(f.rounds, &so);
-      if (haveGoal) so.minRoundShare = 0;  // the search validates what each run asks for
       if (haveGoal) {
-        // Each run of the search in two rounds at most: its validation pixels go
-        // with its first; pixels left at their preview value after one round
-        // carry errors few validation pixels see (docs/QUALITY.md).
-        so.maxRounds = std::min(f.rounds.maxRounds, 2);
+        LimitRoundsForValidation(&so);
         QualityReport report;
         st = ReconstructToQualityWithPreview(*provider, previewProvider, options, goal, so, &rec, &report, &qrounds);
         if (st.ok()) quality = std::move(report);

@@ -1,5 +1,6 @@
 #include "engine_flags.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -255,6 +256,16 @@ void ApplyRoundFlags(const RoundFlags& f, PreviewScheduleOptions* so) {
   so->filterRadius = f.previewFilter;
   so->errorRound = f.errorRound;
   so->planSignificance = f.planSignificance;
+}
+
+void LimitRoundsForValidation(PreviewScheduleOptions* so) {
+  so->maxRounds = std::min(so->maxRounds, 2);
+  so->minRoundShare = 0;
+}
+
+int VariancePoolRadius(const ReconstructionOptions& options, ProviderCapabilities caps) {
+  caps.variance = true;
+  return ResolveSettings(options, caps).elementaryBlock;
 }
 
 Status ScheduleFor(const RoundFlags& flags, const RoundCost& cost, bool previewAvailable, RoundSchedule* out) {

@@ -82,6 +82,17 @@ void AddRoundFlags(CLI::App* app, RoundFlags* flags);
 /// filterRadius, errorRound and planSignificance as the flags say.
 void ApplyRoundFlags(const RoundFlags& flags, PreviewScheduleOptions* schedule);
 
+/// The schedule of ReconstructToQualityWithPreview's runs: each in two rounds
+/// at most (its validation pixels go with its first; pixels left at their
+/// preview value after one round carry errors few validation pixels see,
+/// docs/QUALITY.md), and no round skipped for being small (the search
+/// validates what each run asks for).
+void LimitRoundsForValidation(PreviewScheduleOptions* schedule);
+
+/// The radius a preview's or an exact pixel's variance is pooled over: the
+/// elementary block of the noisy regime with `options` on `caps`.
+int VariancePoolRadius(const ReconstructionOptions& options, ProviderCapabilities caps);
+
 /// The schedule the flags select for a renderer whose rounds cost `cost`:
 /// the one named, or with "auto" ChooseSchedule(cost); kPreview only where
 /// `previewAvailable` (a preview asked for without one is an error naming --schedule).

@@ -2,11 +2,10 @@
 #include "render_preview.h"
 
 #include <chrono>
-#include <utility>
+#include <memory>
 #include <vector>
 
 #include "common/elapsed.h"
-#include "dcm/noise_estimate.h"
 #include "dcm/preview_correction.h"
 #include "dcm/reconstructor.h"
 #include "dcm/round_schedule.h"
@@ -46,42 +45,22 @@ Status ReconstructFromTracerPreview(embree::EmbreeProvider& provider, const Reco
   DCM_RETURN_IF_ERROR(provider.RenderPreview(kTracerPreviewDivisor, &s));
 
   const ProviderCapabilities caps = provider.Capabilities();
-  const int W = caps.width, H = caps.height;
-  std::vector<RGB> L(s.size()), Li, Lc, own(s.size());
-  if (caps.splitRadiance) {
-    Li.resize(s.size());
-    Lc.resize(s.size());
-  }
-  for (size_t i = 0; i < s.size(); ++i) {
-    L[i] = s[i].L;
-    own[i] = s[i].variance;
-    if (caps.splitRadiance) {
-      Li[i] = s[i].Li;
-      Lc[i] = s[i].Lc;
-    }
-  }
-  // Two estimates give each pixel's variance one degree of freedom: pooled
-  // over its surface within the noisy regime's elementary block, as dcm
-  // blender's preview is.
-  ProviderCapabilities noisy = caps;
-  noisy.variance = true;
-  const int poolRadius = ResolveSettings(options, noisy).elementaryBlock;
   GuideImage ids;
-  DCM_RETURN_IF_ERROR(provider.Guides(Bounds2i{{0, 0}, {W, H}}, {true, true, false, false}, &ids));
-  std::vector<RGB> pooled = SurfaceWindowRelativeMean(own, L, W, H, ids.objectId, ids.shaderId, poolRadius);
-  ImagePreviewProvider preview(W, H, W, H, std::move(L), std::move(Li), std::move(Lc), std::move(pooled));
-
+  DCM_RETURN_IF_ERROR(
+      provider.Guides(Bounds2i{{0, 0}, {caps.width, caps.height}}, {true, true, false, false}, &ids));
   PreviewScheduleOptions so;
+  const std::unique_ptr<SampleProvider> preview =
+      PreviewFromSamples(s, caps.width, caps.height, caps.splitRadiance, true, ids,
+                         VariancePoolRadius(options, caps), &so.previewOwnVariance);
   ApplyRoundFlags(RoundFlags{}, &so);  // the renderers' defaults (docs/TUNING.md), not chosen on the tracer
   so.maxRounds = kTracerMaxRounds;
   so.minRoundShare = 0;
-  so.previewOwnVariance = std::move(own);
-  run->previewPsnr = PreviewNoisePsnr(preview, so.previewOwnVariance);
+  run->previewPsnr = PreviewNoisePsnr(*preview, so.previewOwnVariance);
   run->previewRays = provider.rayCounts().Since(before);
   run->previewS = toolkit::SecondsSince(t0);
-  if (!CanTargetFromPreview(preview, so, why)) return Status::Ok();
+  if (!CanTargetFromPreview(*preview, so, why)) return Status::Ok();
   *judged = true;
-  return ReconstructToTargetFromPreview(provider, preview, options, goal, so, out, report, &run->ladder);
+  return ReconstructToTargetFromPreview(provider, *preview, options, goal, so, out, report, &run->ladder);
 }
 
 }  // namespace dcm::cli

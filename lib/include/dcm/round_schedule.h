@@ -6,6 +6,8 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -210,5 +212,17 @@ class ImagePreviewProvider : public SampleProvider {
   int workWidth_, workHeight_, previewWidth_, previewHeight_;
   std::vector<RGB> L_, Li_, Lc_, variance_;
 };
+
+/// A preview of a whole width x height working image from its stand-in
+/// `samples` (row-major): an ImagePreviewProvider at the same resolution with
+/// L, L_i and L_c where `split`, and where `variance` the samples' variance,
+/// pooled over each pixel's surface (SurfaceWindowRelativeMean over the
+/// object and shader IDs of `ids`, radius `varianceRadius`; 0: not pooled):
+/// one pixel's variance from two halves has a degree of freedom or two.
+/// `ownVariance` (if given): each pixel's own, not pooled (empty without
+/// `variance`), for PreviewScheduleOptions::previewOwnVariance.
+std::unique_ptr<SampleProvider> PreviewFromSamples(std::span<const ExactSample> samples, int width, int height,
+                                                   bool split, bool variance, const GuideImage& ids,
+                                                   int varianceRadius, std::vector<RGB>* ownVariance = nullptr);
 
 }  // namespace dcm
