@@ -1,6 +1,7 @@
 // A small DCM render with the engine against the full render of the same scene.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -115,6 +116,62 @@ TEST(DcmRender, ShadowGuideFindsShadowsSmallerThanTheLattice) {
   // it (the image is otherwise a smooth gradient). 10 dB is a fraction of
   // the gap.
   EXPECT_GT(psnr[1], psnr[0] + 10.0);
+}
+
+// Shiny balls under a small light: each shows a highlight a few pixels
+// across, inside blocks whose corners see only the balls' smooth shading.
+// Without the highlight guide and without probes (what the tracer did when
+// it claimed every small feature guided) the lattice interpolates over them;
+// with it (render.highlight_guide) a highlight is a surface of its own and is
+// refined like a thin object, with no probe.
+TEST(DcmRender, HighlightGuideFindsHighlightsSmallerThanTheLattice) {
+  auto scene = [](bool guide) {
+    std::string balls;
+    for (double x : {-1.2, -0.4, 0.4, 1.2})
+      for (double z : {-0.8, 0.0, 0.8})
+        balls += R"(, {"type": "sphere", "material": "shiny", "radius": 0.3, "center": [)" + std::to_string(x) +
+                 ", 0.3, " + std::to_string(z) + "]}";
+    return std::string(R"({
+      "camera": {"position": [0, 4, 2.5], "look_at": [0, 0, 0], "fov": 45, "resolution": [96, 96]},
+      "render": {"shadow_rays": 16, "highlight_guide": )") + (guide ? "true" : "false") + R"(},
+      "materials": {"floor": {"type": "diffuse", "color": 0.5},
+                    "shiny": {"type": "plastic", "color": [0.1, 0.3, 0.6], "specular": 0.5, "exponent": 300}},
+      "objects": [
+        {"type": "quad", "material": "floor", "origin": [-3, 0, 3], "edge_u": [6, 0, 0], "edge_v": [0, 0, -6]})" +
+           balls + R"(
+      ],
+      "lights": [{"type": "rect", "origin": [-0.1, 4, 1.0], "edge_u": [0.2, 0, 0], "edge_v": [0, 0, 0.2], "radiance": 300}]
+    })";
+  };
+  int highlights[2] = {0, 0}, kept[2] = {0, 0};
+  for (bool guide : {false, true}) {
+    auto p = MakeProvider(scene(guide));
+    ASSERT_TRUE(p);
+    ASSERT_EQ(p->effects().highlightGuide, guide);
+    // No point light: with the guide nothing small is left for a probe.
+    EXPECT_EQ(p->Capabilities().hardShadowsGuided, guide);
+    ReconstructionOptions o = Options(*p);
+    o.smoothRefinement = SmoothRefinement::kNever;
+    Reconstruction dcm, full;
+    ASSERT_TRUE(Reconstruct(*p, o, &dcm).ok());
+    o.fullEvaluation = true;
+    ASSERT_TRUE(Reconstruct(*p, o, &full).ok());
+    // A highlight pixel: brighter than the light's diffuse share gives any
+    // pixel here; kept: within 10 % of the full render (a pixel interpolated
+    // over its highlight loses most of it).
+    for (size_t i = 0; i < full.image.size(); ++i) {
+      const float f = full.image[i].r + full.image[i].g + full.image[i].b;
+      const float d = dcm.image[i].r + dcm.image[i].g + dcm.image[i].b;
+      if (f <= 3.f) continue;
+      ++highlights[guide];
+      kept[guide] += std::abs(d - f) < 0.1f * f;
+    }
+    ASSERT_GT(highlights[guide], 12) << "no highlights in the full render";
+    std::printf("highlight guide %s: %d of %d highlight pixels kept, %.1f %% exact pixels\n", guide ? "on" : "off",
+                kept[guide], highlights[guide], 100.0 * dcm.stats.exactFraction());
+  }
+  ASSERT_LT(kept[0], highlights[0]) << "the lattice kept every highlight without the guide: the scene tests nothing";
+  EXPECT_EQ(kept[1], highlights[1]);
 }
 
 TEST(DcmRender, TextureSplitSavesExactSamples) {

@@ -181,6 +181,44 @@ TEST(Effects, ShadowGuideOnlyWithPointLightsAndByDefaultOnlyForMonteCarloPixels)
   }
 }
 
+// The highlight guide (render.highlight_guide): on wherever a used material
+// is plastic, off with false or without one; it traces no ray, and only with
+// it does the tracer tell the engine that its guides show every small feature.
+TEST(Effects, HighlightGuideOnlyWithPlasticAndTracesNoRay) {
+  const char* plastic =
+      R"({"floor": {"type": "diffuse"}, "ball": {"type": "plastic", "exponent": 20}, "block": {"type": "diffuse"}})";
+  const char* unused = R"({"floor": {"type": "diffuse"}, "ball": {"type": "diffuse"}, "block": {"type": "diffuse"},
+                          "unused": {"type": "plastic"}})";
+  struct Case {
+    const char* materials;
+    const char* render;
+    bool on;
+  } cases[] = {
+      {plastic, R"({"shadow_rays": 4})", true},
+      {plastic, R"({"shadow_rays": 4, "glossy_rays": 0})", true},  // highlights of light samples alone
+      {plastic, R"({"shadow_rays": 4, "highlight_guide": false})", false},
+      {unused, R"({"shadow_rays": 4})", false},
+      {kDiffuse, R"({"shadow_rays": 4, "highlight_guide": true})", false},
+  };
+  for (const Case& c : cases) {
+    auto p = MakeProvider(SceneJson(c.materials, c.render));
+    ASSERT_TRUE(p) << c.render;
+    EXPECT_EQ(p->effects().highlightGuide, c.on) << c.materials << c.render;
+    const bool plasticUsed = c.materials == plastic;
+    EXPECT_EQ(p->Capabilities().hardShadowsGuided, !plasticUsed || c.on) << c.materials << c.render;
+    p->ResetRayCounts();
+    GuideImage g;
+    GuideRequest req;
+    req.objectId = req.shaderId = true;
+    ASSERT_TRUE(p->Guides({{0, 0}, {p->workWidth(), p->workHeight()}}, req, &g).ok());
+    EXPECT_EQ(p->rayCounts().guide, uint64_t(32 * 32)) << c.render;  // the camera rays alone
+  }
+  Scene scene;
+  const Status st = testing::Parse(SceneJson(kDiffuse, R"({"highlight_guide": "auto"})"), &scene);
+  EXPECT_FALSE(st.ok());
+  EXPECT_NE(st.message().find("render.highlight_guide"), std::string::npos) << st.message();
+}
+
 TEST(Effects, ShadowGuideRejectsOtherValues) {
   Scene scene;
   const Status st = testing::Parse(SceneJson(kDiffuse, R"({"shadow_guide": "yes"})"), &scene);

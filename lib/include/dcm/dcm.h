@@ -82,8 +82,9 @@ enum {
   DCM_SAMPLE_SPLIT = 2,
   /** Every hard shadow of the scene shows in the guides: the scene has no
    *  point or directional light, or the IDs set carry a shadow guide (lit and
-   *  unlit pixels of a surface have different IDs). Smooth blocks then get
-   *  no centre probe. */
+   *  unlit pixels of a surface have different IDs); and, where a material has
+   *  highlights, so does every highlight. Smooth blocks then get no centre
+   *  probe. */
   DCM_SAMPLE_HARD_SHADOWS_GUIDED = 4
 };
 

@@ -27,11 +27,13 @@ struct ProviderCapabilities {
   bool variance = false;       ///< samples carry the variance of their estimate of L
   /// Every hard shadow of the scene shows in the guides: the scene has no
   /// point or directional light, or the guides mark where such a light's
-  /// visibility changes (a shadow guide folded into the IDs). Then a smooth
-  /// block of samples that are not noisy needs no centre probe
-  /// (SmoothRefinement::kCentreProbe, ResolvedSettings::smoothRefinement): what the probe
-  /// finds between a block's corners is a shadow smaller than the block,
-  /// and the guides show those.
+  /// visibility changes (a shadow guide folded into the IDs); and so does
+  /// every highlight where the provider knows the scene has any (the
+  /// tracer's highlight guide). Then a smooth block of samples that are not
+  /// noisy needs no centre probe (SmoothRefinement::kCentreProbe,
+  /// ResolvedSettings::smoothRefinement): what the probe finds between a
+  /// block's corners is a shadow or a highlight smaller than the block, and
+  /// the guides show those.
   bool hardShadowsGuided = false;
   /// Evaluate() may be called concurrently from several threads on disjoint
   /// batches. Providers that are not thread safe are called from one thread.

@@ -18,6 +18,7 @@ std::vector<std::string> Effects::Names() const {
   if (textures) n.push_back("textures");
   if (indirect) n.push_back("indirect");
   if (shadowGuide) n.push_back("shadow_guide");
+  if (highlightGuide) n.push_back("highlight_guide");
   return n;
 }
 
@@ -65,6 +66,7 @@ Status EmbreeProvider::Create(const Scene& scene, std::unique_ptr<EmbreeProvider
       p->textures_.push_back(std::move(t));
       fx.textures = true;
     }
+    if (used[i] && m.glossy()) fx.plastic = true;
     if (used[i] && m.glossy() && rs.glossyRays > 0) fx.glossy = true;
     if (used[i] && m.kind == MaterialKind::kMirror && rs.mirrorDepth > 0) fx.mirror = true;
     materials.push_back(m);
@@ -81,6 +83,7 @@ Status EmbreeProvider::Create(const Scene& scene, std::unique_ptr<EmbreeProvider
   using SG = RenderSettings::ShadowGuide;
   fx.shadowGuide = fx.pointLights && (rs.shadowGuide == SG::kOn ||
                                       (rs.shadowGuide == SG::kAuto && (rs.samplesPerPixel > 1 || fx.indirect)));
+  fx.highlightGuide = fx.plastic && rs.highlightGuide;
   p->effects_ = fx;
 
   DCM_RETURN_IF_ERROR(EmbreeScene::Build(scene, &p->bvh_));
@@ -97,6 +100,7 @@ Status EmbreeProvider::Create(const Scene& scene, std::unique_ptr<EmbreeProvider
   cfg.seed = rs.seed;
   cfg.background = rs.background;
   cfg.shadowGuide = fx.shadowGuide;
+  cfg.highlightGuide = fx.highlightGuide;
   p->integrator_ = std::make_unique<Integrator>(*p->bvh_, *p->camera_, cfg, std::move(materials), std::move(lights),
                                                 std::move(objectMaterial), std::move(objectId), std::move(lightId));
   *out = std::move(p);
@@ -113,8 +117,9 @@ ProviderCapabilities EmbreeProvider::Capabilities() const {
   c.normal = true;
   c.splitRadiance = effects_.textures;
   c.variance = scene_.render.samplesPerPixel > 1;
-  // Point lights cast the only hard shadows; the shadow guide marks them.
-  c.hardShadowsGuided = !effects_.pointLights || effects_.shadowGuide;
+  // Point lights cast the only hard shadows, the shadow guide marks them;
+  // a highlight between a block's corners is what else a probe would find.
+  c.hardShadowsGuided = (!effects_.pointLights || effects_.shadowGuide) && (!effects_.plastic || effects_.highlightGuide);
   c.threadSafe = true;
   c.name = "embree";
   return c;

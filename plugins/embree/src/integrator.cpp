@@ -368,6 +368,13 @@ PixelGuide Integrator::GuideFromHit(const CameraRay& cr, SurfaceHit h, bool want
           shaders[n - 1] = shaders[n - 1] * 2654435761u + lit;
         }
       }
+      // A highlight smaller than the lattice would hide inside a smooth
+      // block: its footprint is a surface of its own (as the AOV path's
+      // highlight guide; the top bit stays ChainId's).
+      if (cfg_.highlightGuide && InHighlight(h, dir)) {
+        objects[n - 1] ^= 0x05EBCA6Bu;
+        shaders[n - 1] ^= 0x05EBCA6Bu;
+      }
       break;
     }
     Vec3 next = Normalize(Reflect(dir, h.ns));
@@ -398,6 +405,36 @@ uint32_t Integrator::PointLightVisibility(const SurfaceHit& h, RayCounts* counts
     if (Unoccluded(org, r)) lit |= 1u << l;
   }
   return lit;
+}
+
+bool Integrator::InHighlight(const SurfaceHit& h, Vec3 dir) const {
+  const Material& m = materials_[size_t(objectMaterial_[size_t(h.object)])];
+  if (!m.glossy()) return false;
+  const Vec3 org = EmbreeScene::Offset(h.p, h.ng);
+  const Vec3 wr = Normalize(Reflect(dir, h.ns));
+  RGB glossy;
+  auto add = [&](Vec3 toLight, RGB irradianceAtOne) {
+    const float dist = Length(toLight);
+    if (!(dist > 0.f)) return;
+    const Vec3 wi = toLight / dist;
+    const float cosS = Dot(h.ns, wi);
+    if (cosS <= 0.f || Dot(h.ng, wi) <= 0.f) return;
+    glossy += m.specular * irradianceAtOne * (cosS / (dist * dist) * PhongLobe(wr, wi, m.exponent));
+  };
+  constexpr int kGrid = 4;
+  for (const Light& light : lights_) {
+    if (light.kind == LightKind::kPoint) {
+      add(light.position - org, light.intensity);
+      continue;
+    }
+    for (int j = 0; j < kGrid; ++j)
+      for (int i = 0; i < kGrid; ++i) {
+        const Vec3 y = light.PointAt({(float(i) + 0.5f) / kGrid, (float(j) + 0.5f) / kGrid});
+        const float cosL = -Dot(Normalize(y - org), light.normal);
+        if (cosL > 0.f) add(y - org, light.radiance * (cosL * light.area / float(kGrid * kGrid)));
+      }
+  }
+  return glossy.r + glossy.g + glossy.b > kHighlightLevel;
 }
 
 bool Integrator::FacesPointLight(const SurfaceHit& h, Vec3 org, const Light& light, PointLightRay* r) const {

@@ -82,6 +82,7 @@ Status ReadRender(const Json& j, const std::string& file, RenderSettings* s) {
     else
       r.Fail("shadow_guide", "expected true, false or \"auto\", got " + TypeName(*g));
   }
+  r.Bool("highlight_guide", &s->highlightGuide);
   if (const Json* ind = r.Get("indirect"); ind && r.ok()) {
     FieldReader ri(*ind, r.Path("indirect"), file);
     ri.Int("bounces", &s->indirectBounces, false, 0, 16);

@@ -70,7 +70,13 @@ struct IntegratorConfig {
   uint32_t seed = 0;
   RGB background;
   bool shadowGuide = false;  ///< point-light visibility folded into the guides' IDs
+  bool highlightGuide = false;  ///< highlights of plastic surfaces folded into the guides' IDs (InHighlight)
 };
+
+/// R + G + B of a plastic surface's direct glossy light above which a pixel
+/// is in a highlight: the AOV path's default `--highlight-level`, as bright
+/// as mid-grey on the display.
+inline constexpr float kHighlightLevel = 1.5f;
 
 /// Evaluates pixels of the working image. Thread safe: all state is const and
 /// every call seeds its own random numbers from the pixel.
@@ -111,6 +117,11 @@ class Integrator {
   /// Bit l set when point light l (of the first 32) lights `h`: the same
   /// shadow ray as DirectLight's (counted as a guide ray).
   uint32_t PointLightVisibility(const SurfaceHit& h, RayCounts* counts) const;
+  /// True when the direct glossy light that `h` (a plastic surface seen
+  /// along `dir`) reflects towards the eye exceeds kHighlightLevel in
+  /// R + G + B, every light unshadowed (point lights, and rect lights as 4 x 4
+  /// points): a highlight's footprint without a ray or a random number.
+  bool InHighlight(const SurfaceHit& h, Vec3 dir) const;
   /// The shadow ray from `org` (just above `h`) to a point light.
   struct PointLightRay {
     Vec3 wi;           ///< unit, towards the light

@@ -135,6 +135,13 @@ struct RenderSettings {
   /// is a Monte Carlo estimate (samples_per_pixel > 1 or indirect light),
   /// where one ray per point light is cheap beside it.
   enum class ShadowGuide { kAuto, kOn, kOff } shadowGuide = ShadowGuide::kAuto;
+  /// Highlights as a guide: where the direct glossy light of a plastic
+  /// surface (unshadowed, from fixed points of each light) is brighter than
+  /// kHighlightLevel, a highlight and the rest of its surface are different
+  /// surfaces, so that a highlight smaller than the lattice is found like a
+  /// thin object. No ray. true: on wherever a plastic material is used; false:
+  /// off.
+  bool highlightGuide = true;
   RGB background{0.f, 0.f, 0.f}; ///< radiance of rays that leave the scene
 };
 
