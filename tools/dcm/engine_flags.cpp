@@ -294,7 +294,7 @@ std::string SettingsSummary(const ReconstructionOptions& o, const ProviderCapabi
                           : o.downsample >= 2 ? "noisy samples: the supersampled rules are off"
                                               : "final resolution";
   std::string refine(ToString(s.smoothRefinement));
-  if (s.smoothRefinement != o.smoothRefinement) refine += " (the guides show every hard shadow)";
+  if (s.smoothRefinement != o.smoothRefinement) refine += " (the provider's guides show what a probe would find)";
   return std::string("contrast ") + std::string(ToString(s.contrastMetric)) + ", threshold " + threshold + ", " +
          std::to_string(s.directions) + " directions, thin-object test " + std::string(ToString(s.thinObjects)) +
          ", crossing fill " + std::to_string(s.crossingFillReach) + " (" + why + "); smooth blocks: " + refine;

@@ -138,7 +138,7 @@ std::string QualityWarning(const QualityReport& report, const EngineFlags& flags
 /// provider, as the engine will use them on a provider with `caps`
 /// ("contrast display-weighted, threshold 0.15, 16 directions, thin-object test
 /// none-matches, crossing fill 2 (supersampled rules: --downsample 2);
-/// smooth blocks: never (the guides show every hard shadow)").
+/// smooth blocks: never (the provider's guides show what a probe would find)").
 std::string SettingsSummary(const ReconstructionOptions& options, const ProviderCapabilities& caps);
 
 }  // namespace dcm::cli
