@@ -34,7 +34,8 @@ constexpr double kPredictMarginDb = 1;
 constexpr double kPlateauDb = 0.1;
 /// With a budget, the share of what is left that a run's plan on the preview
 /// may ask for: its later rounds add the pixels whose choice the exact values
-/// changed (on the tuning room at 512 spp, 2.4 % of the first round's).
+/// changed (on the tuning room at 512 spp, 2.4 % of the first round's). Where
+/// it does not hold the coarsest plan, the first run may take all of it.
 constexpr double kPlanShare = 0.9;
 /// The thresholds a budget chooses from, and the plans (engine runs on the
 /// preview, no pixel rendered) its bisection in log threshold may make: 10
@@ -186,13 +187,18 @@ Status ReconstructToTargetFromPreview(SampleProvider& exact, SampleProvider& pre
         if (planned > allowed) {
           const double coarser = s.thresholds.empty() ? std::max(kMaxThreshold, threshold) : s.thresholds.back();
           bool fits = false;
+          const double from = threshold;
           DCM_RETURN_IF_ERROR(
-              FitThreshold(planning, o, threshold, coarser, allowed, &s.timeEngineS, &threshold, &fits));
+              FitThreshold(planning, o, from, coarser, allowed, &s.timeEngineS, &threshold, &fits));
+          // The first run may take the whole budget where its share does not
+          // hold the coarsest plan: later rounds stop at the budget, and a
+          // budget a single threshold's run fits is not refused.
+          if (!fits && s.thresholds.empty() && left > allowed)
+            DCM_RETURN_IF_ERROR(FitThreshold(planning, o, from, coarser, left, &s.timeEngineS, &threshold, &fits));
           if (!fits && s.thresholds.empty())
             return Status::Error("--budget " + Num(goal.budget) + ": below what the coarsest reconstruction "
                                  "needs (at threshold " + Num(coarser) + " the plan on the preview asks for more "
-                                 "than " + std::to_string(allowed) + " of the " +
-                                 std::to_string(schedule.maxExactPixels) + " pixels the budget allows)");
+                                 "than the " + std::to_string(left) + " pixels the budget allows)");
           budgetBound = true;
           if (!fits || (!s.thresholds.empty() && threshold >= s.thresholds.back())) break;
         }

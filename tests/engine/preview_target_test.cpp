@@ -13,6 +13,7 @@
 
 #include "dcm/preview_correction.h"
 #include "dcm/preview_target.h"
+#include "planning_provider.h"
 #include "run_helpers.h"
 
 namespace dcm::testing {
@@ -533,6 +534,53 @@ TEST(PreviewTarget, ABudgetBelowTheCoarsestPlanIsAnErrorBeforeAnyPixelIsRendered
   render.targetRender = true;
   render.budget = 0.1;
   EXPECT_FALSE(ReconstructToTargetFromPreview(exact, preview, Options(), render, {}, &r, &report).ok());
+}
+
+TEST(PreviewTarget, ABudgetThatHoldsTheCoarsestPlanButNotItsShareIsSpentNotRefused) {
+  // The coarsest plan (threshold 16, on the preview): a budget between it and
+  // it over 0.9 (the share a first run's plan may take) is a budget that a
+  // single threshold's run fits; the run takes the whole of it and never
+  // passes it. One pixel fewer than the plan is refused before any render.
+  AnalyticProvider truth(M, M, FurnishedScene(M, M));
+  const std::vector<RGB> ref = truth.FullRender();
+  const double total = double(M) * M;
+  int64_t coarsest = 0;
+  {
+    ImagePreviewProvider preview = NoisyPreview(ref, 0.01f, 10);
+    PlanningProvider planning(truth, preview);
+    ReconstructionOptions o = Options();
+    o.contrastThreshold = 16.f;
+    Reconstruction dry;
+    double engineS = 0;
+    ASSERT_TRUE(Plan(planning, o, &dry, &coarsest, &engineS).ok());
+  }
+  ASSERT_GT(coarsest, 0);
+  // 5 % above the plan: its share, 0.945 of the plan, holds less than the plan.
+  const int64_t pixels = coarsest + int64_t(0.05 * double(coarsest));
+  ASSERT_LT(0.9 * double(pixels), double(coarsest));
+  for (int64_t budgetPixels : {pixels, coarsest - 1}) {
+    ImagePreviewProvider preview = NoisyPreview(ref, 0.01f, 10);
+    CountingProvider exact(truth);
+    Reconstruction r;
+    QualityReport report;
+    // The budget as a fraction whose pixels round down to budgetPixels.
+    const double budget = (double(budgetPixels) + 0.5) / total;
+    const Status s = ReconstructToTargetFromPreview(exact, preview, Options(), Goal(0, budget), {}, &r, &report);
+    std::printf("coarsest plan %lld pixels, budget %lld: %s, %lld exact\n", static_cast<long long>(coarsest),
+                static_cast<long long>(budgetPixels), s.ok() ? "spent" : s.message().c_str(),
+                static_cast<long long>(report.exactPixels));
+    if (budgetPixels < coarsest) {
+      EXPECT_FALSE(s.ok());
+      EXPECT_NE(s.message().find("--budget"), std::string::npos) << s.message();
+      EXPECT_EQ(exact.calls, 0);
+      continue;
+    }
+    ASSERT_TRUE(s.ok()) << s.message();
+    EXPECT_LE(exact.pixelsAsked, budgetPixels);
+    EXPECT_LE(report.exactPixels, budgetPixels);
+    EXPECT_GE(report.exactPixels, coarsest) << "the coarsest plan's first round is rendered";
+    EXPECT_TRUE(report.budgetBound);
+  }
 }
 
 TEST(PreviewTarget, APreviewThatCannotTellIsRefusedWithTheReason) {

@@ -94,8 +94,9 @@ double RenderPsnrFromPreview(SampleProvider& preview, const PreviewScheduleOptio
 /// the first add the pixels whose choice the exact values changed. With a
 /// target, the ladder's run that would pass that share is bisected the same
 /// way between its threshold and the one before, and ends the ladder
-/// (`report->budgetBound`). A budget below the plan at threshold 16 is an error
-/// naming --budget, before any pixel is rendered.
+/// (`report->budgetBound`). Where 0.9 of the budget does not hold even the
+/// plan at threshold 16, the first run may take the whole budget; a budget
+/// below that plan is an error naming --budget, before any pixel is rendered.
 ///
 /// `report` is that of ReconstructToQuality (estimate against the converged
 /// image, from the preview: `estimateSource` kPreview, no validation pixels;
