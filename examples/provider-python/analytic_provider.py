@@ -18,6 +18,8 @@ import sys
 import numpy as np
 
 PROTOCOL_VERSION = 1
+# The sd of one preview sample's L_i (--preview-samples).
+PREVIEW_SD = 0.2
 
 
 class ProtocolError(Exception):
@@ -82,9 +84,11 @@ class AnalyticScene:
 class Provider:
     """Serves a scene over the dcm-pipe protocol."""
 
-    def __init__(self, scene, name="analytic-python", noise=0.0, normals=False, round_latency=0.0):
+    def __init__(self, scene, name="analytic-python", noise=0.0, normals=False, round_latency=0.0,
+                 preview_samples=0):
         self.scene = scene
         self.round_latency = round_latency
+        self.preview_samples = preview_samples
         self.name = name
         self.noise = noise
         self.normals = normals
@@ -110,9 +114,12 @@ class Provider:
         caps = ("object_id,shader_id,texture,split" + (",normal" if self.normals else "") +
                 (",variance" if self.noise > 0 else ""))
         cost = ""
-        if self.round_latency > 0:
+        if self.round_latency > 0 or self.preview_samples > 0:
             caps += ",preview"
+        if self.round_latency > 0:
             cost = " round_latency=%g sample_cost=1e-6" % self.round_latency
+        if self.preview_samples > 0:
+            cost += " preview_samples=%d" % self.preview_samples
         return "dcm-pipe %d width=%d height=%d caps=%s name=%s%s\n" % (
             PROTOCOL_VERSION, self.scene.width, self.scene.height, caps, self.name, cost)
 
@@ -165,15 +172,35 @@ class Provider:
         self.batches += 1
 
     def answer_preview(self, tokens, out):
-        """A half-resolution preview: each pixel gets its 2x2 block's top-left value."""
+        """With --preview-samples N, a Monte Carlo preview in miniature: every
+        pixel's L_i with Gaussian noise of sd PREVIEW_SD / sqrt(N), and that
+        variance; else a half-resolution preview: each pixel gets its 2x2
+        block's top-left value."""
         x0, y0, x1, y1 = (int(t) for t in tokens[1:5])
         if not (0 <= x0 < x1 <= self.scene.width and 0 <= y0 < y1 <= self.scene.height):
             raise ProtocolError("preview region outside the image")
-        split = len(tokens) > 5 and "split" in tokens[5].split(",")
+        what = tokens[5].split(",") if len(tokens) > 5 else []
+        split = "split" in what
+        want_variance = "variance" in what
+        if want_variance and not (self.noise > 0 or self.preview_samples > 0):
+            raise ProtocolError("preview: variance asked for, and not announced")
         ys, xs = np.mgrid[y0:y1, x0:x1]
-        L, li, lc = self.scene.radiance(xs.ravel() & ~1, ys.ravel() & ~1)
-        out.write(b"samples %d\n" % xs.size)
-        out.write(np.hstack([L] + ([li, lc] if split else [])).astype("<f4").tobytes())
+        x, y = xs.ravel(), ys.ravel()
+        var = np.zeros((x.size, 3), np.float32)
+        if self.preview_samples > 0:
+            L, li, lc = self.scene.radiance(x, y)
+            tau = self.scene.guides(x, y)[2]
+            sd = PREVIEW_SD / np.sqrt(self.preview_samples)
+            # Another deviate than the exact pixels': the preview's own samples.
+            dev = np.array([np.random.default_rng(int(py) * 65536 + int(px) + (1 << 40)).standard_normal()
+                            for px, py in zip(x, y)], np.float32)[:, None]
+            li = li + sd * dev
+            L = li * tau + lc
+            var = np.full((x.size, 3), sd * sd, np.float32) * tau * tau
+        else:
+            L, li, lc = self.scene.radiance(x & ~1, y & ~1)
+        out.write(b"samples %d\n" % x.size)
+        out.write(np.hstack([L] + ([li, lc] if split else []) + ([var] if want_variance else [])).astype("<f4").tobytes())
 
     def serve(self, inp, out):
         """Answers requests until 'quit' or end of input; returns the exit status."""
@@ -193,7 +220,8 @@ class Provider:
                     self.answer_guides(tokens, out)
                 elif tokens[0] == "eval" and len(tokens) >= 2:
                     self.answer_eval(tokens, inp, out)
-                elif tokens[0] == "preview" and len(tokens) >= 5 and self.round_latency > 0:
+                elif tokens[0] == "preview" and len(tokens) >= 5 and (self.round_latency > 0 or
+                                                                       self.preview_samples > 0):
                     self.answer_preview(tokens, out)
                 else:
                     raise ProtocolError("unknown request %r" % line[:60])
@@ -215,6 +243,9 @@ def main(argv=None):
     ap.add_argument("--normals", action="store_true", help="announce and serve normal guides")
     ap.add_argument("--round-latency", type=float, default=0.0,
                     help="announce this latency per round (seconds) and serve a half-resolution preview")
+    ap.add_argument("--preview-samples", type=int, default=0,
+                    help="serve a noisy full-resolution preview of this many samples per pixel (noise of sd %g "
+                         "over their square root on L_i, with its variance) and announce preview_samples=" % PREVIEW_SD)
     ap.add_argument("--count-file", help="at the end, write the number of evaluated pixels to this file")
     args = ap.parse_args(argv)
     scene = AnalyticScene(args.width, args.height)
@@ -223,7 +254,8 @@ def main(argv=None):
         L, _, _ = scene.radiance(xs.ravel(), ys.ravel())
         L.astype("<f4").tofile(args.truth)
         return 0
-    provider = Provider(scene, noise=args.noise, normals=args.normals, round_latency=args.round_latency)
+    provider = Provider(scene, noise=args.noise, normals=args.normals, round_latency=args.round_latency,
+                        preview_samples=args.preview_samples)
     status = provider.serve(sys.stdin.buffer, sys.stdout.buffer)
     sys.stderr.write("analytic_provider: evaluated %d pixels in %d batches\n" % (provider.evaluated, provider.batches))
     if args.count_file:

@@ -683,7 +683,7 @@ PsnrEstimate EstimatePsnr(const std::vector<double>& d, const std::vector<double
       var += (y - m) * (y - m);
     }
     const double se = std::sqrt(var / (double(n) * double(n - 1)));
-    return {PsnrOf(m), PsnrOf(m + kZ * se), PsnrOf(std::max(0.0, m - kZ * se)), e.effective};
+    return {PsnrOf(m), PsnrOf(std::max(0.0, m) + kZ * se), PsnrOf(std::max(0.0, m - kZ * se)), e.effective};
   }
   if (n == 0 || !(W > 0)) {
     e.psnr = e.low = e.high = kNaN;
@@ -701,7 +701,9 @@ PsnrEstimate EstimatePsnr(const std::vector<double>& d, const std::vector<double
   for (size_t i = 0; i < n; ++i) var += (w[i] / W) * (w[i] / W) * (d[i] - m) * (d[i] - m);
   var *= double(n) / double(n - 1);
   const double se = std::sqrt(var);
-  e.low = PsnrOf(m + kZ * se);
+  // A mean squared error is not negative: where the noise taken out of the
+  // terms (a preview's) leaves a negative mean, the bound is that of 0.
+  e.low = PsnrOf(std::max(0.0, m) + kZ * se);
   e.high = PsnrOf(std::max(0.0, m - kZ * se));
   return e;
 }

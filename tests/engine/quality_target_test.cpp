@@ -54,6 +54,15 @@ TEST(QualityTarget, EstimateOfAConstantErrorIsExact) {
   EXPECT_LT(s.low, s.psnr);
   EXPECT_GT(s.high, s.psnr);
   EXPECT_TRUE(std::isnan(EstimatePsnr({}, {}).psnr));
+  // Noise-corrected errors whose mean is negative: the point estimate is
+  // +inf, its lower bound that of an error of 0 plus the spread, finite
+  // (the spread of these terms is all the estimate knows).
+  for (double total : {0.0, 3.0}) {
+    const PsnrEstimate n = EstimatePsnr({-3e-4, 1e-4, -1e-4}, {1, 1, 1}, total);
+    EXPECT_TRUE(std::isinf(n.psnr)) << total;
+    EXPECT_TRUE(std::isfinite(n.low)) << total;
+    EXPECT_GT(n.low, 30.0) << total;
+  }
 }
 
 TEST(QualityTarget, EffectivePixelsCountThoseThatCarryTheEstimate) {

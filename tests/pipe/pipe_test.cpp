@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "common/image_io.h"
+#include "common/metrics.h"
 #include "dcm/pipe/pipe_provider.h"
 #include "dcm/reconstructor.h"
 #include "dcm/round_schedule.h"
@@ -199,6 +200,16 @@ TEST(PipeProvider, HandshakeCarriesTheRoundCostAndThePreview) {
         Start(std::string("printf 'dcm-pipe 1 width=4 height=3 ") + bad + "\\n'; cat >/dev/null", &p);
     ASSERT_FALSE(st.ok()) << bad;
     EXPECT_TRUE(Contains(st.message(), "must be seconds")) << st.message();
+  }
+  // preview_samples=: a whole number, with the preview it describes.
+  ASSERT_TRUE(Start("printf 'dcm-pipe 1 width=4 height=3 caps=preview preview_samples=16\\n'; cat >/dev/null", &p).ok());
+  EXPECT_EQ(p->previewSamples(), 16);
+  EXPECT_TRUE(p->Finish().ok());
+  for (const char* bad : {"caps=preview preview_samples=-1", "caps=preview preview_samples=1.5", "preview_samples=16"}) {
+    const dcm::Status st =
+        Start(std::string("printf 'dcm-pipe 1 width=4 height=3 ") + bad + "\\n'; cat >/dev/null", &p);
+    ASSERT_FALSE(st.ok()) << bad;
+    EXPECT_TRUE(Contains(st.message(), "preview_samples")) << st.message();
   }
 }
 
@@ -669,6 +680,70 @@ TEST(DcmPipe, ACallThatCostsALatencyIsPlannedOnThePreview) {
             2)
       << log;
   EXPECT_TRUE(Contains(log, "--schedule preview")) << log;
+}
+
+// A child whose preview is its own render at fewer samples (preview_samples=,
+// with its variance) gets a goal judged by the preview's estimate, as `dcm
+// blender` does: no validation pixel, the ladder's first run in one call.
+TEST(DcmPipe, AGoalIsJudgedByAPreviewOfTheSameImageAtFewerSamples) {
+  TempDir dir;
+  const std::string truth = dir / "truth.raw";
+  std::string log;
+  ASSERT_EQ(RunShell(Analytic("--width 192 --height 144 --truth " + truth), &log), 0) << log;
+  std::vector<float> ref(size_t(192 * 144 * 3));
+  std::ifstream tf(truth, std::ios::binary);
+  tf.read(reinterpret_cast<char*>(ref.data()), std::streamsize(ref.size() * 4));
+  ASSERT_TRUE(tf.good());
+  const std::string child = Analytic("--width 192 --height 144 --round-latency 0.5 --preview-samples 64");
+  auto run = [&](const std::string& flags, nlohmann::json* j, double* psnr) {
+    const std::string out = dir / "out.exr", stats = dir / "stats.json";
+    const int rc = RunShell(std::string(DCM_BINARY) + " pipe --quiet --provider-cmd " + Quoted(child) + " -o " + out +
+                                " --stats " + stats + " " + flags,
+                            &log);
+    ASSERT_EQ(rc, 0) << log;
+    std::ifstream js(stats);
+    *j = nlohmann::json::parse(js);
+    int w = 0, h = 0;
+    std::vector<dcm::RGB> img;
+    ASSERT_TRUE(dcm::toolkit::ReadRgb(out, &w, &h, &img).ok());
+    std::vector<dcm::RGB> truthImg(img.size());
+    for (size_t i = 0; i < img.size(); ++i) truthImg[i] = {ref[3 * i], ref[3 * i + 1], ref[3 * i + 2]};
+    *psnr = dcm::toolkit::Compare(img, truthImg, w, h).psnr;
+  };
+  nlohmann::json byPreview, byValidation;
+  double previewPsnr = 0, validationPsnr = 0;
+  run("--target-psnr 45", &byPreview, &previewPsnr);
+  run("--target-psnr 45 --estimate-from validation", &byValidation, &validationPsnr);
+  EXPECT_EQ(byPreview.at("estimated_psnr_from"), "preview");
+  EXPECT_EQ(byValidation.at("estimated_psnr_from"), "validation");
+  EXPECT_TRUE(byPreview.at("quality").at("target_reached").get<bool>());
+  EXPECT_EQ(byPreview.at("quality").at("validation_pixels").get<int64_t>(), 0);
+  EXPECT_FALSE(byPreview.at("quality").at("ladder").empty());
+  // The tolerance: the truth at least the target less 0.5 dB.
+  EXPECT_GE(previewPsnr, 45 - 0.5);
+  // No validation pixels and no second call: fewer of both than the search.
+  EXPECT_LE(byPreview.at("provider_calls").get<int>(), byValidation.at("provider_calls").get<int>());
+  EXPECT_LT(byPreview.at("exact_pixels").get<int64_t>(), byValidation.at("exact_pixels").get<int64_t>());
+  std::printf("by the preview: %.2f dB at %lld exact pixels in %d calls; by validation: %.2f dB at %lld in %d\n",
+              previewPsnr, static_cast<long long>(byPreview.at("exact_pixels").get<int64_t>()),
+              byPreview.at("provider_calls").get<int>(), validationPsnr,
+              static_cast<long long>(byValidation.at("exact_pixels").get<int64_t>()),
+              byValidation.at("provider_calls").get<int>());
+  // A preview of another kind (half resolution, no preview_samples=) cannot judge.
+  EXPECT_EQ(RunShell(std::string(DCM_BINARY) + " pipe --quiet --estimate-from preview --target-psnr 45 --provider-cmd " +
+                         Quoted(Analytic("--width 64 --height 64 --round-latency 0.5")) + " -o " + (dir / "h.exr"),
+                     &log),
+            1)
+      << log;
+  EXPECT_TRUE(Contains(log, "--estimate-from preview") && Contains(log, "preview_samples=")) << log;
+  EXPECT_FALSE(fs::exists(dir / "h.exr"));
+  // Nor without the preview schedule.
+  EXPECT_EQ(RunShell(std::string(DCM_BINARY) + " pipe --quiet --estimate-from preview --schedule levels "
+                         "--target-psnr 45 --provider-cmd " + Quoted(child) + " -o " + (dir / "l.exr"),
+                     &log),
+            2)
+      << log;
+  EXPECT_TRUE(Contains(log, "--estimate-from preview")) << log;
 }
 
 TEST(DcmPipe, FullEvaluationAsksForEveryPixel) {

@@ -25,6 +25,7 @@
 #include "common/summary.h"
 #include "common/tiles.h"
 #include "dcm/pipe/pipe_provider.h"
+#include "dcm/preview_target.h"
 #include "dcm/quality_preview.h"
 #include "dcm/reconstructor.h"
 #include "dcm/round_schedule.h"
@@ -52,29 +53,64 @@ namespace {
 
 /// What the preview schedule did.
 struct PreviewRun {
+  PreviewTargetStats ladder;   ///< a goal judged by the preview
+  bool judgedByPreview = false;
   PreviewScheduleStats sched;  ///< without a goal
   QualityRoundStats goal;      ///< with one
   double previewS = 0;         ///< fetching the preview
 };
 
+/// Why the preview cannot judge the goal of `f` (empty: it can, as far as
+/// the flags and the handshake tell; CanTargetFromPreview asks its noise).
+std::string PreviewCannotJudge(const pipe::PipeProvider& provider, const ReconstructionOptions& options,
+                               const PipeFlags& f) {
+  if (f.engine.TargetsRender()) return "--target-psnr render: validation pixels judge the render's own noise";
+  if (!f.engine.targetPsnr && !f.engine.budget) return "it judges --target-psnr or --budget, and neither is given";
+  if (provider.previewSamples() <= 0)
+    return "the provider did not announce preview_samples= (a preview of the same image at fewer samples, "
+           "with its variance; plugins/pipe/PROTOCOL.md)";
+  if (provider.Capabilities().variance)
+    return "the exact samples are noisy, and validation pixels judge them against the converged image";
+  if (options.downsample != 1) return "--downsample: the preview estimates at final resolution only";
+  if (f.engine.method != "dcm") return "--method " + f.engine.method + ": the preview plans dcm's runs";
+  if (f.rounds.previewCorrection < 1) return "--preview-correction 0: the correction makes the estimate";
+  return "";
+}
+
 /// Reconstructs on the provider's preview (RoundSchedule::kPreview): the
 /// preview fetched once, with its variance where the provider gives one (the
-/// preview correction needs it), then a few large calls for the exact pixels;
-/// with a goal, the validation search in rounds, each run in two calls at
-/// most (ReconstructToQualityWithPreview, as `dcm povray`).
+/// preview correction needs it), then a few large calls for the exact pixels.
+/// With a goal: judged by the preview's estimate where the child announced
+/// preview_samples= and the preview can tell (ReconstructToTargetFromPreview,
+/// as `dcm blender`), else the validation search in rounds, each run in two
+/// calls at most (ReconstructToQualityWithPreview, as `dcm povray`).
 Status ReconstructOnPreview(pipe::PipeProvider& provider, const ReconstructionOptions& options, const PipeFlags& f,
                             Reconstruction* rec, std::optional<QualityReport>* quality, PreviewRun* run) {
   const ProviderCapabilities caps = provider.Capabilities();
   PreviewScheduleOptions so;
   std::unique_ptr<SampleProvider> preview;
   const auto t0 = std::chrono::steady_clock::now();
-  DCM_RETURN_IF_ERROR(provider.FetchPreview({options.textureSplit && caps.splitRadiance, caps.variance}, &preview,
-                                            VariancePoolRadius(options, caps), &so.previewOwnVariance,
-                                            &so.previewTextureCovariance));
+  DCM_RETURN_IF_ERROR(provider.FetchPreview(
+      {options.textureSplit && caps.splitRadiance, caps.variance || provider.previewSamples() > 0}, &preview,
+      VariancePoolRadius(options, caps), &so.previewOwnVariance, &so.previewTextureCovariance));
   run->previewS = toolkit::SecondsSince(t0);
   ApplyRoundFlags(f.rounds, &so);
   QualityGoal goal;
   if (!QualityGoalOf(f.engine, &goal)) return ReconstructWithPreview(provider, *preview, options, so, rec, &run->sched);
+  if (f.estimateFrom != "validation") {
+    std::string why = PreviewCannotJudge(provider, options, f);
+    if (why.empty() && CanTargetFromPreview(*preview, so, &why)) {
+      if (f.engine.verbose) std::cerr << "the goal is judged by the preview's estimate\n";
+      QualityReport report;
+      DCM_RETURN_IF_ERROR(ReconstructToTargetFromPreview(provider, *preview, options, goal, so, rec, &report,
+                                                         &run->ladder));
+      run->judgedByPreview = true;
+      *quality = std::move(report);
+      return Status::Ok();
+    }
+    if (f.estimateFrom == "preview") return Status::Error("--estimate-from preview: " + why);
+    if (f.engine.verbose) std::cerr << "the goal is judged by validation pixels: " << why << "\n";
+  }
   LimitRoundsForValidation(&so);
   QualityReport report;
   DCM_RETURN_IF_ERROR(ReconstructToQualityWithPreview(provider, *preview, options, goal, so, rec, &report, &run->goal));
@@ -150,6 +186,10 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
     return Fail("--schedule preview: not with --tile, --region, --progressive or --full (they follow the levels)",
                 kExitUsage);
   }
+  if (f.estimateFrom == "preview" && schedule != RoundSchedule::kPreview)
+    return Fail("--estimate-from preview: needs the preview schedule (a provider that announced a round_latency and "
+                "a preview, or --schedule preview; not with --tile, --region, --progressive or --full)",
+                kExitUsage);
   if (f.engine.verbose && schedule == RoundSchedule::kPreview)
     std::cerr << "schedule preview: a call costs " << provider->roundCost().latencyS << " s besides "
               << provider->roundCost().perSampleS << " s a pixel; the exact pixels are chosen on the preview and "
@@ -213,11 +253,17 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
     j["schedule"] = std::string(ToString(schedule));
     if (schedule == RoundSchedule::kPreview) {
       const bool goal = quality.has_value();
+      const bool ladder = previewRun.judgedByPreview;
       j["preview"] = {{"time_s", previewRun.previewS},
-                      {"pixels_per_call", goal ? previewRun.goal.pixelsPerRound : previewRun.sched.pixelsPerRound},
-                      {"stand_ins", goal ? previewRun.goal.previewStandIns : previewRun.sched.previewStandIns}};
+                      {"pixels_per_call", ladder ? previewRun.ladder.pixelsPerRound
+                                          : goal ? previewRun.goal.pixelsPerRound
+                                                 : previewRun.sched.pixelsPerRound},
+                      {"stand_ins", ladder ? previewRun.ladder.last.previewStandIns
+                                    : goal ? previewRun.goal.previewStandIns
+                                           : previewRun.sched.previewStandIns}};
     }
     if (quality) toolkit::AddQualityJson(*quality, f.engine.targetPsnr.value_or(0), f.engine.budget.value_or(0), &j);
+    if (quality && previewRun.judgedByPreview) toolkit::AddLadderJson(previewRun.ladder, &j["quality"]);
     if (Status w = toolkit::WriteJson(f.stats, j); !w.ok()) return Fail(w.message());
   }
   if (Status w = outputs.Commit(); !w.ok()) return Fail(w.message());
@@ -260,6 +306,13 @@ Registration reg("pipe", "Reconstruct with an external renderer as a child proce
                    AddExrFormatFlags(app, &f->exr);
                    AddEngineFlags(app, &f->engine);
                    AddRoundFlags(app, &f->rounds);
+                   app->add_option("--estimate-from", f->estimateFrom,
+                                   "what judges --target-psnr and --budget on the preview schedule: the preview's "
+                                   "estimate at every pixel (a child that announced preview_samples=, noise-free "
+                                   "exact samples), validation pixels rendered exactly, or auto (the preview where "
+                                   "it can tell)")
+                       ->check(CLI::IsMember({"auto", "preview", "validation"}))
+                       ->capture_default_str();
                    AddTileFlags(app, &f->tiles);
                    return [f] { return RunPipe("pipe", *f); };
                  });

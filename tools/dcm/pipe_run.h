@@ -25,6 +25,10 @@ struct PipeFlags {
   RoundFlags rounds;  ///< --schedule and the preview schedule's flags, for a provider whose calls cost a latency
   TileFlags tiles;  ///< --tile / --region: a part of the frame for `dcm merge` (no --frames)
   toolkit::ExrFormat exr;  ///< -d, --compression, --ch (the whole frame)
+  /// --estimate-from: what judges a goal on the preview schedule: auto (the
+  /// preview where the child announced preview_samples= and it can tell),
+  /// preview, validation.
+  std::string estimateFrom = "auto";
 };
 
 /// Adds --provider-timeout and --provider-startup-timeout.

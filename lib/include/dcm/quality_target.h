@@ -199,7 +199,8 @@ Status ReconstructToQuality(SampleProvider& provider, const ReconstructionOption
 /// The estimate from per-pixel mean squared display errors `d` with weights
 /// `w` (the share of the image each stands for): exposed for tests. A `d`
 /// may be negative (an unbiased estimate of an error from which a noise
-/// variance was subtracted); a mean at or below 0 gives +inf. With `total`
+/// variance was subtracted); a mean at or below 0 gives +inf, and the lower
+/// bound is then that of a mean of 0 (an error is not negative). With `total`
 /// > 0, the weights are those of independent draws (1 / (draws * probability))
 /// whose sum is `total` on average: the Hansen-Hurwitz mean sum(w d) / total
 /// and its variance; else the weighted mean sum(w d) / sum(w) (a stratified

@@ -25,6 +25,8 @@ using Clock = ChildProcess::Clock;
 constexpr size_t kMaxLine = 4096;
 /// Largest side of the image a child may announce.
 constexpr int kMaxSide = 1 << 17;
+/// preview_samples= (a renderer's samples per pixel).
+constexpr int64_t kMaxSamplesPerPixel = int64_t(1) << 30;
 
 std::vector<std::string> Split(const std::string& s, char sep) {
   std::vector<std::string> out;
@@ -224,6 +226,11 @@ Status PipeProvider::Handshake() {
       }
     } else if (key == "name") {
       caps_.name = value;
+    } else if (key == "preview_samples") {
+      if (!ParseInt(value, &v) || v < 0 || v > kMaxSamplesPerPixel)
+        return Fail("handshake: preview_samples must be a whole number from 0 (unknown) to " +
+                    std::to_string(kMaxSamplesPerPixel) + ", got " + Quote(value));
+      previewSamples_ = double(v);
     } else if (key == "round_latency" || key == "sample_cost" || key == "preview_cost") {
       double seconds = 0;
       if (!ParseSeconds(value, &seconds))
@@ -233,6 +240,7 @@ Status PipeProvider::Handshake() {
     // Unknown keys are ignored (newer providers).
   }
   if (!haveW || !haveH) return Fail("handshake without width= and height=");
+  if (previewSamples_ > 0 && !preview_) return Fail("handshake: preview_samples= without the capability 'preview'");
   if (caps_.name.empty()) caps_.name = "pipe";
   return Status::Ok();
 }
@@ -448,7 +456,7 @@ Status PipeProvider::Preview(const Bounds2i& region, const SampleRequest& what, 
   if (region.empty() || Intersect(region, all) != region)
     return Status::Error(Prefix() + ": preview region outside the image");
   const bool split = what.split && caps_.splitRadiance;
-  const bool variance = what.variance && caps_.variance;
+  const bool variance = what.variance && (caps_.variance || previewSamples_ > 0);
   const bool texcov = textureCovariance && split && textureCovariance_;
   const std::string request = "preview " + std::to_string(region.min.x) + " " + std::to_string(region.min.y) + " " +
                               std::to_string(region.max.x) + " " + std::to_string(region.max.y) + " L" +

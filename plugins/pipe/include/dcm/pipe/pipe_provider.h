@@ -80,9 +80,16 @@ class PipeProvider final : public SampleProvider {
   /// Whether the child serves cheap preview samples (capability `preview`).
   bool hasPreview() const { return preview_; }
 
+  /// The samples per pixel of the child's preview where it announced it
+  /// (`preview_samples=`: the same image as its exact pixels, an unbiased
+  /// estimate with noise, whose variance it serves); 0: not announced (a
+  /// preview of some other kind, e.g. a lower resolution).
+  double previewSamples() const { return previewSamples_; }
+
   /// Asks the child for the preview samples of every pixel of `region`
   /// ("preview" request), row-major, with the preview's variance where
-  /// `what.variance` and the child announced `variance`. Only when hasPreview().
+  /// `what.variance` and the child announced `variance` or
+  /// `preview_samples=`. Only when hasPreview().
   /// `textureCovariance`, when given and the child announced
   /// `texture_covariance`: each pixel's covariance of the preview's estimates
   /// of the texture guide and of L (empty otherwise).
@@ -156,6 +163,7 @@ class PipeProvider final : public SampleProvider {
   bool textureCovariance_ = false;  ///< capability `texture_covariance`
   bool extra_ = false;              ///< capability `extra`
   bool exactSamples_ = false;       ///< capability `exact_samples`
+  double previewSamples_ = 0;       ///< preview_samples=, 0: none
   std::vector<Point2i> extraPixels_;      ///< the last eval's extra pixels
   std::vector<ExactSample> extraSamples_;
   int64_t evalRequests_ = 0;
