@@ -67,7 +67,34 @@ int RunShell(const std::string& command, std::string* output) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
+/// The analytic example's noise-free image of w x h pixels (its --truth),
+/// float RGB, row-major; empty where it could not be made.
+std::vector<float> AnalyticTruth(const std::string& path, int w, int h) {
+  std::string log;
+  if (RunShell(Analytic("--width " + std::to_string(w) + " --height " + std::to_string(h) + " --truth " + path), &log))
+    return {};
+  std::vector<float> ref(size_t(w) * size_t(h) * 3);
+  std::ifstream tf(path, std::ios::binary);
+  tf.read(reinterpret_cast<char*>(ref.data()), std::streamsize(ref.size() * 4));
+  return tf.good() ? ref : std::vector<float>{};
+}
+
 std::string Quoted(const std::string& s) { return "'" + s + "'"; }
+
+/// Runs `dcm pipe --quiet` on the child command `child` with `flags`, into
+/// DIR/out.exr with DIR/stats.json (`dir` ends with a slash); false (and
+/// `log` says why) where it failed or its outputs cannot be read.
+bool RunDcmPipe(const std::string& dir, const std::string& child, const std::string& flags, std::string* log,
+                nlohmann::json* stats, std::vector<dcm::RGB>* img, int* w, int* h) {
+  const std::string out = dir + "out.exr", statsPath = dir + "stats.json";
+  if (RunShell(std::string(DCM_BINARY) + " pipe --quiet --provider-cmd " + Quoted(child) + " -o " + out +
+                   " --stats " + statsPath + " " + flags,
+               log) != 0)
+    return false;
+  std::ifstream js(statsPath);
+  *stats = nlohmann::json::parse(js, nullptr, false);
+  return !stats->is_discarded() && dcm::toolkit::ReadRgb(out, w, h, img).ok() && size_t(*w) * size_t(*h) == img->size();
+}
 
 // --- PipeProvider ------------------------------------------------------------
 
@@ -628,26 +655,15 @@ TEST(DcmPipe, ReconstructsTheAnalyticScene) {
 // preview, as PROTOCOL.md promises; --schedule levels asks step by step.
 TEST(DcmPipe, ACallThatCostsALatencyIsPlannedOnThePreview) {
   TempDir dir;
-  const std::string truth = dir / "truth.raw";
+  const std::vector<float> ref = AnalyticTruth(dir / "truth.raw", 192, 144);
+  ASSERT_FALSE(ref.empty());
   std::string log;
-  ASSERT_EQ(RunShell(Analytic("--width 192 --height 144 --truth " + truth), &log), 0) << log;
-  std::vector<float> ref(size_t(192 * 144 * 3));
-  std::ifstream tf(truth, std::ios::binary);
-  tf.read(reinterpret_cast<char*>(ref.data()), std::streamsize(ref.size() * 4));
-  ASSERT_TRUE(tf.good());
   auto run = [&](const std::string& flags, nlohmann::json* j, double* meanError) {
-    const std::string out = dir / "out.exr", stats = dir / "stats.json";
-    const int rc = RunShell(std::string(DCM_BINARY) + " pipe --quiet --provider-cmd " +
-                                Quoted(Analytic("--width 192 --height 144 --round-latency 0.5")) + " -o " + out +
-                                " --stats " + stats + " " + flags,
-                            &log);
-    ASSERT_EQ(rc, 0) << log;
-    std::ifstream js(stats);
-    *j = nlohmann::json::parse(js);
     int w = 0, h = 0;
     std::vector<dcm::RGB> img;
-    ASSERT_TRUE(dcm::toolkit::ReadRgb(out, &w, &h, &img).ok());
-    ASSERT_EQ(size_t(w) * size_t(h), img.size());
+    ASSERT_TRUE(RunDcmPipe(dir / "", Analytic("--width 192 --height 144 --round-latency 0.5"), flags, &log, j, &img,
+                           &w, &h))
+        << log;
     double sum = 0;
     for (size_t i = 0; i < img.size(); ++i)
       for (int c = 0; c < 3; ++c) sum += std::fabs(double(img[i][c]) - double(ref[3 * i + size_t(c)]));
@@ -687,25 +703,14 @@ TEST(DcmPipe, ACallThatCostsALatencyIsPlannedOnThePreview) {
 // blender` does: no validation pixel, the ladder's first run in one call.
 TEST(DcmPipe, AGoalIsJudgedByAPreviewOfTheSameImageAtFewerSamples) {
   TempDir dir;
-  const std::string truth = dir / "truth.raw";
+  const std::vector<float> ref = AnalyticTruth(dir / "truth.raw", 192, 144);
+  ASSERT_FALSE(ref.empty());
   std::string log;
-  ASSERT_EQ(RunShell(Analytic("--width 192 --height 144 --truth " + truth), &log), 0) << log;
-  std::vector<float> ref(size_t(192 * 144 * 3));
-  std::ifstream tf(truth, std::ios::binary);
-  tf.read(reinterpret_cast<char*>(ref.data()), std::streamsize(ref.size() * 4));
-  ASSERT_TRUE(tf.good());
   const std::string child = Analytic("--width 192 --height 144 --round-latency 0.5 --preview-samples 64");
   auto run = [&](const std::string& flags, nlohmann::json* j, double* psnr) {
-    const std::string out = dir / "out.exr", stats = dir / "stats.json";
-    const int rc = RunShell(std::string(DCM_BINARY) + " pipe --quiet --provider-cmd " + Quoted(child) + " -o " + out +
-                                " --stats " + stats + " " + flags,
-                            &log);
-    ASSERT_EQ(rc, 0) << log;
-    std::ifstream js(stats);
-    *j = nlohmann::json::parse(js);
     int w = 0, h = 0;
     std::vector<dcm::RGB> img;
-    ASSERT_TRUE(dcm::toolkit::ReadRgb(out, &w, &h, &img).ok());
+    ASSERT_TRUE(RunDcmPipe(dir / "", child, flags, &log, j, &img, &w, &h)) << log;
     std::vector<dcm::RGB> truthImg(img.size());
     for (size_t i = 0; i < img.size(); ++i) truthImg[i] = {ref[3 * i], ref[3 * i + 1], ref[3 * i + 2]};
     *psnr = dcm::toolkit::Compare(img, truthImg, w, h).psnr;
