@@ -413,13 +413,13 @@ bool Integrator::InHighlight(const SurfaceHit& h, Vec3 dir) const {
   const Vec3 org = EmbreeScene::Offset(h.p, h.ng);
   const Vec3 wr = Normalize(Reflect(dir, h.ns));
   RGB glossy;
-  auto add = [&](Vec3 toLight, RGB irradianceAtOne) {
+  auto add = [&](Vec3 toLight, RGB intensity) {  // W/sr towards the surface
     const float dist = Length(toLight);
     if (!(dist > 0.f)) return;
     const Vec3 wi = toLight / dist;
     const float cosS = Dot(h.ns, wi);
     if (cosS <= 0.f || Dot(h.ng, wi) <= 0.f) return;
-    glossy += m.specular * irradianceAtOne * (cosS / (dist * dist) * PhongLobe(wr, wi, m.exponent));
+    glossy += m.specular * intensity * (cosS / (dist * dist) * PhongLobe(wr, wi, m.exponent));
   };
   constexpr int kGrid = 4;
   for (const Light& light : lights_) {

@@ -27,7 +27,7 @@ struct Effects {
   bool indirect = false;      ///< indirect diffuse (render.indirect.bounces > 0)
   bool shadowGuide = false;   ///< point-light visibility in the guides (render.shadow_guide)
   bool plastic = false;       ///< a plastic material with a specular lobe: highlights of direct light
-  bool highlightGuide = false;///< highlights in the guides (render.highlight_guide)
+  bool highlightGuide = false; ///< highlights in the guides (render.highlight_guide)
   /// Names of the active effects ("point_lights", "area_lights", "glossy",
   /// "mirror", "textures", "indirect", "shadow_guide", "highlight_guide").
   std::vector<std::string> Names() const;
