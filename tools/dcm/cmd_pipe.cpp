@@ -12,7 +12,9 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "commands.h"
 #include "common/elapsed.h"
@@ -53,11 +55,10 @@ namespace {
 
 /// What the preview schedule did.
 struct PreviewRun {
-  PreviewTargetStats ladder;   ///< a goal judged by the preview
-  bool judgedByPreview = false;
-  PreviewScheduleStats sched;  ///< without a goal
-  QualityRoundStats goal;      ///< with one
-  double previewS = 0;         ///< fetching the preview
+  double previewS = 0;                       ///< fetching the preview
+  std::vector<int64_t> pixelsPerCall;        ///< exact pixels of each call, whichever way the goal was judged
+  int64_t standIns = 0;                      ///< wanted pixels left at their preview value
+  std::optional<PreviewTargetStats> ladder;  ///< a goal judged by the preview
 };
 
 /// Why the preview cannot judge the goal of `f` (empty: it can, as far as
@@ -91,20 +92,28 @@ Status ReconstructOnPreview(pipe::PipeProvider& provider, const ReconstructionOp
   std::unique_ptr<SampleProvider> preview;
   const auto t0 = std::chrono::steady_clock::now();
   DCM_RETURN_IF_ERROR(provider.FetchPreview(
-      {options.textureSplit && caps.splitRadiance, caps.variance || provider.previewSamples() > 0}, &preview,
+      {options.textureSplit && caps.splitRadiance, provider.previewHasVariance()}, &preview,
       VariancePoolRadius(options, caps), &so.previewOwnVariance, &so.previewTextureCovariance));
   run->previewS = toolkit::SecondsSince(t0);
   ApplyRoundFlags(f.rounds, &so);
   QualityGoal goal;
-  if (!QualityGoalOf(f.engine, &goal)) return ReconstructWithPreview(provider, *preview, options, so, rec, &run->sched);
+  if (!QualityGoalOf(f.engine, &goal)) {
+    PreviewScheduleStats sched;
+    DCM_RETURN_IF_ERROR(ReconstructWithPreview(provider, *preview, options, so, rec, &sched));
+    run->pixelsPerCall = sched.pixelsPerRound;
+    run->standIns = sched.previewStandIns;
+    return Status::Ok();
+  }
   if (f.estimateFrom != "validation") {
     std::string why = PreviewCannotJudge(provider, options, f);
     if (why.empty() && CanTargetFromPreview(*preview, so, &why)) {
       if (f.engine.verbose) std::cerr << "the goal is judged by the preview's estimate\n";
       QualityReport report;
-      DCM_RETURN_IF_ERROR(ReconstructToTargetFromPreview(provider, *preview, options, goal, so, rec, &report,
-                                                         &run->ladder));
-      run->judgedByPreview = true;
+      PreviewTargetStats ladder;
+      DCM_RETURN_IF_ERROR(ReconstructToTargetFromPreview(provider, *preview, options, goal, so, rec, &report, &ladder));
+      run->pixelsPerCall = ladder.pixelsPerRound;
+      run->standIns = ladder.last.previewStandIns;
+      run->ladder = std::move(ladder);
       *quality = std::move(report);
       return Status::Ok();
     }
@@ -113,7 +122,10 @@ Status ReconstructOnPreview(pipe::PipeProvider& provider, const ReconstructionOp
   }
   LimitRoundsForValidation(&so);
   QualityReport report;
-  DCM_RETURN_IF_ERROR(ReconstructToQualityWithPreview(provider, *preview, options, goal, so, rec, &report, &run->goal));
+  QualityRoundStats rounds;
+  DCM_RETURN_IF_ERROR(ReconstructToQualityWithPreview(provider, *preview, options, goal, so, rec, &report, &rounds));
+  run->pixelsPerCall = rounds.pixelsPerRound;
+  run->standIns = rounds.previewStandIns;
   *quality = std::move(report);
   return Status::Ok();
 }
@@ -252,18 +264,12 @@ int RunPipe(const std::string& cmd, const PipeFlags& f) {
     if (partial) j["part"] = PartJson(tile, info);
     j["schedule"] = std::string(ToString(schedule));
     if (schedule == RoundSchedule::kPreview) {
-      const bool goal = quality.has_value();
-      const bool ladder = previewRun.judgedByPreview;
       j["preview"] = {{"time_s", previewRun.previewS},
-                      {"pixels_per_call", ladder ? previewRun.ladder.pixelsPerRound
-                                          : goal ? previewRun.goal.pixelsPerRound
-                                                 : previewRun.sched.pixelsPerRound},
-                      {"stand_ins", ladder ? previewRun.ladder.last.previewStandIns
-                                    : goal ? previewRun.goal.previewStandIns
-                                           : previewRun.sched.previewStandIns}};
+                      {"pixels_per_call", previewRun.pixelsPerCall},
+                      {"stand_ins", previewRun.standIns}};
     }
     if (quality) toolkit::AddQualityJson(*quality, f.engine.targetPsnr.value_or(0), f.engine.budget.value_or(0), &j);
-    if (quality && previewRun.judgedByPreview) toolkit::AddLadderJson(previewRun.ladder, &j["quality"]);
+    if (quality && previewRun.ladder) toolkit::AddLadderJson(*previewRun.ladder, &j["quality"]);
     if (Status w = toolkit::WriteJson(f.stats, j); !w.ok()) return Fail(w.message());
   }
   if (Status w = outputs.Commit(); !w.ok()) return Fail(w.message());

@@ -413,26 +413,31 @@ bool Integrator::InHighlight(const SurfaceHit& h, Vec3 dir) const {
   const Vec3 org = EmbreeScene::Offset(h.p, h.ng);
   const Vec3 wr = Normalize(Reflect(dir, h.ns));
   RGB glossy;
-  auto add = [&](Vec3 toLight, RGB intensity) {  // W/sr towards the surface
+  constexpr int kGrid = 4;
+  // Light from the point `y` of `light`: a point light's intensity, or a
+  // rect light's radiance times its cosine at y and a 1/kGrid^2 of its area.
+  auto add = [&](Vec3 y, const Light& light) {
+    const Vec3 toLight = y - org;
     const float dist = Length(toLight);
     if (!(dist > 0.f)) return;
     const Vec3 wi = toLight / dist;
+    RGB intensity = light.intensity;
+    if (light.kind != LightKind::kPoint) {
+      const float cosL = -Dot(wi, light.normal);
+      if (cosL <= 0.f) return;
+      intensity = light.radiance * (cosL * light.area / float(kGrid * kGrid));
+    }
     const float cosS = Dot(h.ns, wi);
     if (cosS <= 0.f || Dot(h.ng, wi) <= 0.f) return;
     glossy += m.specular * intensity * (cosS / (dist * dist) * PhongLobe(wr, wi, m.exponent));
   };
-  constexpr int kGrid = 4;
   for (const Light& light : lights_) {
     if (light.kind == LightKind::kPoint) {
-      add(light.position - org, light.intensity);
+      add(light.position, light);
       continue;
     }
     for (int j = 0; j < kGrid; ++j)
-      for (int i = 0; i < kGrid; ++i) {
-        const Vec3 y = light.PointAt({(float(i) + 0.5f) / kGrid, (float(j) + 0.5f) / kGrid});
-        const float cosL = -Dot(Normalize(y - org), light.normal);
-        if (cosL > 0.f) add(y - org, light.radiance * (cosL * light.area / float(kGrid * kGrid)));
-      }
+      for (int i = 0; i < kGrid; ++i) add(light.PointAt({(float(i) + 0.5f) / kGrid, (float(j) + 0.5f) / kGrid}), light);
   }
   return glossy.r + glossy.g + glossy.b > kHighlightLevel;
 }

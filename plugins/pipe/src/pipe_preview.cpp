@@ -15,7 +15,7 @@ Status PipeProvider::FetchPreview(const SampleRequest& what, std::unique_ptr<Sam
                                   std::vector<RGB>* textureCovariance) {
   std::vector<ExactSample> s;
   DCM_RETURN_IF_ERROR(Preview(Bounds2i{{0, 0}, {caps_.width, caps_.height}}, what, &s, textureCovariance));
-  const bool variance = what.variance && (caps_.variance || previewSamples_ > 0);
+  const bool variance = what.variance && previewHasVariance();
   GuideImage ids;
   if (variance && varianceRadius > 0)
     DCM_RETURN_IF_ERROR(

@@ -456,7 +456,7 @@ Status PipeProvider::Preview(const Bounds2i& region, const SampleRequest& what, 
   if (region.empty() || Intersect(region, all) != region)
     return Status::Error(Prefix() + ": preview region outside the image");
   const bool split = what.split && caps_.splitRadiance;
-  const bool variance = what.variance && (caps_.variance || previewSamples_ > 0);
+  const bool variance = what.variance && previewHasVariance();
   const bool texcov = textureCovariance && split && textureCovariance_;
   const std::string request = "preview " + std::to_string(region.min.x) + " " + std::to_string(region.min.y) + " " +
                               std::to_string(region.max.x) + " " + std::to_string(region.max.y) + " L" +

@@ -86,6 +86,10 @@ class PipeProvider final : public SampleProvider {
   /// preview of some other kind, e.g. a lower resolution).
   double previewSamples() const { return previewSamples_; }
 
+  /// Whether the child serves the preview's variance: it announced
+  /// `variance` or `preview_samples=`.
+  bool previewHasVariance() const { return caps_.variance || previewSamples_ > 0; }
+
   /// Asks the child for the preview samples of every pixel of `region`
   /// ("preview" request), row-major, with the preview's variance where
   /// `what.variance` and the child announced `variance` or
